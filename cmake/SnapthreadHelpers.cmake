@@ -1,0 +1,16 @@
+# snapthread_add_test(NAME SOURCES a.cc b.cc LIBS x y [LABELS l] [TIMEOUT s])
+# One GoogleTest executable, registered with ctest through gtest_discover_tests.
+function(snapthread_add_test name)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main)
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 300)
+  endif()
+  include(GoogleTest)
+  gtest_discover_tests(${name}
+    PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}"
+               ENVIRONMENT "SNAPTHREAD_SOURCE_DIR=${PROJECT_SOURCE_DIR};SNAPTHREAD_BIN_DIR=${PROJECT_BINARY_DIR}/bin"
+    DISCOVERY_TIMEOUT 60)
+endfunction()
