@@ -55,17 +55,56 @@ bool SkipString(const uint8_t* p, int size, int* pos) {
   return true;
 }
 
+// Checks `count` consecutive strings starting at byte `pos`; advances pos past them.
+bool CheckStrings(const void* data, int size, int* pos, int count, const char* type,
+                  std::string* why) {
+  const auto* p = static_cast<const uint8_t*>(data);
+  if (size < *pos) return Fail(why, std::string(type) + " truncated");
+  for (int i = 0; i < count; ++i) {
+    if (!SkipString(p, size, pos)) {
+      return Fail(why, std::string(type) + ": malformed string length");
+    }
+  }
+  return true;
+}
+
 }  // namespace
+
+// Offsets: 8-byte type hash, then the fields in .lcm order (lcmtypes/*.lcm).
+template <>
+bool PreDecodeCheck<force_model_t>(const void*, int, std::string*) {
+  return true;  // fixed size: the generated decoder checks every read against the length
+}
+
+template <>
+bool PreDecodeCheck<device_state_t>(const void* data, int size, std::string* why) {
+  int pos = 24;  // hash, utime, seq | device_id
+  return CheckStrings(data, size, &pos, 1, "device_state_t", why);
+}
+
+template <>
+bool PreDecodeCheck<solver_status_t>(const void* data, int size, std::string* why) {
+  int pos = 24;  // hash, utime, seq | scene, method
+  return CheckStrings(data, size, &pos, 2, "solver_status_t", why);
+}
+
+template <>
+bool PreDecodeCheck<device_status_t>(const void* data, int size, std::string* why) {
+  int pos = 24;  // hash, utime, seq | device_id
+  return CheckStrings(data, size, &pos, 1, "device_status_t", why);
+}
+
+template <>
+bool PreDecodeCheck<command_t>(const void* data, int size, std::string* why) {
+  int pos = 17;  // hash, utime, command (int8) | argument
+  return CheckStrings(data, size, &pos, 1, "command_t", why);
+}
 
 template <>
 bool PreDecodeCheck<thread_shape_t>(const void* data, int size, std::string* why) {
-  // Layout: hash(8) utime(8) seq(8) scene(str) model(str) num_nodes(i32) positions...
+  int pos = 24;  // hash, utime, seq | scene, model | num_nodes, positions...
+  if (!CheckStrings(data, size, &pos, 2, "thread_shape_t", why)) return false;
   const auto* p = static_cast<const uint8_t*>(data);
-  int pos = 24;
-  if (size < pos) return Fail(why, "thread_shape_t truncated");
-  if (!SkipString(p, size, &pos) || !SkipString(p, size, &pos)) {
-    return Fail(why, "thread_shape_t: malformed string field");
-  }
   int32_t num_nodes = 0;
   if (!ReadI32(p, size, &pos, &num_nodes)) return Fail(why, "thread_shape_t truncated");
   if (num_nodes < 0 || num_nodes > kMaxShapeNodes) {

@@ -36,15 +36,26 @@ bool Validate(const solver_status_t& msg, std::string* why);
 bool Validate(const device_status_t& msg, std::string* why);
 bool Validate(const command_t& msg, std::string* why);
 
-// Checks an encoded buffer before handing it to the generated decoder, for the types
-// whose decoder would otherwise allocate whatever a corrupted count says
-// (thread_shape_t: num_nodes). The generic version accepts everything.
+// Checks an encoded buffer before handing it to the generated decoder. lcm-gen 1.3.1's
+// decoders trust the wire: a string length of INT32_MIN makes them read 2 GB past the
+// buffer, and a corrupted num_nodes makes thread_shape_t allocate whatever it says. So
+// every type with a string or a variable array has its length fields checked here
+// first (each string length in [1, bytes left], num_nodes in [0, kMaxShapeNodes] and
+// within the buffer). force_model_t has neither and needs no check.
 template <class T>
-bool PreDecodeCheck(const void* /*data*/, int /*size*/, std::string* /*why*/) {
-  return true;
-}
+bool PreDecodeCheck(const void* data, int size, std::string* why);
+template <>
+bool PreDecodeCheck<force_model_t>(const void* data, int size, std::string* why);
+template <>
+bool PreDecodeCheck<device_state_t>(const void* data, int size, std::string* why);
 template <>
 bool PreDecodeCheck<thread_shape_t>(const void* data, int size, std::string* why);
+template <>
+bool PreDecodeCheck<solver_status_t>(const void* data, int size, std::string* why);
+template <>
+bool PreDecodeCheck<device_status_t>(const void* data, int size, std::string* why);
+template <>
+bool PreDecodeCheck<command_t>(const void* data, int size, std::string* why);
 
 // Decodes `data` into *out and validates it. False (with *why) for a malformed buffer
 // (wrong hash, truncated, trailing bytes, absurd counts) or an invalid message.

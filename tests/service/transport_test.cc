@@ -1,0 +1,645 @@
+// Tests of libsnapthread_transport: channel names, URL resolution, round trips of every
+// message over memq://, validation, malformed-buffer fuzzing and the lock-free
+// hand-over primitives under two-thread stress.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <algorithm>
+#include <cstdlib>
+#include <memory>
+#include <limits>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "snapthread/transport/channels.h"
+#include "snapthread/transport/clock.h"
+#include "snapthread/transport/latest_value.h"
+#include "snapthread/transport/lcm_url.h"
+#include "snapthread/transport/percentiles.h"
+#include "snapthread/transport/spsc_ring.h"
+#include "snapthread/transport/validate.h"
+
+namespace snapthread::transport {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ---- sample messages ---------------------------------------------------------------
+
+device_state_t SampleDeviceState() {
+  device_state_t m;
+  m.utime = 123456789;
+  m.seq = 42;
+  m.device_id = "virtual-hand";
+  m.position[0] = 0.01; m.position[1] = -0.02; m.position[2] = 0.03;
+  m.orientation[0] = 1.0; m.orientation[1] = 0.0; m.orientation[2] = 0.0; m.orientation[3] = 0.0;
+  m.buttons = 1;
+  return m;
+}
+
+force_model_t SampleForceModel() {
+  force_model_t m{};
+  m.utime = 1700000000000000;
+  m.seq = 7;
+  m.device_seq = 41;
+  m.device_utime = 123456000;
+  m.server_receive_utime = 1700000000000100;
+  m.solve_us = 250;
+  m.status = force_model_t::STATUS_NEAR_FOLD;
+  for (int i = 0; i < 3; ++i) {
+    m.u0[i] = 0.01 * (i + 1);
+    m.f0[i] = -0.5 * (i + 1);
+    m.torque0[i] = 0.001 * i;
+    for (int j = 0; j < 3; ++j) m.K[i][j] = (i == j) ? -300.0 : 10.0 * (i + j);
+  }
+  m.has_torque = 1;
+  m.iterations = 3;
+  m.residual = 1e-9;
+  return m;
+}
+
+thread_shape_t SampleShape(int n) {
+  thread_shape_t m{};
+  m.utime = 5;
+  m.seq = 6;
+  m.scene = "curve2d_snap";
+  m.model = "curve2d";
+  m.num_nodes = n;
+  m.positions.assign(n, std::vector<double>(3, 0.0));
+  for (int i = 0; i < n; ++i) {
+    m.positions[i][0] = i;
+    m.positions[i][1] = 0.5 * i;
+  }
+  m.grasp[0] = n;
+  m.grip_direction[0] = 1.0;
+  m.force[1] = 2.0;
+  m.force_newtons[1] = 0.2;
+  m.status = force_model_t::STATUS_SNAPPED;
+  m.snaps = 3;
+  return m;
+}
+
+solver_status_t SampleSolverStatus() {
+  solver_status_t m{};
+  m.utime = 9;
+  m.seq = 10;
+  m.scene = "zeeman";
+  m.method = "higher-order";
+  m.iterations = 2;
+  m.residual = 1e-11;
+  m.lambda_min = -0.25;
+  m.negative_pivots = 1;
+  m.status = force_model_t::STATUS_REGULAR;
+  m.update_rate_hz = 950.0;
+  m.solve_us_p50 = 40.0;
+  m.solve_us_p99 = 120.0;
+  m.updates = 1000;
+  m.snaps = 2;
+  m.dropped_poses = 5;
+  m.rejected_messages = 1;
+  return m;
+}
+
+device_status_t SampleDeviceStatus() {
+  device_status_t m{};
+  m.utime = 11;
+  m.seq = 12;
+  m.device_id = "sim-path";
+  m.tick_rate_hz = 1000.0;
+  m.lateness_us_p50 = 50;
+  m.lateness_us_p99 = 120;
+  m.lateness_us_max = 900;
+  m.model_age_ms = 1.5;
+  m.round_trip_us_p50 = 400;
+  m.round_trip_us_p99 = 1200;
+  m.force_norm_n = 0.7;
+  m.ticks = 10000;
+  m.models_received = 9000;
+  m.models_rejected = 1;
+  m.force_clamps = 2;
+  m.stiffness_clamps = 3;
+  m.slew_limits = 4;
+  m.fades = 5;
+  m.snaps_felt = 6;
+  return m;
+}
+
+command_t SampleCommand() {
+  command_t m{};
+  m.utime = 13;
+  m.command = command_t::LOAD_SCENE;
+  m.argument = "scenes/zeeman.yaml";
+  return m;
+}
+
+// Equality through the encoding: two messages are equal when their bytes are.
+template <class T>
+std::vector<uint8_t> Encode(const T& m) {
+  std::vector<uint8_t> buf(m.getEncodedSize());
+  EXPECT_EQ(m.encode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
+  return buf;
+}
+
+// ---- Channels / URL / clock ----------------------------------------------------------
+
+TEST(ChannelsTest, NamesArePrefixedBySession) {
+  Channels c("LAB_2");
+  EXPECT_EQ(c.device_state, "LAB_2_DEVICE_STATE");
+  EXPECT_EQ(c.force_model, "LAB_2_FORCE_MODEL");
+  EXPECT_EQ(c.shape, "LAB_2_SHAPE");
+  EXPECT_EQ(c.solver_status, "LAB_2_SOLVER_STATUS");
+  EXPECT_EQ(c.device_status, "LAB_2_DEVICE_STATUS");
+  EXPECT_EQ(c.command, "LAB_2_COMMAND");
+  EXPECT_EQ(Channels().device_state, "SNAPTHREAD_DEVICE_STATE");
+}
+
+TEST(ChannelsTest, RejectsInvalidSessionNames) {
+  for (const char* bad : {"", "A B", "A-B", "A.B", "ÄB", "A/B", "A*"}) {
+    EXPECT_THROW(Channels{bad}, std::invalid_argument) << bad;
+    EXPECT_FALSE(IsValidSessionName(bad)) << bad;
+  }
+  try {
+    Channels c("bad name");
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("bad name"), std::string::npos);
+  }
+}
+
+TEST(LcmUrlTest, FlagThenEnvironmentThenDefault) {
+  const char* saved = std::getenv("LCM_DEFAULT_URL");
+  std::string saved_value = saved ? saved : "";
+  unsetenv("LCM_DEFAULT_URL");
+  EXPECT_EQ(ResolveLcmUrl(""), "udpm://239.255.76.67:7667?ttl=0");
+  setenv("LCM_DEFAULT_URL", "memq://", 1);
+  EXPECT_EQ(ResolveLcmUrl(""), "memq://");
+  EXPECT_EQ(ResolveLcmUrl("udpm://239.255.76.67:7700?ttl=1"), "udpm://239.255.76.67:7700?ttl=1");
+  if (saved) {
+    setenv("LCM_DEFAULT_URL", saved_value.c_str(), 1);
+  } else {
+    unsetenv("LCM_DEFAULT_URL");
+  }
+}
+
+TEST(ClockTest, MonotonicAdvancesAndRealtimeIsRecent) {
+  const int64_t a = MonotonicMicros();
+  std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  const int64_t b = MonotonicMicros();
+  EXPECT_GE(b - a, 1500);
+  EXPECT_LT(b - a, 2000000);
+  EXPECT_GT(RealtimeMicros(), int64_t{1600000000} * 1000000);  // after 2020
+}
+
+// ---- memq:// round trips ------------------------------------------------------------
+
+template <class T>
+class Catcher {
+ public:
+  void Handle(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+    T msg;
+    std::string why;
+    if (DecodeAndValidate(rbuf, &msg, &why)) {
+      got.push_back(msg);
+    } else {
+      rejected.push_back(why);
+    }
+  }
+  std::vector<T> got;
+  std::vector<std::string> rejected;
+};
+
+template <class T>
+void RoundTrip(const T& sent) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  Catcher<T> catcher;
+  lcm.subscribe("RT_TEST", &Catcher<T>::Handle, &catcher);
+  ASSERT_EQ(lcm.publish("RT_TEST", &sent), 0);
+  for (int i = 0; i < 10 && catcher.got.empty() && catcher.rejected.empty(); ++i) {
+    lcm.handleTimeout(100);
+  }
+  ASSERT_TRUE(catcher.rejected.empty()) << catcher.rejected.front();
+  ASSERT_EQ(catcher.got.size(), 1u);
+  EXPECT_EQ(Encode(catcher.got.front()), Encode(sent));
+}
+
+TEST(RoundTripTest, DeviceState) { RoundTrip(SampleDeviceState()); }
+TEST(RoundTripTest, ForceModel) {
+  RoundTrip(SampleForceModel());
+}
+TEST(RoundTripTest, ThreadShape) {
+  RoundTrip(SampleShape(0));
+  RoundTrip(SampleShape(1));
+  RoundTrip(SampleShape(200));
+}
+TEST(RoundTripTest, SolverStatus) { RoundTrip(SampleSolverStatus()); }
+TEST(RoundTripTest, DeviceStatus) { RoundTrip(SampleDeviceStatus()); }
+TEST(RoundTripTest, Command) { RoundTrip(SampleCommand()); }
+
+TEST(RoundTripTest, ForceModelFieldsSurvive) {
+  // One explicit field-by-field check so that an encoding comparison bug cannot hide one.
+  const force_model_t sent = SampleForceModel();
+  const auto bytes = Encode(sent);
+  force_model_t got;
+  std::string why;
+  ASSERT_TRUE(DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &got, &why)) << why;
+  EXPECT_EQ(got.seq, sent.seq);
+  EXPECT_EQ(got.device_seq, sent.device_seq);
+  EXPECT_EQ(got.device_utime, sent.device_utime);
+  EXPECT_EQ(got.status, sent.status);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(got.u0[i], sent.u0[i]);
+    EXPECT_EQ(got.f0[i], sent.f0[i]);
+    for (int j = 0; j < 3; ++j) EXPECT_EQ(got.K[i][j], sent.K[i][j]);
+  }
+}
+
+// ---- Validate -------------------------------------------------------------------------
+
+TEST(ValidateTest, AcceptsSamples) {
+  std::string why;
+  EXPECT_TRUE(Validate(SampleDeviceState(), &why)) << why;
+  EXPECT_TRUE(Validate(SampleForceModel(), &why)) << why;
+  EXPECT_TRUE(Validate(SampleShape(5), &why)) << why;
+  EXPECT_TRUE(Validate(SampleSolverStatus(), &why)) << why;
+  EXPECT_TRUE(Validate(SampleDeviceStatus(), &why)) << why;
+  EXPECT_TRUE(Validate(SampleCommand(), &why)) << why;
+}
+
+TEST(ValidateTest, RejectsNonFiniteDeviceState) {
+  for (double bad : {kNaN, kInf, -kInf}) {
+    for (int i = 0; i < 3; ++i) {
+      auto m = SampleDeviceState();
+      m.position[i] = bad;
+      std::string why;
+      EXPECT_FALSE(Validate(m, &why));
+      EXPECT_NE(why.find("position"), std::string::npos) << why;
+    }
+    for (int i = 0; i < 4; ++i) {
+      auto m = SampleDeviceState();
+      m.orientation[i] = bad;
+      EXPECT_FALSE(Validate(m, nullptr));
+    }
+  }
+}
+
+TEST(ValidateTest, QuaternionNormRange) {
+  auto m = SampleDeviceState();
+  m.orientation[0] = 0.0;  // zero quaternion
+  EXPECT_FALSE(Validate(m, nullptr));
+  m.orientation[0] = 3.0;
+  EXPECT_FALSE(Validate(m, nullptr));
+  m.orientation[0] = 0.6;
+  EXPECT_TRUE(Validate(m, nullptr));
+  m.orientation[0] = 1.9;
+  EXPECT_TRUE(Validate(m, nullptr));
+}
+
+TEST(ValidateTest, RejectsNonFiniteForceModel) {
+  for (double bad : {kNaN, kInf, -kInf}) {
+    for (int i = 0; i < 3; ++i) {
+      auto a = SampleForceModel(); a.u0[i] = bad; EXPECT_FALSE(Validate(a, nullptr));
+      auto b = SampleForceModel(); b.f0[i] = bad; EXPECT_FALSE(Validate(b, nullptr));
+      auto c = SampleForceModel(); c.torque0[i] = bad; EXPECT_FALSE(Validate(c, nullptr));
+      for (int j = 0; j < 3; ++j) {
+        auto d = SampleForceModel(); d.K[i][j] = bad;
+        std::string why;
+        EXPECT_FALSE(Validate(d, &why));
+        EXPECT_NE(why.find("K"), std::string::npos);
+      }
+    }
+    auto e = SampleForceModel(); e.residual = bad; EXPECT_FALSE(Validate(e, nullptr));
+  }
+  auto s = SampleForceModel();
+  s.status = 4;
+  EXPECT_FALSE(Validate(s, nullptr));
+  s.status = -1;
+  EXPECT_FALSE(Validate(s, nullptr));
+  auto t = SampleForceModel();
+  t.has_torque = 2;
+  EXPECT_FALSE(Validate(t, nullptr));
+}
+
+TEST(ValidateTest, ShapeCountsMustAgree) {
+  auto m = SampleShape(4);
+  m.num_nodes = 5;
+  std::string why;
+  EXPECT_FALSE(Validate(m, &why));
+  EXPECT_NE(why.find("num_nodes"), std::string::npos) << why;
+  auto r = SampleShape(4);
+  r.positions[2].resize(2);
+  EXPECT_FALSE(Validate(r, &why));
+  auto neg = SampleShape(0);
+  neg.num_nodes = -1;
+  EXPECT_FALSE(Validate(neg, nullptr));
+  auto big = SampleShape(0);
+  big.num_nodes = kMaxShapeNodes + 1;
+  EXPECT_FALSE(Validate(big, nullptr));
+  auto nan = SampleShape(3);
+  nan.positions[1][2] = kNaN;
+  EXPECT_FALSE(Validate(nan, nullptr));
+  auto inf = SampleShape(3);
+  inf.force_newtons[0] = kInf;
+  EXPECT_FALSE(Validate(inf, nullptr));
+}
+
+TEST(ValidateTest, StatusesAndCommands) {
+  auto s = SampleSolverStatus();
+  s.residual = kNaN;
+  EXPECT_FALSE(Validate(s, nullptr));
+  auto d = SampleDeviceStatus();
+  d.lateness_us_p99 = kInf;
+  EXPECT_FALSE(Validate(d, nullptr));
+  auto c = SampleCommand();
+  c.command = 0;
+  EXPECT_FALSE(Validate(c, nullptr));
+  c.command = command_t::SET_METHOD;
+  EXPECT_TRUE(Validate(c, nullptr));
+  c.argument.assign(kMaxStringBytes + 1, 'x');
+  EXPECT_FALSE(Validate(c, nullptr));
+}
+
+// ---- DecodeAndValidate against malformed buffers ------------------------------------------
+
+template <class T>
+void ExpectTruncationsRejected(const T& sample) {
+  const auto bytes = Encode(sample);
+  T out;
+  std::string why;
+  ASSERT_TRUE(DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &out, &why)) << why;
+  for (size_t len = 0; len < bytes.size(); ++len) {
+    EXPECT_FALSE(DecodeAndValidate(bytes.data(), static_cast<int>(len), &out, &why)) << len;
+  }
+  // Oversized: trailing bytes after a valid message are refused too.
+  auto longer = bytes;
+  longer.resize(bytes.size() + 16, 0xAB);
+  EXPECT_FALSE(DecodeAndValidate(longer.data(), static_cast<int>(longer.size()), &out, &why));
+  EXPECT_NE(why.find("trailing"), std::string::npos) << why;
+  // Wrong type (hash mismatch).
+  const auto other = Encode(SampleCommand());
+  if constexpr (!std::is_same_v<T, command_t>) {
+    EXPECT_FALSE(DecodeAndValidate(other.data(), static_cast<int>(other.size()), &out, &why));
+  }
+}
+
+TEST(DecodeTest, TruncatedOversizedAndWrongTypeRejected) {
+  ExpectTruncationsRejected(SampleDeviceState());
+  ExpectTruncationsRejected(SampleForceModel());
+  ExpectTruncationsRejected(SampleShape(7));
+  ExpectTruncationsRejected(SampleSolverStatus());
+  ExpectTruncationsRejected(SampleDeviceStatus());
+  ExpectTruncationsRejected(SampleCommand());
+}
+
+TEST(DecodeTest, HugeShapeCountIsRefusedBeforeAllocation) {
+  auto m = SampleShape(2);
+  auto bytes = Encode(m);
+  // num_nodes sits after hash, utime, seq and the two strings (4-byte length + bytes + NUL).
+  const size_t pos = 24 + 4 + m.scene.size() + 1 + 4 + m.model.size() + 1;
+  for (uint32_t bad : {0x7fffffffu, 0x80000000u, 0xffffffffu, 100001u, 3u}) {
+    bytes[pos + 0] = static_cast<uint8_t>(bad >> 24);
+    bytes[pos + 1] = static_cast<uint8_t>(bad >> 16);
+    bytes[pos + 2] = static_cast<uint8_t>(bad >> 8);
+    bytes[pos + 3] = static_cast<uint8_t>(bad);
+    thread_shape_t out;
+    std::string why;
+    EXPECT_FALSE(DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &out, &why)) << bad;
+  }
+}
+
+TEST(DecodeTest, CorruptStringLengthDoesNotThrow) {
+  auto m = SampleDeviceState();
+  auto bytes = Encode(m);
+  // device_id's length field follows hash, utime and seq.
+  for (uint32_t bad : {0u, 0xffffffffu, 0x80000000u, 0x7fffffffu}) {
+    bytes[24] = static_cast<uint8_t>(bad >> 24);
+    bytes[25] = static_cast<uint8_t>(bad >> 16);
+    bytes[26] = static_cast<uint8_t>(bad >> 8);
+    bytes[27] = static_cast<uint8_t>(bad);
+    device_state_t out;
+    std::string why;
+    EXPECT_NO_THROW(
+        EXPECT_FALSE(DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &out, &why)))
+        << bad;
+  }
+}
+
+// Random garbage, and valid messages with random byte flips: never a crash, a throw or
+// an accepted message with non-finite content.
+template <class T>
+void Fuzz(const T& sample, uint32_t seed, int* accepted) {
+  std::mt19937 rng(seed);
+  const auto valid = Encode(sample);
+  std::uniform_int_distribution<int> byte(0, 255);
+  std::uniform_int_distribution<int> len(0, static_cast<int>(valid.size()) * 2 + 8);
+  for (int iter = 0; iter < 3000; ++iter) {
+    std::vector<uint8_t> buf;
+    if (iter % 2 == 0) {
+      buf.resize(len(rng));
+      for (auto& b : buf) b = static_cast<uint8_t>(byte(rng));
+      // Keep the right hash half of the time so the decoder goes past the first check.
+      if (iter % 4 == 0 && buf.size() >= 8) std::copy(valid.begin(), valid.begin() + 8, buf.begin());
+    } else {
+      buf = valid;
+      std::uniform_int_distribution<size_t> where(8, buf.size() - 1);
+      const int flips = 1 + iter % 4;
+      for (int f = 0; f < flips; ++f) buf[where(rng)] = static_cast<uint8_t>(byte(rng));
+    }
+    T out;
+    std::string why;
+    bool ok = false;
+    EXPECT_NO_THROW(ok = DecodeAndValidate(buf.data(), static_cast<int>(buf.size()), &out, &why));
+    if (ok) {
+      ++*accepted;
+      EXPECT_TRUE(Validate(out, &why)) << why;
+    }
+  }
+}
+
+TEST(DecodeTest, FuzzEveryType) {
+  int accepted = 0;
+  Fuzz(SampleDeviceState(), 1, &accepted);
+  Fuzz(SampleForceModel(), 2, &accepted);
+  Fuzz(SampleShape(10), 3, &accepted);
+  Fuzz(SampleSolverStatus(), 4, &accepted);
+  Fuzz(SampleDeviceStatus(), 5, &accepted);
+  Fuzz(SampleCommand(), 6, &accepted);
+  // Flipping bytes of doubles often still gives a valid message: the fuzz reaches Validate.
+  EXPECT_GT(accepted, 0);
+}
+
+TEST(DecodeTest, GarbageOverMemqIsCountedNotFatal) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  Catcher<force_model_t> catcher;
+  lcm.subscribe("FUZZ", &Catcher<force_model_t>::Handle, &catcher);
+  std::mt19937 rng(99);
+  std::uniform_int_distribution<int> byte(0, 255);
+  for (int i = 0; i < 200; ++i) {
+    std::vector<uint8_t> buf(1 + i % 300);
+    for (auto& b : buf) b = static_cast<uint8_t>(byte(rng));
+    lcm.publish("FUZZ", buf.data(), static_cast<unsigned>(buf.size()));
+  }
+  auto bad = SampleForceModel();
+  bad.K[1][1] = kNaN;
+  lcm.publish("FUZZ", &bad);
+  const auto good = SampleForceModel();
+  lcm.publish("FUZZ", &good);
+  while (lcm.handleTimeout(10) > 0) {
+  }
+  EXPECT_EQ(catcher.rejected.size(), 201u);
+  EXPECT_EQ(catcher.got.size(), 1u);
+}
+
+// ---- LatestValue / SpscRing ------------------------------------------------------------
+
+// A value whose fields must always agree: a torn read shows up as a mismatch.
+struct Stamped {
+  uint64_t seq;
+  double a[16];
+  uint64_t check;
+};
+
+Stamped MakeStamped(uint64_t seq) {
+  Stamped s{};
+  s.seq = seq;
+  for (int i = 0; i < 16; ++i) s.a[i] = static_cast<double>(seq) * (i + 1);
+  s.check = ~seq;
+  return s;
+}
+
+bool Consistent(const Stamped& s) {
+  if (s.check != ~s.seq) return false;
+  for (int i = 0; i < 16; ++i) {
+    if (s.a[i] != static_cast<double>(s.seq) * (i + 1)) return false;
+  }
+  return true;
+}
+
+TEST(LatestValueTest, EmptyThenLatestWins) {
+  LatestValue<Stamped> lv;
+  Stamped out{};
+  bool fresh = true;
+  EXPECT_FALSE(lv.Read(&out, &fresh));
+  EXPECT_FALSE(fresh);
+  lv.Write(MakeStamped(1));
+  lv.Write(MakeStamped(2));
+  ASSERT_TRUE(lv.Read(&out, &fresh));
+  EXPECT_TRUE(fresh);
+  EXPECT_EQ(out.seq, 2u);
+  ASSERT_TRUE(lv.Read(&out, &fresh));
+  EXPECT_FALSE(fresh);
+  EXPECT_EQ(out.seq, 2u);
+  lv.Write(MakeStamped(3));
+  ASSERT_TRUE(lv.Read(&out, &fresh));
+  EXPECT_TRUE(fresh);
+  EXPECT_EQ(out.seq, 3u);
+  EXPECT_EQ(lv.writes(), 3u);
+}
+
+TEST(LatestValueTest, TwoThreadStressNeverTornNeverBackwards) {
+  LatestValue<Stamped> lv;
+  constexpr uint64_t kWrites = 400000;
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    for (uint64_t i = 1; i <= kWrites; ++i) lv.Write(MakeStamped(i));
+    done.store(true);
+  });
+  uint64_t last = 0;
+  uint64_t reads = 0, torn = 0, backwards = 0, fresh_count = 0;
+  while (true) {
+    const bool finished = done.load();
+    bool fresh = false;
+    const Stamped* s = lv.Latest(&fresh);
+    if (s != nullptr) {
+      ++reads;
+      if (!Consistent(*s)) ++torn;
+      if (s->seq < last) ++backwards;
+      if (fresh) ++fresh_count;
+      last = s->seq;
+    }
+    if (finished) break;
+  }
+  writer.join();
+  const Stamped* s = lv.Latest();
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(s->seq, kWrites);  // the final value is always delivered
+  EXPECT_EQ(torn, 0u);
+  EXPECT_EQ(backwards, 0u);
+  EXPECT_GT(fresh_count, 1u);
+  EXPECT_GT(reads, 0u);
+}
+
+TEST(SpscRingTest, FifoAndFull) {
+  SpscRing<Stamped, 4> ring;
+  Stamped out{};
+  EXPECT_FALSE(ring.TryPop(&out));
+  for (uint64_t i = 0; i < 4; ++i) EXPECT_TRUE(ring.TryPush(MakeStamped(i)));
+  EXPECT_FALSE(ring.TryPush(MakeStamped(99)));
+  EXPECT_EQ(ring.dropped(), 1u);
+  EXPECT_EQ(ring.size(), 4u);
+  for (uint64_t i = 0; i < 4; ++i) {
+    ASSERT_TRUE(ring.TryPop(&out));
+    EXPECT_EQ(out.seq, i);
+  }
+  EXPECT_FALSE(ring.TryPop(&out));
+}
+
+TEST(SpscRingTest, TwoThreadStressDeliversEverythingInOrder) {
+  auto ring = std::make_unique<SpscRing<Stamped, 64>>();  // small: forces full/empty races
+  constexpr uint64_t kItems = 500000;
+  std::thread producer([&] {
+    for (uint64_t i = 0; i < kItems;) {
+      if (ring->TryPush(MakeStamped(i))) ++i;
+    }
+  });
+  uint64_t expected = 0, errors = 0;
+  Stamped out{};
+  while (expected < kItems) {
+    if (ring->TryPop(&out)) {
+      if (out.seq != expected || !Consistent(out)) ++errors;
+      expected = out.seq + 1;
+    }
+  }
+  producer.join();
+  EXPECT_EQ(errors, 0u);
+  EXPECT_EQ(expected, kItems);
+  EXPECT_FALSE(ring->TryPop(&out));
+}
+
+// ---- SampleWindow ---------------------------------------------------------------------
+
+TEST(SampleWindowTest, PercentilesOfKnownSamples) {
+  SampleWindow w(1000);
+  EXPECT_EQ(w.Compute().count, 0u);
+  // 1..1000 shuffled: p50 = 500, p99 = 990, max = 1000 (nearest rank).
+  std::vector<double> v(1000);
+  for (int i = 0; i < 1000; ++i) v[i] = i + 1;
+  std::shuffle(v.begin(), v.end(), std::mt19937(3));
+  for (double x : v) w.Push(x);
+  const auto s = w.Compute();
+  EXPECT_EQ(s.count, 1000u);
+  EXPECT_EQ(s.p50, 500.0);
+  EXPECT_EQ(s.p99, 990.0);
+  EXPECT_EQ(s.max, 1000.0);
+  EXPECT_DOUBLE_EQ(s.mean, 500.5);
+}
+
+TEST(SampleWindowTest, KeepsOnlyTheNewestSamples) {
+  SampleWindow w(10);
+  for (int i = 0; i < 100; ++i) w.Push(1000.0);
+  for (int i = 0; i < 10; ++i) w.Push(i);
+  const auto s = w.Compute();
+  EXPECT_EQ(s.count, 10u);
+  EXPECT_EQ(s.max, 9.0);
+  EXPECT_EQ(w.total_pushed(), 110u);
+  EXPECT_THROW(SampleWindow(0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace snapthread::transport
