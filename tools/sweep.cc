@@ -1,0 +1,96 @@
+#include "sweep.h"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "snapthread/models.h"
+
+namespace snapthread {
+
+std::unique_ptr<EquilibriumTracker> MakeTracker(const Scene& scene) {
+  auto t = std::make_unique<EquilibriumTracker>(MakeModel(scene.params), scene.solver);
+  const bool chain = scene.params.model == "curve2d" || scene.params.model == "thread3d";
+  t->SetSnapThreshold(chain ? 0.1 * scene.params.segment_length : 0.1);
+  return t;
+}
+
+std::vector<Vec> SweepControls(const Scene& scene, const SweepSpec& spec) {
+  const int m = static_cast<int>(scene.grasp_start.size());
+  const int d = static_cast<int>(spec.from.size());
+  if (spec.to.size() != d || d > m) throw std::invalid_argument("sweep: --from/--to size mismatch");
+  if (spec.steps < 1) throw std::invalid_argument("sweep: --steps must be >= 1");
+  std::vector<Vec> us;
+  auto at = [&](double t) {
+    Vec u = scene.grasp_start;
+    u.head(d) = spec.from + t * (spec.to - spec.from);
+    return u;
+  };
+  for (int i = 0; i <= spec.steps; ++i) us.push_back(at(static_cast<double>(i) / spec.steps));
+  if (spec.back)
+    for (int i = spec.steps - 1; i >= 0; --i) us.push_back(at(static_cast<double>(i) / spec.steps));
+  return us;
+}
+
+std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls) {
+  std::vector<SweepRow> rows;
+  rows.reserve(controls.size());
+  for (size_t i = 0; i < controls.size(); ++i) {
+    const TrackResult& r = i == 0 ? tracker->Reset(controls[i]) : tracker->Update(controls[i]);
+    SweepRow row;
+    row.step = static_cast<int>(i);
+    row.u = controls[i];
+    row.force = r.force;
+    row.probe = r.probe;
+    row.energy = r.energy;
+    row.residual = r.summary.residual;
+    row.lambda_min = r.summary.lambda_min;
+    row.solve_us = r.summary.solve_us;
+    row.iterations = r.summary.iterations;
+    row.gradient_evaluations = r.summary.gradient_evaluations;
+    row.hessian_evaluations = r.summary.hessian_evaluations;
+    row.snapped = i > 0 && r.snapped;
+    row.status = r.summary.status;
+    row.termination = r.summary.termination;
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+void WriteSweepCsv(const std::vector<SweepRow>& rows, Method method, std::ostream& out) {
+  out << "step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,"
+         "solve_us,status,termination,gradient_evals,hessian_evals\n";
+  out << std::setprecision(12);
+  for (const SweepRow& r : rows) {
+    auto comp = [](const Vec& v, int i) { return i < v.size() ? v[i] : 0.0; };
+    const bool planar = r.u.size() == 2;
+    out << r.step << ',' << comp(r.u, 0) << ',' << comp(r.u, 1) << ',' << (planar ? 0.0 : comp(r.u, 2)) << ','
+        << comp(r.force, 0) << ',' << comp(r.force, 1) << ',' << (planar ? 0.0 : comp(r.force, 2)) << ','
+        << r.probe << ',' << r.energy << ',' << r.residual << ',' << r.iterations << ',' << ToString(method)
+        << ',' << r.lambda_min << ',' << (r.snapped ? 1 : 0) << ',' << std::setprecision(4) << r.solve_us
+        << std::setprecision(12) << ',' << ToString(r.status) << ',' << ToString(r.termination) << ','
+        << r.gradient_evaluations << ',' << r.hessian_evaluations << '\n';
+  }
+}
+
+Vec ParsePoint(const std::string& text, int dim, const std::string& what) {
+  std::vector<double> vals;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) {
+    try {
+      size_t used = 0;
+      const double v = std::stod(item, &used);
+      if (used != item.size() || !std::isfinite(v)) throw std::invalid_argument(item);
+      vals.push_back(v);
+    } catch (const std::exception&) {
+      throw std::invalid_argument(what + ": '" + item + "' is not a finite number");
+    }
+  }
+  if (static_cast<int>(vals.size()) != dim)
+    throw std::invalid_argument(what + ": expected " + std::to_string(dim) + " comma-separated numbers (" +
+                                (dim == 2 ? "X,Y" : "X,Y,Z") + "), got '" + text + "'");
+  return Eigen::Map<Vec>(vals.data(), dim);
+}
+
+}  // namespace snapthread

@@ -88,6 +88,9 @@ class EquilibriumSolver {
   // The factorisation of E_xx at the returned state (for implicit differentiation);
   // null if the last Solve could not factorise it.
   virtual const SymmetricLinearSolver* Factorization() const = 0;
+  // Unit eigenvector estimate of E_xx's smallest eigenvalue (summary.lambda_min) at the
+  // returned state, tracked by inverse iteration with the factorisation.
+  virtual const Vec& LowestEigenvector() const = 0;
 };
 
 // Throws std::invalid_argument if !options.IsValid().

@@ -45,6 +45,9 @@ class EquilibriumTracker {
   const Vec& state() const { return x_; }
   const Vec& control() const { return u_; }
   const TrackResult& last() const { return result_; }
+  // A state change larger than this (max norm, model units) against the predicted
+  // state counts as a jump to another branch (default 0.1; scenes set 0.1 l).
+  void SetSnapThreshold(double t) { snap_threshold_ = t; }
 
  private:
   void ComputeForces();
@@ -54,9 +57,11 @@ class EquilibriumTracker {
   std::unique_ptr<EquilibriumSolver> solver_;
   Vec x_, x_prev_, u_, u_prev_;
   bool have_prev_ = false;
+  double snap_threshold_ = 0.1;
+  double lambda_ref_ = -1.0;
   TrackResult result_;
   // scratch
-  Vec eu_, scratch_;
+  Vec eu_, scratch_, x_pred_;
   Mat exu_, euu_, sol_;
 };
 

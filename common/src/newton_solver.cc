@@ -1,1 +1,199 @@
-// (being written)
+#include "newton_solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace snapthread {
+
+SolverBase::SolverBase(const Model& model, const SolverOptions& options)
+    : model_(model), options_(options), n_(model.NumStates()) {
+  h_ = model_.HessianPattern();
+  h_mod_ = h_;
+  std::string error;
+  factor_ = MakeLinearSolver(options_.linear_solver, n_, model_.HessianBandwidth(), &error);
+  alt_factor_ = MakeLinearSolver(options_.linear_solver, n_, model_.HessianBandwidth(), &error);
+  if (!factor_ || !alt_factor_) throw std::invalid_argument("solver.linear_solver: " + error);
+  if (factor_->Analyze(h_) != LinearSolverStatus::kSuccess ||
+      alt_factor_->Analyze(h_) != LinearSolverStatus::kSuccess) {
+    throw std::runtime_error("linear solver analysis failed: " + factor_->message());
+  }
+  diag_index_.assign(n_, -1);
+  for (int j = 0; j < n_; ++j) {
+    for (int p = h_.outerIndexPtr()[j]; p < h_.outerIndexPtr()[j + 1]; ++p) {
+      if (h_.innerIndexPtr()[p] == j) diag_index_[j] = p;
+    }
+    if (diag_index_[j] < 0) throw std::logic_error("Hessian pattern lacks a diagonal entry");
+  }
+  eig_.Resize(n_);
+  g_.resize(n_);
+  dx_.resize(n_);
+  trial_.resize(n_);
+  last_good_.resize(n_);
+}
+
+void SolverBase::Reset() {
+  eig_.Reset();
+  factor_valid_ = false;
+  lambda_ref_ = -1.0;
+}
+
+void SolverBase::Classify(SolverSummary* s) {
+  const bool indefinite = s->negative_pivots != 0;
+  const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : s->lambda_min;
+  const bool near_fold = indefinite || !(s->lambda_min > options_.degeneracy_ratio * ref);
+  if (!near_fold && (s->IsConverged() || s->snapped)) lambda_ref_ = s->lambda_min;
+  s->status = s->snapped ? EquilibriumStatus::kSnapped
+                         : (near_fold ? EquilibriumStatus::kNearFold : EquilibriumStatus::kRegular);
+}
+
+int SolverBase::Budget() const {
+  return options_.max_iterations > 0 ? options_.max_iterations : SolverOptions::kUnlimitedIterations;
+}
+
+void SolverBase::BeginSolve(SolverSummary* s) {
+  *s = SolverSummary{};
+  start_ = Clock::now();
+  factor_valid_ = false;
+}
+
+bool SolverBase::BudgetLeft(const SolverSummary& s) const {
+  if (s.iterations >= Budget()) return false;
+  if (options_.max_time_us > 0.0) {
+    const double us = std::chrono::duration<double, std::micro>(Clock::now() - start_).count();
+    if (us >= options_.max_time_us) return false;
+  }
+  return true;
+}
+
+double SolverBase::EvalGradient(const Vec& x, const Vec& u, Vec* g, SolverSummary* s) const {
+  model_.Gradient(x, u, g);
+  ++s->gradient_evaluations;
+  return g->norm();
+}
+
+LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummary* s) {
+  model_.Hessian(x, u, &h_);
+  ++s->hessian_evaluations;
+  ++s->factorizations;
+  const LinearSolverStatus st = factor_->Factorize(h_);
+  factor_valid_ = st == LinearSolverStatus::kSuccess;
+  return st;
+}
+
+LinearSolverStatus SolverBase::FactorShifted(double shift, SolverSummary* s) {
+  std::copy(h_.valuePtr(), h_.valuePtr() + h_.nonZeros(), h_mod_.valuePtr());
+  for (int i = 0; i < n_; ++i) h_mod_.valuePtr()[diag_index_[i]] += shift;
+  ++s->factorizations;
+  return alt_factor_->Factorize(h_mod_);
+}
+
+bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s) {
+  // Inertia-corrected Newton (Nocedal & Wright, Alg. 3.3): add tau I until the LDL^T
+  // has no negative pivot, then backtrack on the energy (Armijo).
+  const LinearSolverStatus st = FactorAt(*x, u, s);
+  const SymmetricLinearSolver* f = factor_.get();
+  if (st != LinearSolverStatus::kSuccess || factor_->NegativePivots() > 0) {
+    double max_diag = 0.0;
+    for (int i = 0; i < n_; ++i) max_diag = std::max(max_diag, std::abs(h_.valuePtr()[diag_index_[i]]));
+    double tau = std::max(1e-3 * max_diag, 1e-8);
+    bool ok = false;
+    for (int k = 0; k < 60; ++k) {
+      if (FactorShifted(tau, s) == LinearSolverStatus::kSuccess && alt_factor_->NegativePivots() == 0) {
+        ok = true;
+        break;
+      }
+      tau *= 4.0;
+    }
+    if (!ok) return false;
+    f = alt_factor_.get();
+  }
+  if (f->Solve(*g, &dx_) != LinearSolverStatus::kSuccess) return false;
+  dx_ = -dx_;
+  const double e0 = model_.Energy(*x, u);
+  const double slope = g->dot(dx_);
+  if (!(slope < 0.0)) return false;
+  double alpha = 1.0;
+  for (int k = 0; k < 40; ++k) {
+    trial_ = *x + alpha * dx_;
+    const double e = model_.Energy(trial_, u);
+    if (std::isfinite(e) && e <= e0 + 1e-4 * alpha * slope) {
+      x->swap(trial_);
+      return true;
+    }
+    alpha *= 0.5;
+  }
+  return false;
+}
+
+void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s) {
+  s->residual = EvalGradient(x, u, &g_, s);
+  s->energy = model_.Energy(x, u);
+  // The factorisation at the returned state serves implicit differentiation (K) and
+  // the eigenvalue estimate.
+  const LinearSolverStatus st = FactorAt(x, u, s);
+  if (st == LinearSolverStatus::kSuccess) {
+    s->negative_pivots = factor_->NegativePivots();
+    s->lambda_min = eig_.Update(*factor_, h_, 2);
+  } else {
+    s->negative_pivots = -1;
+    s->lambda_min = 0.0;  // singular to working precision
+  }
+  s->solve_us = std::chrono::duration<double, std::micro>(Clock::now() - start_).count();
+}
+
+NewtonSolver::NewtonSolver(const Model& model, const SolverOptions& options)
+    : SolverBase(model, options) {}
+
+SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
+  SolverSummary s;
+  BeginSolve(&s);
+  const bool line_search = options_.method == Method::kNewtonLineSearch;
+  Vec& x_ref = *x;
+  Vec& last_good = last_good_;  // last finite state, restored on NaN
+  last_good = x_ref;
+  double r = EvalGradient(x_ref, u, &g_, &s);
+  s.termination = Termination::kBudgetSpent;
+  while (true) {
+    if (!std::isfinite(r)) {
+      x_ref = last_good;
+      s.termination = Termination::kNonFinite;
+      s.message = "non-finite gradient; state restored";
+      break;
+    }
+    if (r < options_.cutoff) {
+      s.termination = Termination::kConverged;
+      break;
+    }
+    if (!BudgetLeft(s)) break;
+    ++s.iterations;
+    last_good = x_ref;
+    if (line_search) {
+      if (!GlobalizedStep(u, &x_ref, &g_, &s)) {
+        s.termination = Termination::kLinearSolverFailed;
+        s.message = "no descent step found";
+        break;
+      }
+    } else {
+      // (2.18): linearise the field E_x at x_i, solve for its zero.
+      if (FactorAt(x_ref, u, &s) != LinearSolverStatus::kSuccess ||
+          factor_->Solve(g_, &dx_) != LinearSolverStatus::kSuccess) {
+        s.termination = Termination::kLinearSolverFailed;
+        s.message = std::string("factorisation failed: ") + factor_->message();
+        break;
+      }
+      x_ref -= dx_;
+    }
+    r = EvalGradient(x_ref, u, &g_, &s);
+  }
+  if (!x_ref.allFinite()) {
+    x_ref = last_good;
+    s.termination = Termination::kNonFinite;
+  }
+  Finish(x_ref, u, &s);
+  Classify(&s);
+  return s;
+}
+
+}  // namespace snapthread

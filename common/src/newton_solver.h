@@ -1,0 +1,67 @@
+// Newton-type equilibrium solvers and the machinery every method shares.
+#pragma once
+
+#include <chrono>
+#include <memory>
+
+#include "eigen_tracking.h"
+#include "snapthread/solver.h"
+
+namespace snapthread {
+
+// State shared by all methods: the model, one Hessian with its fixed pattern, its
+// factorisation (symbolic analysis done once), a second factorisation object for
+// modified matrices with the same pattern (shifted or restricted), the tracked lowest
+// eigenpair, and evaluation counters.
+class SolverBase : public EquilibriumSolver {
+ public:
+  SolverBase(const Model& model, const SolverOptions& options);
+  Method method() const override { return options_.method; }
+  void Reset() override;
+  const SymmetricLinearSolver* Factorization() const override {
+    return factor_valid_ ? factor_.get() : nullptr;
+  }
+  const Vec& LowestEigenvector() const override { return eig_.vector(); }
+
+ protected:
+  using Clock = std::chrono::steady_clock;
+
+  void BeginSolve(SolverSummary* s);
+  bool BudgetLeft(const SolverSummary& s) const;
+  double EvalGradient(const Vec& x, const Vec& u, Vec* g, SolverSummary* s) const;
+  // Assembles E_xx at x into h_ and factorises it into factor_.
+  LinearSolverStatus FactorAt(const Vec& x, const Vec& u, SolverSummary* s);
+  // Factorises h_ + shift I into alt_factor_ (pattern includes the diagonal).
+  LinearSolverStatus FactorShifted(double shift, SolverSummary* s);
+  // Final bookkeeping at the returned state: factorisation for implicit
+  // differentiation, lowest eigenpair, inertia, residual, energy, timing.
+  void Finish(const Vec& x, const Vec& u, SolverSummary* s);
+  // Newton-ls step: inertia-corrected Newton direction + Armijo backtracking from x
+  // with gradient g. Returns false if no decrease could be found.
+  bool GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s);
+  int Budget() const;
+  // Sets summary.status from the final eigenvalue against the reference lambda_0 of
+  // the last regular converged state (DESIGN.md #1), and updates that reference.
+  void Classify(SolverSummary* s);
+
+  const Model& model_;
+  SolverOptions options_;
+  int n_;
+  SparseMatrix h_, h_mod_;
+  std::unique_ptr<SymmetricLinearSolver> factor_, alt_factor_;
+  bool factor_valid_ = false;
+  double lambda_ref_ = -1.0;  // lambda_0 at the last regular converged state
+  std::vector<int> diag_index_;  // position of (i,i) in h_.valuePtr()
+  SmallestEigenpair eig_;
+  Vec g_, dx_, trial_, last_good_;
+  Clock::time_point start_;
+};
+
+// newton (2.18) and newton-ls.
+class NewtonSolver final : public SolverBase {
+ public:
+  NewtonSolver(const Model& model, const SolverOptions& options);
+  SolverSummary Solve(const Vec& u, Vec* x) override;
+};
+
+}  // namespace snapthread

@@ -1,0 +1,49 @@
+// Quasi-static sweeps of a scene along a straight control path (snapthread-sweep, the
+// stability suite and the benchmarks share this).
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "snapthread/scene.h"
+#include "snapthread/tracker.h"
+
+namespace snapthread {
+
+struct SweepSpec {
+  Vec from, to;      // position part of the controls (2 or 3 entries)
+  int steps = 100;   // N equal steps: rows 0..N
+  bool back = false; // continue N more steps back to `from` (2N+1 rows)
+};
+
+struct SweepRow {
+  int step = 0;
+  Vec u;                 // full controls
+  Vec force;             // F = -E_u
+  double probe = 0.0, energy = 0.0, residual = 0.0, lambda_min = 0.0, solve_us = 0.0;
+  int iterations = 0, gradient_evaluations = 0, hessian_evaluations = 0;
+  bool snapped = false;
+  EquilibriumStatus status = EquilibriumStatus::kRegular;
+  Termination termination = Termination::kConverged;
+};
+
+// The control at each row of the sweep (the direction part of a gripped thread3d
+// scene stays at the scene's grasp direction).
+std::vector<Vec> SweepControls(const Scene& scene, const SweepSpec& spec);
+
+// Resets a tracker at the first control (solved to the cutoff) and updates it along
+// the path. Row 0 is the reset state.
+std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls);
+
+// A tracker for the scene (model from its params, its solver options).
+std::unique_ptr<EquilibriumTracker> MakeTracker(const Scene& scene);
+
+// The CSV of snapthread-sweep: header, then one line per row. The first columns are
+// step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,solve_us
+void WriteSweepCsv(const std::vector<SweepRow>& rows, Method method, std::ostream& out);
+
+// Parses "x,y[,z]" with `dim` finite numbers; throws std::invalid_argument naming `what`.
+Vec ParsePoint(const std::string& text, int dim, const std::string& what);
+
+}  // namespace snapthread
