@@ -1,0 +1,486 @@
+#include "server.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <utility>
+
+#include <spdlog/spdlog.h>
+
+#include "pose_mapping.h"
+#include "server_messages.h"
+#include "snapthread/models.h"
+#include "snapthread/transport/clock.h"
+#include "snapthread/transport/lcm_url.h"
+#include "snapthread/transport/validate.h"
+
+namespace snapthread::server {
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+constexpr int64_t kLogPeriodUs = 1000000;  // rate limit for repeated warnings: 1 per second
+constexpr int kHandleTimeoutMs = 50;       // how long Stop() may wait for the receive thread
+
+int64_t SteadyMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             SteadyClock::now().time_since_epoch())
+      .count();
+}
+
+// True at most once per kLogPeriodUs per *last (any thread).
+bool ShouldLog(std::atomic<int64_t>* last) {
+  const int64_t now = SteadyMicros();
+  int64_t prev = last->load(std::memory_order_relaxed);
+  if (now - prev < kLogPeriodUs && prev != 0) return false;
+  return last->compare_exchange_strong(prev, now);
+}
+
+std::string Format(const Vec& v) {
+  std::string out;
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (i > 0) out += ", ";
+    out += std::to_string(v[i]);
+  }
+  return out;
+}
+
+SteadyClock::duration Period(double rate_hz) {
+  return std::chrono::duration_cast<SteadyClock::duration>(
+      std::chrono::duration<double>(1.0 / rate_hz));
+}
+
+}  // namespace
+
+struct Server::Session {
+  Scene scene;
+  std::unique_ptr<EquilibriumTracker> tracker;
+};
+
+Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
+    : params_(params), hooks_(std::move(hooks)) {
+  std::string error;
+  if (!params_.IsValid(&error)) throw std::invalid_argument(error);
+  channels_ = transport::Channels(params_.session);
+  method_override_ = params_.method;
+
+  // The scene first: a bad scene is the user's most likely mistake, report it before
+  // touching the network.
+  Scene scene = LoadScene(params_.scene_path);
+  session_ = MakeSession(scene);
+
+  if (lcm != nullptr) {
+    lcm_ = lcm;
+    lcm_url_ = "(provided)";
+  } else {
+    lcm_url_ = transport::ResolveLcmUrl(params_.lcm_url);
+    owned_lcm_ = std::make_unique<lcm::LCM>(lcm_url_);
+    if (!owned_lcm_->good()) {
+      throw LcmInitError("LCM failed to start on " + lcm_url_ + ": " +
+                         transport::LcmStartHint(lcm_url_));
+    }
+    lcm_ = owned_lcm_.get();
+  }
+}
+
+Server::~Server() { Stop(); }
+
+std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
+  auto session = std::make_unique<Session>();
+  session->scene = scene;
+  SolverOptions options = scene.solver;
+  if (!method_override_.empty()) {
+    Method m;
+    if (!ParseMethod(method_override_, &m)) {
+      throw std::invalid_argument("unknown method '" + method_override_ + "'");
+    }
+    options.method = m;
+  }
+  session->scene.solver = options;
+  // MakeModel / the tracker throw std::invalid_argument for invalid parameters.
+  session->tracker = std::make_unique<EquilibriumTracker>(MakeModel(scene.params), options);
+  if (scene.grasp_start.size() != session->tracker->model().NumControls()) {
+    throw SceneError(scene.file + ": grasp_start has " +
+                     std::to_string(scene.grasp_start.size()) + " entries, model " +
+                     std::string(session->tracker->model().Name()) + " has " +
+                     std::to_string(session->tracker->model().NumControls()) + " controls");
+  }
+  session->tracker->Reset(scene.grasp_start);
+  return session;
+}
+
+void Server::SetInfo(const std::string& scene, const std::string& method,
+                     const std::string* command) {
+  std::lock_guard<std::mutex> lock(info_mutex_);
+  scene_name_ = scene;
+  method_name_ = method;
+  if (command != nullptr) last_command_message_ = *command;
+}
+
+void Server::Start() {
+  if (started_) return;
+  started_ = true;
+  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), nullptr);
+  state_sub_ = lcm_->subscribe(channels_.device_state, &Server::HandleDeviceState, this);
+  command_sub_ = lcm_->subscribe(channels_.command, &Server::HandleCommand, this);
+  running_ = true;
+  solve_thread_ = std::thread([this] { SolveLoop(); });
+  receive_thread_ = std::thread([this] { ReceiveLoop(); });
+  spdlog::info("server: session {} on {}, scene '{}' ({}), method {}", channels_.session,
+               lcm_url_, session_->scene.name, session_->scene.file,
+               ToString(session_->tracker->options().method));
+}
+
+void Server::Stop() {
+  if (!started_ || !running_.exchange(false)) return;
+  stop_ = true;
+  inbox_.RequestStop();
+  if (receive_thread_.joinable()) receive_thread_.join();
+  if (solve_thread_.joinable()) solve_thread_.join();
+  if (state_sub_ != nullptr) lcm_->unsubscribe(state_sub_);
+  if (command_sub_ != nullptr) lcm_->unsubscribe(command_sub_);
+  state_sub_ = command_sub_ = nullptr;
+}
+
+// ---------------------------------------------------------------- receive thread
+
+void Server::ReceiveLoop() {
+  while (!stop_.load()) {
+    if (lcm_->handleTimeout(kHandleTimeoutMs) < 0) {
+      // An LCM error (socket gone): do not spin on it.
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+}
+
+void Server::Reject(const std::string& channel, const std::string& why) {
+  const int64_t total = rejected_messages_.fetch_add(1) + 1;
+  if (ShouldLog(&last_reject_log_us_)) {
+    spdlog::warn("server: dropped a bad message on {}: {} ({} rejected so far)", channel, why,
+                 total);
+  }
+}
+
+void Server::HandleDeviceState(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  try {
+    PoseSample sample;
+    std::string why;
+    if (!transport::DecodeAndValidate(rbuf, &sample.state, &why)) {
+      Reject(channel, why);
+      return;
+    }
+    sample.receive_utime = transport::RealtimeMicros();
+    poses_received_.fetch_add(1);
+    if (inbox_.PutPose(sample)) dropped_poses_.fetch_add(1);
+  } catch (...) {
+    // Only allocation can throw here; an LCM handler must not let it escape.
+    rejected_messages_.fetch_add(1);
+  }
+}
+
+void Server::HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  try {
+    command_t command;
+    std::string why;
+    if (!transport::DecodeAndValidate(rbuf, &command, &why)) {
+      Reject(channel, why);
+      return;
+    }
+    if (!inbox_.PushCommand(command)) {
+      commands_refused_.fetch_add(1);
+      if (ShouldLog(&last_reject_log_us_)) {
+        spdlog::warn("server: command queue full, refused a command on {}", channel);
+      }
+    }
+  } catch (...) {
+    rejected_messages_.fetch_add(1);
+  }
+}
+
+// ---------------------------------------------------------------- solve thread
+
+void Server::SolveLoop() {
+  const auto shape_period = Period(params_.shape_rate_hz);
+  const auto status_period = Period(params_.status_rate_hz);
+  auto now = SteadyClock::now();
+  auto next_shape = now;
+  auto next_status = now;
+  last_status_time_ = now;
+  while (true) {
+    ServerInbox::Taken taken = inbox_.Wait(std::min(next_shape, next_status));
+    if (taken.stop) break;
+    bool changed_session = false;
+    for (const command_t& command : taken.commands) {
+      ApplyCommand(command);
+      changed_session = true;
+    }
+    if (taken.pose) SolveAndPublish(*taken.pose);
+    now = SteadyClock::now();
+    if (now >= next_shape || changed_session) {
+      PublishShape();
+      next_shape += shape_period;
+      if (next_shape <= now) next_shape = now + shape_period;  // fell behind: no burst
+    }
+    if (now >= next_status || changed_session) {
+      PublishStatus();
+      next_status += status_period;
+      if (next_status <= now) next_status = now + status_period;
+    }
+  }
+}
+
+void Server::SolveAndPublish(const PoseSample& pose) {
+  EquilibriumTracker& tracker = *session_->tracker;
+  const Model& model = tracker.model();
+  const DeviceMapping& mapping = session_->scene.device;
+  const Eigen::Vector3d position(pose.state.position[0], pose.state.position[1],
+                                 pose.state.position[2]);
+  const Eigen::Vector4d quaternion(pose.state.orientation[0], pose.state.orientation[1],
+                                   pose.state.orientation[2], pose.state.orientation[3]);
+  const Vec u = PoseToControls(mapping, model, position, quaternion);
+
+  if (hooks_.before_update) hooks_.before_update();
+  const TrackResult* result = nullptr;
+  const auto t0 = SteadyClock::now();
+  try {
+    result = &tracker.Update(u);
+  } catch (const std::exception& e) {
+    if (ShouldLog(&last_solve_error_log_us_)) {
+      spdlog::error("server: update at u = ({}) failed: {}", Format(u), e.what());
+    }
+  }
+  const double solve_us = std::chrono::duration<double, std::micro>(SteadyClock::now() - t0).count();
+
+  ForceModelInputs in;
+  in.mapping = &mapping;
+  in.model = &model;
+  in.u = u;
+  in.position_m = position;
+  in.result = result;
+  in.device_seq = pose.state.seq;
+  in.device_utime = pose.state.utime;
+  in.server_receive_utime = pose.receive_utime;
+  in.solve_us = solve_us;
+  in.seq = model_seq_++;
+  in.utime = transport::RealtimeMicros();
+  force_model_t msg = BuildForceModel(in);
+  std::string why;
+  if (!transport::Validate(msg, &why)) {
+    // BuildForceModel guarantees finiteness; this is the last line before the device.
+    spdlog::error("server: refusing to publish an invalid force model: {}", why);
+    msg = BuildForceModel(ForceModelInputs{in.mapping, in.model, in.u, Eigen::Vector3d::Zero(),
+                                           nullptr, in.device_seq, in.device_utime,
+                                           in.server_receive_utime, 0.0, in.seq, in.utime});
+  }
+  if (lcm_->publish(channels_.force_model, &msg) != 0) publish_failures_.fetch_add(1);
+
+  last_status_ = msg.status;
+  for (int i = 0; i < 3; ++i) last_force_n_[i] = msg.f0[i];
+  updates_.fetch_add(1);
+  if (msg.status == force_model_t::STATUS_INVALID) invalid_models_.fetch_add(1);
+  if (msg.status == force_model_t::STATUS_SNAPPED) {
+    snaps_.fetch_add(1);
+    ++snaps_since_reset_;
+    spdlog::debug("server: snap at u = ({})", Format(u));
+  }
+  status_window_.Push(solve_us);
+  const int64_t now_us = SteadyMicros();
+  std::lock_guard<std::mutex> lock(info_mutex_);
+  run_window_.Push(solve_us);
+  if (first_update_us_ == 0) first_update_us_ = now_us;
+  last_update_us_ = now_us;
+}
+
+void Server::ApplyCommand(const command_t& command) {
+  std::string message;
+  bool ok = true;
+  switch (command.command) {
+    case command_t::RESET: {
+      try {
+        session_->tracker->Reset(session_->scene.grasp_start);
+        message = "RESET: back to the start of scene '" + session_->scene.name + "'";
+      } catch (const std::exception& e) {
+        ok = false;
+        message = std::string("RESET failed: ") + e.what();
+      }
+      break;
+    }
+    case command_t::LOAD_SCENE: {
+      try {
+        std::unique_ptr<Session> next = MakeSession(LoadScene(command.argument));
+        session_ = std::move(next);
+        message = "LOAD_SCENE: now scene '" + session_->scene.name + "' (" + command.argument + ")";
+      } catch (const std::exception& e) {
+        ok = false;
+        message = "LOAD_SCENE refused, keeping scene '" + session_->scene.name + "': " + e.what();
+      }
+      break;
+    }
+    case command_t::SET_METHOD: {
+      Method m;
+      if (!ParseMethod(command.argument, &m)) {
+        ok = false;
+        message = "SET_METHOD refused: unknown method '" + command.argument +
+                  "' (expected newton, newton-ls or higher-order)";
+        break;
+      }
+      try {
+        SolverOptions options = session_->tracker->options();
+        options.method = m;
+        session_->tracker->SetOptions(options);
+        session_->scene.solver = options;
+        method_override_ = command.argument;
+        message = std::string("SET_METHOD: now ") + ToString(m);
+      } catch (const std::exception& e) {
+        ok = false;
+        message = std::string("SET_METHOD failed: ") + e.what();
+      }
+      break;
+    }
+    default:
+      ok = false;
+      message = "unknown command " + std::to_string(command.command);
+  }
+  if (ok) {
+    // A new start: the shape's snap count is "since the session (re)started".
+    if (command.command != command_t::SET_METHOD) {
+      snaps_since_reset_ = 0;
+      last_status_ = force_model_t::STATUS_REGULAR;
+      for (double& f : last_force_n_) f = 0.0;
+    }
+    commands_applied_.fetch_add(1);
+    spdlog::info("server: {}", message);
+  } else {
+    commands_refused_.fetch_add(1);
+    spdlog::warn("server: {}", message);
+  }
+  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), &message);
+}
+
+void Server::PublishShape() {
+  const EquilibriumTracker& tracker = *session_->tracker;
+  ShapeInputs in;
+  in.scene = session_->scene.name;
+  in.mapping = &session_->scene.device;
+  in.model = &tracker.model();
+  in.x = tracker.state();
+  in.u = tracker.control();
+  in.force_model_units = tracker.last().force;
+  in.force_newtons = Eigen::Vector3d(last_force_n_[0], last_force_n_[1], last_force_n_[2]);
+  in.status = last_status_;
+  in.snaps = snaps_since_reset_;
+  in.seq = shape_seq_++;
+  in.utime = transport::RealtimeMicros();
+  const thread_shape_t msg = BuildShape(in);
+  std::string why;
+  if (!transport::Validate(msg, &why)) {
+    if (ShouldLog(&last_solve_error_log_us_)) spdlog::error("server: bad shape not sent: {}", why);
+    return;
+  }
+  if (lcm_->publish(channels_.shape, &msg) != 0) {
+    publish_failures_.fetch_add(1);
+    return;
+  }
+  shapes_published_.fetch_add(1);
+}
+
+void Server::PublishStatus() {
+  const auto now = SteadyClock::now();
+  const double dt = std::chrono::duration<double>(now - last_status_time_).count();
+  const int64_t updates = updates_.load();
+  const transport::PercentileSummary window = status_window_.Compute();
+  StatusInputs in;
+  in.scene = session_->scene.name;
+  in.method = ToString(session_->tracker->options().method);
+  in.summary = &session_->tracker->last().summary;
+  in.status = last_status_;
+  in.update_rate_hz = dt > 0.0 ? static_cast<double>(updates - updates_at_last_status_) / dt : 0.0;
+  in.solve_us_p50 = window.p50;
+  in.solve_us_p99 = window.p99;
+  in.updates = updates;
+  in.snaps = snaps_.load();
+  in.dropped_poses = dropped_poses_.load();
+  in.rejected_messages = rejected_messages_.load();
+  in.seq = status_seq_++;
+  in.utime = transport::RealtimeMicros();
+  const solver_status_t msg = BuildSolverStatus(in);
+  status_window_.Clear();
+  updates_at_last_status_ = updates;
+  last_status_time_ = now;
+  if (lcm_->publish(channels_.solver_status, &msg) != 0) {
+    publish_failures_.fetch_add(1);
+    return;
+  }
+  statuses_published_.fetch_add(1);
+}
+
+// ---------------------------------------------------------------- statistics
+
+ServerStats Server::Stats() const {
+  ServerStats s;
+  s.poses_received = poses_received_.load();
+  s.updates = updates_.load();
+  s.invalid_models = invalid_models_.load();
+  s.snaps = snaps_.load();
+  s.dropped_poses = dropped_poses_.load();
+  s.rejected_messages = rejected_messages_.load();
+  s.commands_applied = commands_applied_.load();
+  s.commands_refused = commands_refused_.load();
+  s.shapes_published = shapes_published_.load();
+  s.statuses_published = statuses_published_.load();
+  s.publish_failures = publish_failures_.load();
+  std::lock_guard<std::mutex> lock(info_mutex_);
+  const transport::PercentileSummary window = run_window_.Compute();
+  s.solve_us_p50 = window.p50;
+  s.solve_us_p99 = window.p99;
+  const double span_s = 1e-6 * static_cast<double>(last_update_us_ - first_update_us_);
+  s.update_rate_hz = (window.count > 1 && span_s > 0.0)
+                         ? static_cast<double>(s.updates - 1) / span_s
+                         : 0.0;
+  s.scene = scene_name_;
+  s.method = method_name_;
+  s.last_command_message = last_command_message_;
+  return s;
+}
+
+std::string Server::SummaryJson() const {
+  const ServerStats s = Stats();
+  char buf[1024];
+  std::snprintf(buf, sizeof(buf),
+                "{\n  \"updates\": %lld,\n  \"update_rate_hz\": %.3f,\n  \"solve_us_p50\": %.3f,\n"
+                "  \"solve_us_p99\": %.3f,\n  \"snaps\": %lld,\n  \"dropped_poses\": %lld,\n"
+                "  \"rejected_messages\": %lld,\n  \"poses_received\": %lld,\n"
+                "  \"invalid_models\": %lld,\n  \"commands_applied\": %lld,\n"
+                "  \"commands_refused\": %lld,\n  \"shapes_published\": %lld,\n"
+                "  \"statuses_published\": %lld,\n  \"publish_failures\": %lld\n}\n",
+                static_cast<long long>(s.updates), s.update_rate_hz, s.solve_us_p50,
+                s.solve_us_p99, static_cast<long long>(s.snaps),
+                static_cast<long long>(s.dropped_poses),
+                static_cast<long long>(s.rejected_messages),
+                static_cast<long long>(s.poses_received),
+                static_cast<long long>(s.invalid_models),
+                static_cast<long long>(s.commands_applied),
+                static_cast<long long>(s.commands_refused),
+                static_cast<long long>(s.shapes_published),
+                static_cast<long long>(s.statuses_published),
+                static_cast<long long>(s.publish_failures));
+  return buf;
+}
+
+std::string Server::FinalReport() const {
+  const ServerStats s = Stats();
+  char buf[512];
+  std::snprintf(buf, sizeof(buf),
+                "final: updates=%lld update_rate_hz=%.1f solve_us_p50=%.1f solve_us_p99=%.1f "
+                "snaps=%lld dropped_poses=%lld rejected_messages=%lld invalid_models=%lld",
+                static_cast<long long>(s.updates), s.update_rate_hz, s.solve_us_p50,
+                s.solve_us_p99, static_cast<long long>(s.snaps),
+                static_cast<long long>(s.dropped_poses),
+                static_cast<long long>(s.rejected_messages),
+                static_cast<long long>(s.invalid_models));
+  return buf;
+}
+
+}  // namespace snapthread::server

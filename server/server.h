@@ -1,0 +1,158 @@
+// The solver server (shared/DESIGN.md "architecture"): owns the thread's state, follows
+// the equilibrium as device poses arrive and answers each solved pose with a local force
+// model; publishes the shape for viewers and solver statistics; obeys commands.
+//
+// Threads
+//  * receive thread: lcm.handleTimeout() loop. The handlers only decode + validate
+//    (bad input is counted, logged rate-limited and dropped; handlers never throw) and
+//    hand the pose / command to the solve thread through a ServerInbox.
+//  * solve thread: owns the scene and the EquilibriumTracker. Waits for a new pose
+//    (latest wins), maps it to controls, updates, publishes FORCE_MODEL at once, and
+//    SHAPE / SOLVER_STATUS at their rates. Commands run here too, between solves.
+//
+// Tests replace the transport by passing their own lcm::LCM (memq:// in one process);
+// the server then spins that instance's handle loop in its receive thread, so the test's
+// own subscriptions on it are dispatched there as well.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "server_inbox.h"
+#include "server_params.h"
+#include "snapthread/scene.h"
+#include "snapthread/tracker.h"
+#include "snapthread/transport/channels.h"
+#include "snapthread/transport/percentiles.h"
+
+namespace snapthread::server {
+
+// LCM could not start on the URL (exit code 1 in snapthread-server).
+class LcmInitError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Counters since construction; each field is read atomically (the set is not a single
+// snapshot, which statistics do not need).
+struct ServerStats {
+  int64_t poses_received = 0;     // valid device states
+  int64_t updates = 0;            // equilibrium updates answered with a force model
+  int64_t invalid_models = 0;     // of those, STATUS_INVALID (failed solve)
+  int64_t snaps = 0;              // updates that snapped
+  int64_t dropped_poses = 0;      // poses superseded before the solver took them
+  int64_t rejected_messages = 0;  // malformed / invalid DEVICE_STATE or COMMAND packets
+  int64_t commands_applied = 0;
+  int64_t commands_refused = 0;   // bad scene, unknown method, queue full
+  int64_t shapes_published = 0;
+  int64_t statuses_published = 0;
+  int64_t publish_failures = 0;
+  double update_rate_hz = 0.0;    // updates / time between the first and last update
+  double solve_us_p50 = 0.0;      // over the last kSolveWindow updates
+  double solve_us_p99 = 0.0;
+  std::string scene;              // name of the scene in use
+  std::string method;             // solver method in use
+  std::string last_command_message;  // what the last command did or why it was refused
+};
+
+// Test seams. Called on the solve thread.
+struct ServerTestHooks {
+  // Just before each tracker update (a test blocks here to pile up poses).
+  std::function<void()> before_update;
+};
+
+class Server {
+ public:
+  static constexpr size_t kSolveWindow = 100000;
+
+  // Validates params (std::invalid_argument naming the flag), loads the scene
+  // (SceneError) and resets the tracker at the scene's grasp_start. With lcm == nullptr
+  // the server creates its own LCM on ResolveLcmUrl(params.lcm_url) (LcmInitError when
+  // it does not start); otherwise it uses *lcm, which must outlive the server.
+  explicit Server(const ServerParams& params, lcm::LCM* lcm = nullptr,
+                  ServerTestHooks hooks = {});
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  // Subscribes and starts the receive and solve threads. Once.
+  void Start();
+  // Stops and joins both threads, unsubscribes. Idempotent; called by the destructor.
+  void Stop();
+
+  ServerStats Stats() const;
+  // {"updates": ..., "update_rate_hz": ..., "solve_us_p50": ..., "solve_us_p99": ...,
+  //  "snaps": ..., "dropped_poses": ..., "rejected_messages": ..., ...}
+  std::string SummaryJson() const;
+  // One line for the end of the log: the same numbers as key=value pairs.
+  std::string FinalReport() const;
+
+  const transport::Channels& channels() const { return channels_; }
+  const std::string& lcm_url() const { return lcm_url_; }
+  const ServerParams& params() const { return params_; }
+
+ private:
+  struct Session;  // scene + tracker, owned by the solve thread
+
+  // LCM handlers (receive thread). Never throw.
+  void HandleDeviceState(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void Reject(const std::string& channel, const std::string& why);
+
+  void ReceiveLoop();
+  void SolveLoop();
+  // Solve thread.
+  void SolveAndPublish(const PoseSample& pose);
+  void ApplyCommand(const command_t& command);
+  void PublishShape();
+  void PublishStatus();
+  std::unique_ptr<Session> MakeSession(const Scene& scene) const;
+  void SetInfo(const std::string& scene, const std::string& method, const std::string* command);
+
+  ServerParams params_;
+  transport::Channels channels_;
+  std::string lcm_url_;
+  std::unique_ptr<lcm::LCM> owned_lcm_;
+  lcm::LCM* lcm_ = nullptr;
+  ServerTestHooks hooks_;
+  lcm::Subscription* state_sub_ = nullptr;
+  lcm::Subscription* command_sub_ = nullptr;
+
+  ServerInbox inbox_;
+  std::thread receive_thread_, solve_thread_;
+  std::atomic<bool> running_{false};
+  std::atomic<bool> stop_{false};
+  bool started_ = false;
+
+  // Solve-thread state.
+  std::unique_ptr<Session> session_;
+  std::string method_override_;  // "" = the scene's method
+  int64_t model_seq_ = 0, shape_seq_ = 0, status_seq_ = 0;
+  int64_t snaps_since_reset_ = 0;
+  int8_t last_status_ = 0;
+  double last_force_n_[3] = {0.0, 0.0, 0.0};
+  transport::SampleWindow status_window_{4096};  // solve µs since the last status
+  int64_t updates_at_last_status_ = 0;
+  std::chrono::steady_clock::time_point last_status_time_;
+
+  // Shared counters.
+  std::atomic<int64_t> poses_received_{0}, updates_{0}, invalid_models_{0}, snaps_{0},
+      dropped_poses_{0}, rejected_messages_{0}, commands_applied_{0}, commands_refused_{0},
+      shapes_published_{0}, statuses_published_{0}, publish_failures_{0};
+  std::atomic<int64_t> last_reject_log_us_{0};
+  std::atomic<int64_t> last_solve_error_log_us_{0};
+  mutable std::mutex info_mutex_;  // guards the fields below
+  std::string scene_name_, method_name_, last_command_message_;
+  transport::SampleWindow run_window_{kSolveWindow};
+  int64_t first_update_us_ = 0, last_update_us_ = 0;  // steady clock
+};
+
+}  // namespace snapthread::server

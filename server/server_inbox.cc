@@ -1,0 +1,49 @@
+#include "server_inbox.h"
+
+#include <utility>
+
+namespace snapthread::server {
+
+bool ServerInbox::PutPose(const PoseSample& pose) {
+  bool superseded = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    superseded = pose_.has_value();
+    pose_ = pose;
+  }
+  cv_.notify_one();
+  return superseded;
+}
+
+bool ServerInbox::PushCommand(const command_t& command) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (commands_.size() >= kMaxPendingCommands) return false;
+    commands_.push_back(command);
+  }
+  cv_.notify_one();
+  return true;
+}
+
+void ServerInbox::RequestStop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+}
+
+ServerInbox::Taken ServerInbox::Wait(Clock::time_point deadline) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  cv_.wait_until(lock, deadline,
+                 [this] { return stop_ || pose_.has_value() || !commands_.empty(); });
+  Taken taken;
+  taken.stop = stop_;
+  taken.pose = std::move(pose_);
+  pose_.reset();
+  taken.commands.assign(commands_.begin(), commands_.end());
+  commands_.clear();
+  return taken;
+}
+
+}  // namespace snapthread::server

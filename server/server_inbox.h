@@ -1,0 +1,58 @@
+// The hand-over from the LCM receive thread to the solve thread: the newest device pose
+// (latest wins: a pose that arrives before the solver took the previous one replaces it,
+// so the solver never works through a queue of stale poses) and a short FIFO of commands
+// (commands are rare and must not be lost). One mutex and one condition variable; the
+// receive thread is not real-time, so blocking for a few microseconds is fine there.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include "snapthread/command_t.hpp"
+#include "snapthread/device_state_t.hpp"
+
+namespace snapthread::server {
+
+// A validated pose and when it arrived.
+struct PoseSample {
+  device_state_t state;
+  int64_t receive_utime = 0;  // server CLOCK_REALTIME, microseconds
+};
+
+class ServerInbox {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // Commands beyond this many unprocessed ones are refused (a flood, not a user).
+  static constexpr size_t kMaxPendingCommands = 64;
+
+  // Stores the pose as the newest. True when it superseded a pose nobody took (the
+  // caller counts it as a dropped pose).
+  bool PutPose(const PoseSample& pose);
+  // Queues a command. False when the queue is full (the command is refused).
+  bool PushCommand(const command_t& command);
+  // Wakes the solve thread for good.
+  void RequestStop();
+
+  struct Taken {
+    bool stop = false;
+    std::optional<PoseSample> pose;
+    std::vector<command_t> commands;
+  };
+  // Blocks until a pose or command is pending, stop was requested, or `deadline`;
+  // takes everything pending.
+  Taken Wait(Clock::time_point deadline);
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::optional<PoseSample> pose_;
+  std::deque<command_t> commands_;
+  bool stop_ = false;
+};
+
+}  // namespace snapthread::server

@@ -1,0 +1,139 @@
+// snapthread-server: the solver server process. See server.h for what it does and
+// server_params.h for the flags.
+//
+// Exit codes: 0 after a clean stop (SIGINT/SIGTERM or --duration), 1 when LCM does not
+// start (or the --summary file cannot be written), 2 for bad arguments (including a
+// scene that does not load).
+#include <pthread.h>
+
+#include <algorithm>
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <exception>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "server.h"
+#include "server_params.h"
+#include "snapthread/scene.h"
+
+namespace {
+
+constexpr int kExitLcm = 1;
+constexpr int kExitUsage = 2;
+
+int Usage(const std::string& message) {
+  std::fprintf(stderr, "snapthread-server: %s\n", message.c_str());
+  return kExitUsage;
+}
+
+// Waits for SIGINT/SIGTERM (blocked in every thread, so only this sigtimedwait sees
+// them) or until duration_s has passed (0 = forever). Returns the signal or 0.
+int WaitForStop(const sigset_t& signals, double duration_s) {
+  timespec start{};
+  clock_gettime(CLOCK_MONOTONIC, &start);
+  while (true) {
+    double wait_s = 0.2;
+    if (duration_s > 0.0) {
+      timespec now{};
+      clock_gettime(CLOCK_MONOTONIC, &now);
+      const double elapsed = (now.tv_sec - start.tv_sec) + 1e-9 * (now.tv_nsec - start.tv_nsec);
+      if (elapsed >= duration_s) return 0;
+      wait_s = std::min(wait_s, duration_s - elapsed);
+    }
+    timespec timeout{};
+    timeout.tv_sec = static_cast<time_t>(wait_s);
+    timeout.tv_nsec = static_cast<long>((wait_s - timeout.tv_sec) * 1e9);
+    const int sig = sigtimedwait(&signals, nullptr, &timeout);
+    if (sig > 0) return sig;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using snapthread::server::ServerParams;
+  ServerParams params;
+  CLI::App app{"snapthread-server: quasi-static equilibria of an elastic thread, served over "
+               "LCM to a haptic device client (force models) and viewers (shape, status)."};
+  app.add_option("--scene", params.scene_path, "Scene YAML file (scenes/*.yaml)")->required();
+  app.add_option("--session", params.session,
+                 "Session name: channel prefix <SESSION>_DEVICE_STATE, ... ([A-Za-z0-9_]+)")
+      ->capture_default_str();
+  app.add_option("--lcm-url", params.lcm_url,
+                 "LCM provider URL (default: $LCM_DEFAULT_URL, else "
+                 "udpm://239.255.76.67:7667?ttl=0)");
+  app.add_option("--shape-rate-hz", params.shape_rate_hz, "Thread shape rate for viewers, Hz")
+      ->capture_default_str();
+  app.add_option("--status-rate-hz", params.status_rate_hz, "Solver status rate, Hz")
+      ->capture_default_str();
+  app.add_option("--method", params.method,
+                 "Override the scene's solver: newton | newton-ls | higher-order");
+  app.add_option("--duration", params.duration_s, "Run time in seconds; 0 = until SIGINT/SIGTERM")
+      ->capture_default_str();
+  app.add_option("--log-level", params.log_level,
+                 "trace | debug | info | warn | error | critical | off")
+      ->capture_default_str();
+  app.add_option("--summary", params.summary_path,
+                 "Write a JSON summary (updates, update_rate_hz, solve_us_p50/p99, snaps, "
+                 "dropped_poses, rejected_messages) here at exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // CLI11's messages name the flag ("--scene is required", "--duration: Value x not
+    // in range" ...).
+    app.exit(e);
+    return kExitUsage;
+  }
+
+  std::string error;
+  if (!params.IsValid(&error)) return Usage(error);
+  spdlog::set_level(spdlog::level::from_str(params.log_level));
+  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+
+  // Block the stop signals before any thread exists so that every thread inherits the
+  // mask and only WaitForStop receives them.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  std::unique_ptr<snapthread::server::Server> server;
+  try {
+    server = std::make_unique<snapthread::server::Server>(params);
+  } catch (const snapthread::server::LcmInitError& e) {
+    std::fprintf(stderr, "snapthread-server: %s\n", e.what());
+    return kExitLcm;
+  } catch (const snapthread::SceneError& e) {
+    return Usage(std::string("--scene: ") + e.what());
+  } catch (const std::invalid_argument& e) {
+    return Usage(std::string("--scene: ") + e.what());
+  } catch (const std::exception& e) {
+    return Usage(std::string("--scene ") + params.scene_path + ": " + e.what());
+  }
+
+  server->Start();
+  const int sig = WaitForStop(signals, params.duration_s);
+  if (sig > 0) spdlog::info("server: signal {}, stopping", sig);
+  server->Stop();
+  spdlog::info("server: {}", server->FinalReport());
+  if (!params.summary_path.empty()) {
+    std::ofstream out(params.summary_path);
+    out << server->SummaryJson();
+    if (!out) {
+      spdlog::error("server: could not write the summary to {}", params.summary_path);
+      return kExitLcm;
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,194 @@
+#include "server_messages.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "pose_mapping.h"
+
+namespace snapthread::server {
+namespace {
+
+bool Finite(double v) { return std::isfinite(v); }
+
+bool ResultIsUsable(const TrackResult& r, int num_controls) {
+  if (r.summary.termination == Termination::kLinearSolverFailed ||
+      r.summary.termination == Termination::kNonFinite) {
+    return false;
+  }
+  if (r.force.size() != num_controls || r.stiffness.rows() != num_controls ||
+      r.stiffness.cols() != num_controls) {
+    return false;
+  }
+  return r.force.allFinite() && r.stiffness.allFinite();
+}
+
+void ZeroForceModel(force_model_t* m) {
+  for (int i = 0; i < 3; ++i) {
+    m->f0[i] = 0.0;
+    m->torque0[i] = 0.0;
+    for (int j = 0; j < 3; ++j) m->K[i][j] = 0.0;
+  }
+  m->has_torque = 0;
+}
+
+}  // namespace
+
+int8_t ClassifyStatus(const TrackResult* result) {
+  if (result == nullptr) return force_model_t::STATUS_INVALID;
+  if (result->summary.termination == Termination::kLinearSolverFailed ||
+      result->summary.termination == Termination::kNonFinite ||
+      !result->force.allFinite() || !result->stiffness.allFinite()) {
+    return force_model_t::STATUS_INVALID;
+  }
+  if (result->snapped || result->summary.snapped) return force_model_t::STATUS_SNAPPED;
+  if (result->stiffness_regularized ||
+      result->summary.status == EquilibriumStatus::kNearFold) {
+    return force_model_t::STATUS_NEAR_FOLD;
+  }
+  return force_model_t::STATUS_REGULAR;
+}
+
+double PlanarStiffness(const DeviceMapping& mapping) {
+  return 0.5 * mapping.max_stiffness_n_per_m;
+}
+
+force_model_t BuildForceModel(const ForceModelInputs& in) {
+  force_model_t m{};
+  m.utime = in.utime;
+  m.seq = in.seq;
+  m.device_seq = in.device_seq;
+  m.device_utime = in.device_utime;
+  m.server_receive_utime = in.server_receive_utime;
+  const double solve_us = Finite(in.solve_us) ? std::clamp(in.solve_us, 0.0, 2.0e9) : 0.0;
+  m.solve_us = static_cast<int32_t>(std::lround(solve_us));
+  for (int i = 0; i < 3; ++i) m.u0[i] = Finite(in.position_m[i]) ? in.position_m[i] : 0.0;
+  ZeroForceModel(&m);
+  m.iterations = 0;
+  m.residual = 0.0;
+  m.status = force_model_t::STATUS_INVALID;
+  if (in.mapping == nullptr || in.model == nullptr || in.result == nullptr) return m;
+
+  const DeviceMapping& map = *in.mapping;
+  const Model& model = *in.model;
+  const TrackResult& r = *in.result;
+  const int nu = model.NumControls();
+  const int dim = std::min(model.SpatialDimension(), 3);
+  m.iterations = r.summary.iterations;
+  m.residual = Finite(r.summary.residual) ? r.summary.residual : 0.0;
+  if (!ResultIsUsable(r, nu) || in.u.size() != nu || dim > nu) return m;
+
+  // Device force F_dev = N F_model; u_model = origin + s p  =>  dF_dev/dp = N s K_model.
+  const double n_per_f = map.newtons_per_model_force;
+  const double s = map.model_units_per_metre;
+  for (int i = 0; i < dim; ++i) {
+    m.f0[i] = n_per_f * r.force[i];
+    for (int j = 0; j < dim; ++j) m.K[i][j] = n_per_f * s * r.stiffness(i, j);
+  }
+  if (dim == 2) {
+    // Planar models have no z: without a constraint the hand would drift freely out of
+    // the plane the thread lives in and the force would act on a point the user cannot
+    // locate. A stiff virtual plane f_z = -k (z - z0) holds the grasp on the model plane.
+    // k is half the scene's max stable stiffness: stiff enough to feel like a wall, with
+    // headroom for the device client's stiffness clamp, latency and the 1 kHz sample
+    // rate (a spring at the stability limit would buzz).
+    const double k_plane = PlanarStiffness(map);
+    m.f0[2] = -k_plane * (m.u0[2] - PlanarZ0(map));
+    m.K[2][2] = -k_plane;
+  }
+  if (nu >= dim + 3 && dim == 3) {
+    // Grip direction d = u[3:6] (unit): the generalised force F_d = -E_d gives the torque
+    // on the grip tau = d x F_d (a rotation w moves d by w x d, dE = w . (d x E_d)).
+    // F_d is in model energy units = model force x model length: N / (units per metre).
+    const Eigen::Vector3d d = in.u.segment<3>(3).normalized();
+    const Eigen::Vector3d fd = r.force.segment<3>(3);
+    const Eigen::Vector3d tau = d.cross(fd) * (n_per_f / s);
+    for (int i = 0; i < 3; ++i) m.torque0[i] = tau[i];
+    m.has_torque = 1;
+  }
+  m.status = ClassifyStatus(&r);
+  if (!IsFinite(m)) {
+    ZeroForceModel(&m);
+    m.status = force_model_t::STATUS_INVALID;
+  }
+  return m;
+}
+
+bool IsFinite(const force_model_t& m) {
+  for (int i = 0; i < 3; ++i) {
+    if (!Finite(m.u0[i]) || !Finite(m.f0[i]) || !Finite(m.torque0[i])) return false;
+    for (int j = 0; j < 3; ++j) {
+      if (!Finite(m.K[i][j])) return false;
+    }
+  }
+  return Finite(m.residual);
+}
+
+thread_shape_t BuildShape(const ShapeInputs& in) {
+  thread_shape_t msg{};
+  msg.utime = in.utime;
+  msg.seq = in.seq;
+  msg.scene = in.scene;
+  msg.status = in.status;
+  msg.snaps = in.snaps;
+  for (int i = 0; i < 3; ++i) {
+    msg.grasp[i] = 0.0;
+    msg.grip_direction[i] = 0.0;
+    msg.force[i] = 0.0;
+    msg.force_newtons[i] = Finite(in.force_newtons[i]) ? in.force_newtons[i] : 0.0;
+  }
+  msg.num_nodes = 0;
+  if (in.model == nullptr) return msg;
+  const Model& model = *in.model;
+  msg.model = std::string(model.Name());
+  const int dim = std::min(model.SpatialDimension(), 3);
+  Eigen::Matrix3Xd nodes;
+  if (in.x.size() == model.NumStates() && in.u.size() == model.NumControls()) {
+    model.NodePositions(in.x, in.u, &nodes);
+  }
+  // Counts are validated by the receiver, but the encoder trusts num_nodes: keep them equal.
+  msg.num_nodes = static_cast<int32_t>(nodes.cols());
+  msg.positions.assign(nodes.cols(), std::vector<double>(3, 0.0));
+  for (Eigen::Index k = 0; k < nodes.cols(); ++k) {
+    for (int i = 0; i < 3; ++i) msg.positions[k][i] = Finite(nodes(i, k)) ? nodes(i, k) : 0.0;
+  }
+  for (int i = 0; i < dim && i < in.u.size(); ++i) msg.grasp[i] = in.u[i];
+  if (dim == 3 && in.u.size() >= 6) {
+    const Eigen::Vector3d d = in.u.segment<3>(3).normalized();
+    for (int i = 0; i < 3; ++i) msg.grip_direction[i] = Finite(d[i]) ? d[i] : 0.0;
+  }
+  for (int i = 0; i < dim && i < in.force_model_units.size(); ++i) {
+    msg.force[i] = Finite(in.force_model_units[i]) ? in.force_model_units[i] : 0.0;
+  }
+  return msg;
+}
+
+solver_status_t BuildSolverStatus(const StatusInputs& in) {
+  solver_status_t msg{};
+  msg.utime = in.utime;
+  msg.seq = in.seq;
+  msg.scene = in.scene;
+  msg.method = in.method;
+  msg.iterations = 0;
+  msg.residual = 0.0;
+  msg.lambda_min = 0.0;
+  msg.negative_pivots = 0;
+  if (in.summary != nullptr) {
+    msg.iterations = in.summary->iterations;
+    msg.residual = Finite(in.summary->residual) ? in.summary->residual : 0.0;
+    msg.lambda_min = Finite(in.summary->lambda_min) ? in.summary->lambda_min : 0.0;
+    msg.negative_pivots = in.summary->negative_pivots;
+  }
+  msg.status = in.status;
+  msg.update_rate_hz = Finite(in.update_rate_hz) ? in.update_rate_hz : 0.0;
+  msg.solve_us_p50 = Finite(in.solve_us_p50) ? in.solve_us_p50 : 0.0;
+  msg.solve_us_p99 = Finite(in.solve_us_p99) ? in.solve_us_p99 : 0.0;
+  msg.updates = in.updates;
+  msg.snaps = in.snaps;
+  msg.dropped_poses = in.dropped_poses;
+  msg.rejected_messages = in.rejected_messages;
+  return msg;
+}
+
+}  // namespace snapthread::server

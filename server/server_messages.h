@@ -1,0 +1,85 @@
+// Building the server's outgoing messages, separate from sending them (cf. Drake's
+// manipulation/kuka_iiwa/iiwa_command_sender.h): pure functions of the solve result, so
+// tests check units and flags without any transport.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "snapthread/force_model_t.hpp"
+#include "snapthread/model.h"
+#include "snapthread/scene.h"
+#include "snapthread/solver_status_t.hpp"
+#include "snapthread/thread_shape_t.hpp"
+#include "snapthread/tracker.h"
+#include "snapthread/types.h"
+
+namespace snapthread::server {
+
+// force_model_t.STATUS_* for one update. result == nullptr means the update failed
+// (threw): INVALID. A linear-solver failure or a non-finite result is INVALID too; a
+// spent budget is not (the state is the last accepted one and the force is usable).
+// Otherwise SNAPPED if the thread snapped at this update, NEAR_FOLD if the stiffness was
+// regularised or the solver reports a near-fold state, else REGULAR.
+int8_t ClassifyStatus(const TrackResult* result);
+
+// The planar constraint's stiffness for planar models, N/m (see BuildForceModel).
+double PlanarStiffness(const DeviceMapping& mapping);
+
+// The local force model F(p) = f0 + K (p - u0) in device units around the pose p = u0
+// (metres), for the controls u the pose mapped to. `result` is the tracker's result for
+// u (nullptr if the update failed). Never contains NaN/Inf: anything non-finite turns the
+// message into STATUS_INVALID with zero force and stiffness.
+struct ForceModelInputs {
+  const DeviceMapping* mapping = nullptr;
+  const Model* model = nullptr;
+  Vec u;                              // controls the pose mapped to, model units
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // the pose, device metres
+  const TrackResult* result = nullptr;
+  int64_t device_seq = 0;
+  int64_t device_utime = 0;           // echoed: the device's CLOCK_MONOTONIC
+  int64_t server_receive_utime = 0;   // CLOCK_REALTIME when the pose arrived
+  double solve_us = 0.0;
+  int64_t seq = 0;
+  int64_t utime = 0;                  // CLOCK_REALTIME now
+};
+force_model_t BuildForceModel(const ForceModelInputs& in);
+
+// True when every floating-point field is finite.
+bool IsFinite(const force_model_t& msg);
+
+struct ShapeInputs {
+  std::string scene;
+  const DeviceMapping* mapping = nullptr;
+  const Model* model = nullptr;
+  Vec x;                 // state, model units
+  Vec u;                 // controls, model units
+  Vec force_model_units; // F = -E_u (size NumControls; may be empty before the first update)
+  Eigen::Vector3d force_newtons = Eigen::Vector3d::Zero();
+  int8_t status = force_model_t::STATUS_REGULAR;
+  int64_t snaps = 0;
+  int64_t seq = 0;
+  int64_t utime = 0;
+};
+thread_shape_t BuildShape(const ShapeInputs& in);
+
+struct StatusInputs {
+  std::string scene;
+  std::string method;
+  const SolverSummary* summary = nullptr;  // of the last update (nullptr: none yet)
+  int8_t status = force_model_t::STATUS_REGULAR;
+  double update_rate_hz = 0.0;
+  double solve_us_p50 = 0.0;
+  double solve_us_p99 = 0.0;
+  int64_t updates = 0;
+  int64_t snaps = 0;
+  int64_t dropped_poses = 0;
+  int64_t rejected_messages = 0;
+  int64_t seq = 0;
+  int64_t utime = 0;
+};
+solver_status_t BuildSolverStatus(const StatusInputs& in);
+
+}  // namespace snapthread::server

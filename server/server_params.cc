@@ -1,0 +1,55 @@
+#include "server_params.h"
+
+#include <cmath>
+
+#include "snapthread/solver.h"
+#include "snapthread/transport/channels.h"
+
+namespace snapthread::server {
+namespace {
+
+bool Fail(std::string* error, const std::string& message) {
+  if (error != nullptr) *error = message;
+  return false;
+}
+
+bool IsKnownLogLevel(const std::string& level) {
+  for (const char* name : {"trace", "debug", "info", "warn", "warning", "error", "err",
+                           "critical", "off"}) {
+    if (level == name) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool ServerParams::IsValid(std::string* error) const {
+  if (scene_path.empty()) return Fail(error, "--scene: a scene file is required");
+  if (!transport::IsValidSessionName(session)) {
+    return Fail(error, "--session: '" + session + "' is not a valid session name ([A-Za-z0-9_]+)");
+  }
+  // A rate of 0 would make the publish period infinite; 10 kHz is far above any viewer.
+  if (!std::isfinite(shape_rate_hz) || shape_rate_hz <= 0.0 || shape_rate_hz > 10000.0) {
+    return Fail(error, "--shape-rate-hz: must be in (0, 10000], got " + std::to_string(shape_rate_hz));
+  }
+  if (!std::isfinite(status_rate_hz) || status_rate_hz <= 0.0 || status_rate_hz > 1000.0) {
+    return Fail(error, "--status-rate-hz: must be in (0, 1000], got " + std::to_string(status_rate_hz));
+  }
+  if (!method.empty()) {
+    Method m;
+    if (!ParseMethod(method, &m)) {
+      return Fail(error, "--method: unknown method '" + method +
+                             "' (expected newton, newton-ls or higher-order)");
+    }
+  }
+  if (!IsKnownLogLevel(log_level)) {
+    return Fail(error, "--log-level: unknown level '" + log_level +
+                           "' (expected trace, debug, info, warn, error, critical or off)");
+  }
+  if (!std::isfinite(duration_s) || duration_s < 0.0) {
+    return Fail(error, "--duration: must be >= 0 seconds, got " + std::to_string(duration_s));
+  }
+  return true;
+}
+
+}  // namespace snapthread::server
