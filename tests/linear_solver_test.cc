@@ -1,1 +1,508 @@
+// One test body per LDL^T backend (TEST_P, after Ceres' sparse_cholesky_test.cc),
+// checked against a dense solve by relative norm, plus inertia (Sylvester's law), status
+// codes and a malloc-counting guard (after Drake's LimitMalloc) for the
+// "no allocation after the first Factorize()" promise of the interface.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <new>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
 #include <gtest/gtest.h>
+
+#include "snapthread/linear_solver.h"
+
+// ---------------------------------------------------------------------------------
+// Allocation counting. glibc lets a program replace malloc; the replacements forward
+// to __libc_* and count while the calling thread has counting switched on. This sees
+// every heap allocation: operator new (the replacement below calls malloc), Eigen's aligned_malloc
+// (std::malloc, which operator new alone would miss) and CHOLMOD's SuiteSparse_malloc.
+// operator new/delete are replaced as well, with their own counter, so the test can
+// also say "no C++ allocation" independently of the malloc interposition.
+extern "C" void* __libc_malloc(size_t size);
+extern "C" void* __libc_calloc(size_t count, size_t size);
+extern "C" void* __libc_realloc(void* ptr, size_t size);
+extern "C" void __libc_free(void* ptr);
+
+namespace {
+std::atomic<long> g_mallocs{0};
+std::atomic<long> g_news{0};
+thread_local bool t_counting = false;
+}  // namespace
+
+extern "C" void* malloc(size_t size) {
+  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
+  return __libc_malloc(size);
+}
+extern "C" void* calloc(size_t count, size_t size) {
+  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
+  return __libc_calloc(count, size);
+}
+extern "C" void* realloc(void* ptr, size_t size) {
+  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
+  return __libc_realloc(ptr, size);
+}
+extern "C" void free(void* ptr) { __libc_free(ptr); }
+
+void* operator new(size_t size) {
+  if (t_counting) g_news.fetch_add(1, std::memory_order_relaxed);
+  void* p = malloc(size == 0 ? 1 : size);  // counted by malloc too
+  if (p == nullptr) throw std::bad_alloc();
+  return p;
+}
+void* operator new[](size_t size) { return operator new(size); }
+void* operator new(size_t size, const std::nothrow_t&) noexcept {
+  if (t_counting) g_news.fetch_add(1, std::memory_order_relaxed);
+  return malloc(size == 0 ? 1 : size);
+}
+void* operator new[](size_t size, const std::nothrow_t& tag) noexcept {
+  return operator new(size, tag);
+}
+void operator delete(void* p) noexcept { __libc_free(p); }
+void operator delete[](void* p) noexcept { __libc_free(p); }
+void operator delete(void* p, size_t) noexcept { __libc_free(p); }
+void operator delete[](void* p, size_t) noexcept { __libc_free(p); }
+
+namespace snapthread {
+namespace {
+
+// Counts heap allocations of this thread between construction and Stop().
+class AllocationCounter {
+ public:
+  AllocationCounter() : mallocs0_(g_mallocs.load()), news0_(g_news.load()) {
+    t_counting = true;
+  }
+  ~AllocationCounter() { t_counting = false; }
+  void Stop() {
+    t_counting = false;
+    mallocs_ = g_mallocs.load() - mallocs0_;
+    news_ = g_news.load() - news0_;
+  }
+  long mallocs() const { return mallocs_; }
+  long news() const { return news_; }
+
+ private:
+  long mallocs0_, news0_;
+  long mallocs_ = -1, news_ = -1;
+};
+
+// ---------------------------------------------------------------------------------
+// Matrices.
+
+// Sparse matrix with the full band |i - j| <= b as its pattern (zeros stored too, so
+// the pattern depends only on n and b), values from `dense`.
+SparseMatrix BandToSparse(const Mat& dense, int b) {
+  const int n = static_cast<int>(dense.rows());
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < n; ++j) {
+    for (int i = std::max(0, j - b); i <= std::min(n - 1, j + b); ++i) {
+      t.emplace_back(i, j, dense(i, j));
+    }
+  }
+  SparseMatrix a(n, n);
+  a.setFromTriplets(t.begin(), t.end());
+  a.makeCompressed();
+  return a;
+}
+
+// Random symmetric band matrix, entries uniform in [-1, 1].
+Mat RandomSymmetricBand(int n, int b, std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Mat m = Mat::Zero(n, n);
+  for (int j = 0; j < n; ++j) {
+    for (int i = j; i <= std::min(n - 1, j + b); ++i) m(i, j) = m(j, i) = u(*rng);
+  }
+  return m;
+}
+
+// SPD by strict diagonal dominance: a_ii = 1 + sum_j |a_ij| (+ a random scale).
+Mat RandomSpdBand(int n, int b, std::mt19937* rng) {
+  Mat m = RandomSymmetricBand(n, b, rng);
+  for (int i = 0; i < n; ++i) m(i, i) = 1.0 + m.row(i).cwiseAbs().sum() - std::abs(m(i, i));
+  return m;
+}
+
+// Q diag(lambda) Q^T with `negative` eigenvalues in [-3, -0.5], the rest in [0.5, 3].
+Mat RandomWithInertia(int n, int negative, std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0), mag(0.5, 3.0);
+  Mat g(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) g(i, j) = u(*rng);
+  }
+  const Mat q = Eigen::HouseholderQR<Mat>(g).householderQ();
+  Vec lambda(n);
+  for (int i = 0; i < n; ++i) lambda[i] = (i < negative ? -1.0 : 1.0) * mag(*rng);
+  Mat a = q * lambda.asDiagonal() * q.transpose();
+  return 0.5 * (a + a.transpose());
+}
+
+Vec RandomVector(int n, std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Vec v(n);
+  for (int i = 0; i < n; ++i) v[i] = u(*rng);
+  return v;
+}
+
+double RelativeError(const Vec& x, const Vec& reference) {
+  return (x - reference).norm() / reference.norm();
+}
+
+// Path-graph Laplacian (free ends): symmetric, PSD, exactly singular (constant null
+// vector).
+Mat PathLaplacian(int n) {
+  Mat m = Mat::Zero(n, n);
+  for (int i = 0; i + 1 < n; ++i) {
+    m(i, i) += 1.0;
+    m(i + 1, i + 1) += 1.0;
+    m(i, i + 1) = m(i + 1, i) = -1.0;
+  }
+  return m;
+}
+
+// ---------------------------------------------------------------------------------
+// One body per backend.
+
+class LinearSolverTest : public ::testing::TestWithParam<std::string> {
+ protected:
+  std::unique_ptr<SymmetricLinearSolver> Make() {
+    std::string error;
+    auto solver = MakeLinearSolver(GetParam(), 0, -1, &error);
+    EXPECT_NE(solver, nullptr) << error;
+    return solver;
+  }
+
+  // Analyze + Factorize + Solve of a, compared with a dense LU solve of the same system.
+  void ExpectSolves(const Mat& dense, const SparseMatrix& a, int expected_negative,
+                    double tolerance, std::mt19937* rng) {
+    const int n = static_cast<int>(dense.rows());
+    auto solver = Make();
+    ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess) << solver->message();
+    ASSERT_EQ(solver->Factorize(a), LinearSolverStatus::kSuccess) << solver->message();
+    EXPECT_EQ(solver->message(), "");
+    EXPECT_EQ(solver->NegativePivots(), expected_negative);
+    const Vec b = RandomVector(n, rng);
+    Vec x;
+    ASSERT_EQ(solver->Solve(b, &x), LinearSolverStatus::kSuccess);
+    ASSERT_EQ(x.size(), n);
+    const Vec reference = Eigen::FullPivLU<Mat>(dense).solve(b);
+    EXPECT_LT(RelativeError(x, reference), tolerance) << "n = " << n;
+  }
+};
+
+TEST_P(LinearSolverTest, SolvesRandomSpdBandMatrices) {
+  std::mt19937 rng(1);
+  for (int n : {1, 2, 7, 50, 300}) {
+    for (int b : {0, 1, 2, 8}) {
+      const int band = std::min(b, n - 1);
+      SCOPED_TRACE("n = " + std::to_string(n) + ", b = " + std::to_string(band));
+      const Mat dense = RandomSpdBand(n, band, &rng);
+      const SparseMatrix a = BandToSparse(dense, band);
+      ExpectSolves(dense, a, 0, 1e-12, &rng);
+    }
+  }
+}
+
+// For SPD A every pivot of LDL^T (in any symmetric ordering) is a diagonal entry of a
+// Schur complement, so lambda_min(A) <= min |d_i| <= lambda_max(A).
+TEST_P(LinearSolverTest, MinAbsPivotOfSpdMatrixLiesInSpectrum) {
+  std::mt19937 rng(2);
+  for (int n : {1, 7, 50}) {
+    const Mat dense = RandomSpdBand(n, std::min(2, n - 1), &rng);
+    const SparseMatrix a = BandToSparse(dense, std::min(2, n - 1));
+    auto solver = Make();
+    ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess);
+    ASSERT_EQ(solver->Factorize(a), LinearSolverStatus::kSuccess);
+    const Vec lambda = Eigen::SelfAdjointEigenSolver<Mat>(dense).eigenvalues();
+    EXPECT_GE(solver->MinAbsPivot(), lambda.minCoeff() * (1 - 1e-12)) << "n = " << n;
+    EXPECT_LE(solver->MinAbsPivot(), lambda.maxCoeff() * (1 + 1e-12)) << "n = " << n;
+  }
+}
+
+TEST_P(LinearSolverTest, InertiaOfIndefiniteDenseMatrices) {
+  std::mt19937 rng(3);
+  for (int n : {1, 2, 5, 7, 12}) {
+    for (int negative = 0; negative <= n; ++negative) {
+      SCOPED_TRACE("n = " + std::to_string(n) + ", negative = " + std::to_string(negative));
+      const Mat dense = RandomWithInertia(n, negative, &rng);
+      ExpectSolves(dense, BandToSparse(dense, n - 1), negative, 1e-8, &rng);
+    }
+  }
+}
+
+// Chains: random tri-/pentadiagonal T shifted to A = T - sigma I with sigma halfway
+// between two eigenvalues of T, so A has exactly k negative eigenvalues.
+TEST_P(LinearSolverTest, InertiaOfShiftedBandMatrices) {
+  std::mt19937 rng(4);
+  for (int n : {7, 50, 300}) {
+    for (int b : {1, 2}) {
+      const Mat t = RandomSymmetricBand(n, b, &rng);
+      const Vec lambda = Eigen::SelfAdjointEigenSolver<Mat>(t).eigenvalues();  // ascending
+      for (int k : {0, 1, 2, n / 2, n}) {
+        SCOPED_TRACE("n = " + std::to_string(n) + ", b = " + std::to_string(b) +
+                     ", k = " + std::to_string(k));
+        double sigma;
+        if (k == 0) {
+          sigma = lambda[0] - 1.0;
+        } else if (k == n) {
+          sigma = lambda[n - 1] + 1.0;
+        } else {
+          sigma = 0.5 * (lambda[k - 1] + lambda[k]);
+        }
+        const Mat dense = t - sigma * Mat::Identity(n, n);
+        // Unpivoted LDL^T of an indefinite matrix has no growth bound: allow some.
+        ExpectSolves(dense, BandToSparse(dense, b), k, 1e-7, &rng);
+      }
+    }
+  }
+}
+
+TEST_P(LinearSolverTest, RefactorizesWithNewValuesOnTheSamePattern) {
+  std::mt19937 rng(5);
+  const int n = 50, b = 2;
+  auto solver = Make();
+  const Mat first = RandomSpdBand(n, b, &rng);
+  ASSERT_EQ(solver->Analyze(BandToSparse(first, b)), LinearSolverStatus::kSuccess);
+  const Vec rhs = RandomVector(n, &rng);
+  Vec x;
+  for (int round = 0; round < 4; ++round) {
+    // Alternate definite and indefinite values on one pattern.
+    const Mat dense = round % 2 == 0 ? RandomSpdBand(n, b, &rng) : Mat(-RandomSpdBand(n, b, &rng));
+    ASSERT_EQ(solver->Factorize(BandToSparse(dense, b)), LinearSolverStatus::kSuccess)
+        << solver->message();
+    EXPECT_EQ(solver->NegativePivots(), round % 2 == 0 ? 0 : n);
+    ASSERT_EQ(solver->Solve(rhs, &x), LinearSolverStatus::kSuccess);
+    const Vec reference = Eigen::FullPivLU<Mat>(dense).solve(rhs);
+    EXPECT_LT(RelativeError(x, reference), 1e-12) << "round " << round;
+  }
+}
+
+TEST_P(LinearSolverTest, UncompressedStorageGivesTheSameSolution) {
+  std::mt19937 rng(6);
+  const int n = 30, b = 2;
+  const Mat dense = RandomSpdBand(n, b, &rng);
+  SparseMatrix a(n, n);
+  a.reserve(Eigen::VectorXi::Constant(n, 2 * b + 3));  // leaves gaps: not compressed
+  for (int j = 0; j < n; ++j) {
+    for (int i = std::max(0, j - b); i <= std::min(n - 1, j + b); ++i) {
+      a.insert(i, j) = dense(i, j);
+    }
+  }
+  ASSERT_FALSE(a.isCompressed());
+  ExpectSolves(dense, a, 0, 1e-12, &rng);
+  // A solver analysed on the compressed form accepts the uncompressed one (same pattern).
+  auto solver = Make();
+  ASSERT_EQ(solver->Analyze(BandToSparse(dense, b)), LinearSolverStatus::kSuccess);
+  EXPECT_EQ(solver->Factorize(a), LinearSolverStatus::kSuccess) << solver->message();
+}
+
+TEST_P(LinearSolverTest, SingularMatrixIsNumericalIssue) {
+  std::mt19937 rng(7);
+  std::vector<Mat> singular = {PathLaplacian(7), PathLaplacian(50), Mat::Zero(3, 3)};
+  {
+    // Q diag(lambda) Q^T with one exact zero eigenvalue: a round-off zero pivot.
+    Mat g = Mat::Random(6, 6);
+    const Mat q = Eigen::HouseholderQR<Mat>(g).householderQ();
+    Vec lambda(6);
+    lambda << 2.0, -1.0, 0.0, 1.5, 3.0, -2.5;
+    singular.push_back(q * lambda.asDiagonal() * q.transpose());
+    singular.back() = 0.5 * (singular.back() + singular.back().transpose()).eval();
+  }
+  for (const Mat& dense : singular) {
+    const int n = static_cast<int>(dense.rows());
+    SCOPED_TRACE("n = " + std::to_string(n));
+    const SparseMatrix a = BandToSparse(dense, n - 1);
+    auto solver = Make();
+    ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess);
+    EXPECT_EQ(solver->Factorize(a), LinearSolverStatus::kNumericalIssue);
+    EXPECT_NE(solver->message(), "");
+    // No stale or partial factor is used afterwards.
+    Vec x;
+    EXPECT_EQ(solver->Solve(Vec::Ones(n), &x), LinearSolverStatus::kInvalidInput);
+  }
+  // A non-finite entry is a numerical issue too, and a good matrix afterwards recovers.
+  const Mat good = RandomSpdBand(7, 1, &rng);
+  Mat bad = good;
+  bad(3, 3) = std::numeric_limits<double>::quiet_NaN();
+  auto solver = Make();
+  ASSERT_EQ(solver->Analyze(BandToSparse(good, 1)), LinearSolverStatus::kSuccess);
+  EXPECT_EQ(solver->Factorize(BandToSparse(bad, 1)), LinearSolverStatus::kNumericalIssue);
+  EXPECT_NE(solver->message(), "");
+  EXPECT_EQ(solver->Factorize(BandToSparse(good, 1)), LinearSolverStatus::kSuccess);
+  EXPECT_EQ(solver->message(), "");
+}
+
+TEST_P(LinearSolverTest, PatternOrSizeMismatchIsInvalidInput) {
+  std::mt19937 rng(8);
+  const Mat dense = RandomSpdBand(8, 2, &rng);
+  const SparseMatrix analysed = BandToSparse(dense, 1);
+  auto solver = Make();
+  ASSERT_EQ(solver->Analyze(analysed), LinearSolverStatus::kSuccess);
+  // Wider band.
+  EXPECT_EQ(solver->Factorize(BandToSparse(dense, 2)), LinearSolverStatus::kInvalidInput);
+  EXPECT_NE(solver->message(), "");
+  // Other size.
+  EXPECT_EQ(solver->Factorize(BandToSparse(RandomSpdBand(9, 1, &rng), 1)),
+            LinearSolverStatus::kInvalidInput);
+  // Same size and number of nonzeros, entries elsewhere: move the coupling (0,1) to (0,7).
+  {
+    std::vector<Eigen::Triplet<double>> t;
+    for (int j = 0; j < 8; ++j) {
+      for (SparseMatrix::InnerIterator it(analysed, j); it; ++it) {
+        int r = it.row(), c = it.col();
+        if (r + c == 1 && r != c) (r == 0 ? c : r) = 7;
+        t.emplace_back(r, c, it.value());
+      }
+    }
+    SparseMatrix moved(8, 8);
+    moved.setFromTriplets(t.begin(), t.end());
+    ASSERT_EQ(moved.nonZeros(), analysed.nonZeros());
+    EXPECT_EQ(solver->Factorize(moved), LinearSolverStatus::kInvalidInput);
+  }
+  // The analysed pattern still works, and Solve checks the right-hand side's size.
+  ASSERT_EQ(solver->Factorize(analysed), LinearSolverStatus::kSuccess) << solver->message();
+  Vec x;
+  EXPECT_EQ(solver->Solve(Vec::Ones(7), &x), LinearSolverStatus::kInvalidInput);
+  EXPECT_EQ(solver->Solve(Vec::Ones(8), nullptr), LinearSolverStatus::kInvalidInput);
+  EXPECT_EQ(solver->Solve(Vec::Ones(8), &x), LinearSolverStatus::kSuccess);
+}
+
+TEST_P(LinearSolverTest, CallsOutOfOrderAndBadPatternsAreInvalidInput) {
+  std::mt19937 rng(9);
+  const Mat dense = RandomSpdBand(5, 1, &rng);
+  const SparseMatrix a = BandToSparse(dense, 1);
+  Vec x;
+  {
+    auto solver = Make();
+    EXPECT_EQ(solver->Factorize(a), LinearSolverStatus::kInvalidInput);
+    EXPECT_NE(solver->message(), "");
+    EXPECT_EQ(solver->Solve(Vec::Ones(5), &x), LinearSolverStatus::kInvalidInput);
+    ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess);
+    EXPECT_EQ(solver->Solve(Vec::Ones(5), &x), LinearSolverStatus::kInvalidInput);
+  }
+  auto solver = Make();
+  EXPECT_EQ(solver->Analyze(SparseMatrix(3, 4)), LinearSolverStatus::kInvalidInput);
+  EXPECT_NE(solver->message(), "");
+  EXPECT_EQ(solver->Analyze(SparseMatrix(0, 0)), LinearSolverStatus::kInvalidInput);
+  // Only the lower triangle stored: not the full symmetric pattern the interface wants.
+  const SparseMatrix lower = SparseMatrix(a.triangularView<Eigen::Lower>());
+  EXPECT_EQ(solver->Analyze(lower), LinearSolverStatus::kInvalidInput);
+  // A failed Analyze() leaves nothing to factorise.
+  EXPECT_EQ(solver->Factorize(a), LinearSolverStatus::kInvalidInput);
+}
+
+// After a warm-up Factorize + Solve, repeated Factorize + Solve on the same pattern do
+// not touch the heap (malloc, calloc, realloc or operator new), for every backend.
+TEST_P(LinearSolverTest, RepeatedFactorizeAndSolveDoNotAllocate) {
+  std::mt19937 rng(10);
+  for (int n : {7, 300}) {
+    const int b = std::min(8, n - 1);
+    std::vector<SparseMatrix> matrices;
+    for (int k = 0; k < 4; ++k) {
+      Mat dense = RandomSpdBand(n, b, &rng);
+      if (k % 2 == 1) dense.diagonal().array() -= 0.5 * dense.diagonal().mean();  // indefinite
+      matrices.push_back(BandToSparse(dense, b));
+    }
+    const Vec rhs = RandomVector(n, &rng);
+    Vec x(n);
+    auto solver = Make();
+    ASSERT_EQ(solver->Analyze(matrices[0]), LinearSolverStatus::kSuccess);
+    ASSERT_EQ(solver->Factorize(matrices[0]), LinearSolverStatus::kSuccess);
+    ASSERT_EQ(solver->Solve(rhs, &x), LinearSolverStatus::kSuccess);
+
+    std::vector<LinearSolverStatus> statuses(2 * matrices.size());
+    AllocationCounter counter;
+    for (size_t k = 0; k < matrices.size(); ++k) {
+      statuses[2 * k] = solver->Factorize(matrices[k]);
+      statuses[2 * k + 1] = solver->Solve(rhs, &x);
+    }
+    counter.Stop();
+    for (LinearSolverStatus s : statuses) EXPECT_EQ(s, LinearSolverStatus::kSuccess);
+    EXPECT_EQ(counter.mallocs(), 0) << "n = " << n;
+    EXPECT_EQ(counter.news(), 0) << "n = " << n;
+  }
+}
+
+std::vector<std::string> ConcreteBackends() { return {"cholmod", "dense", "banded"}; }
+INSTANTIATE_TEST_SUITE_P(Backends, LinearSolverTest, ::testing::ValuesIn(ConcreteBackends()),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           return info.param;
+                         });
+
+// ---------------------------------------------------------------------------------
+
+// The guard must be able to fail: it sees C++, Eigen and CHOLMOD allocations.
+TEST(AllocationCounterTest, SeesEveryKindOfAllocation) {
+  {
+    AllocationCounter counter;
+    std::vector<int>* v = new std::vector<int>(100);
+    counter.Stop();
+    delete v;
+    EXPECT_GE(counter.news(), 2);
+    EXPECT_GE(counter.mallocs(), 2);
+  }
+  {
+    AllocationCounter counter;
+    Vec* v = new Vec(100);  // the coefficients come from Eigen's aligned_malloc
+    counter.Stop();
+    delete v;
+    EXPECT_GE(counter.mallocs(), 2);
+  }
+  {
+    std::string error;
+    auto solver = MakeLinearSolver("cholmod", 10, 1, &error);
+    ASSERT_NE(solver, nullptr);
+    const SparseMatrix a = BandToSparse(PathLaplacian(10) + Mat::Identity(10, 10), 1);
+    AllocationCounter counter;
+    const LinearSolverStatus s = solver->Analyze(a);
+    counter.Stop();
+    EXPECT_EQ(s, LinearSolverStatus::kSuccess);
+    // cholmod_analyze's own mallocs are counted beyond the std::vectors of Analyze().
+    EXPECT_GT(counter.mallocs(), counter.news());
+  }
+}
+
+TEST(MakeLinearSolverTest, KnownNamesMakeSolversAndUnknownNamesSayWhy) {
+  for (const std::string& name : LinearSolverNames()) {
+    std::string error;
+    EXPECT_NE(MakeLinearSolver(name, 100, 8, &error), nullptr) << name << ": " << error;
+  }
+  std::string error;
+  EXPECT_EQ(MakeLinearSolver("lu", 10, 1, &error), nullptr);
+  EXPECT_NE(error.find("lu"), std::string::npos);
+  EXPECT_NE(error.find("cholmod"), std::string::npos);
+  EXPECT_EQ(MakeLinearSolver("lu", 10, 1, nullptr), nullptr);
+  EXPECT_STREQ(ToString(LinearSolverStatus::kSuccess), "success");
+  EXPECT_STRNE(ToString(LinearSolverStatus::kNumericalIssue),
+               ToString(LinearSolverStatus::kInvalidInput));
+}
+
+// "auto" hands out a concrete backend, whichever it is, and that backend solves a chain.
+TEST(MakeLinearSolverTest, AutoPicksAWorkingBackendForEverySize) {
+  std::mt19937 rng(11);
+  for (int n : {3, 30, 300, 1500}) {
+    for (int b : {2, 8, 40}) {
+      if (b >= n) continue;
+      std::string error;
+      auto solver = MakeLinearSolver("auto", n, b, &error);
+      ASSERT_NE(solver, nullptr) << error;
+      EXPECT_NE(solver->Name(), "auto");
+      const Mat dense = RandomSpdBand(n, b, &rng);
+      const SparseMatrix a = BandToSparse(dense, b);
+      ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess) << solver->message();
+      ASSERT_EQ(solver->Factorize(a), LinearSolverStatus::kSuccess) << solver->message();
+      const Vec rhs = RandomVector(n, &rng);
+      Vec x;
+      ASSERT_EQ(solver->Solve(rhs, &x), LinearSolverStatus::kSuccess);
+      EXPECT_LT((dense * x - rhs).norm() / rhs.norm(), 1e-12)
+          << "n = " << n << ", b = " << b << ", backend " << solver->Name();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace snapthread
