@@ -1,0 +1,174 @@
+// snapthread-linear-bench: Factorize + Solve time of each LDL^T backend on banded SPD
+// matrices with the bandwidth of a 3-D thread chain (thread3d couples nodes up to two
+// apart, 3 coordinates per node: half-bandwidth 2*3 + 2 = 8), for growing n. The
+// numbers set the "auto" rule in common/src/linear_solver.cc.
+//
+// Each cell is the median over samples; a sample times a batch of repetitions long
+// enough (>= --min-sample-us) for the clock, divided by the batch size. The machine is
+// shared, so medians, not means.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "snapthread/linear_solver.h"
+
+namespace snapthread {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Random SPD matrix (strict diagonal dominance) with the full band |i - j| <= b.
+SparseMatrix RandomSpdBand(int n, int b, std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Eigen::Triplet<double>> t;
+  Vec diagonal = Vec::Ones(n);
+  for (int j = 0; j < n; ++j) {
+    for (int i = j + 1; i <= std::min(n - 1, j + b); ++i) {
+      const double v = u(*rng);
+      t.emplace_back(i, j, v);
+      t.emplace_back(j, i, v);
+      diagonal[i] += std::abs(v);
+      diagonal[j] += std::abs(v);
+    }
+  }
+  for (int i = 0; i < n; ++i) t.emplace_back(i, i, diagonal[i]);
+  SparseMatrix a(n, n);
+  a.setFromTriplets(t.begin(), t.end());
+  a.makeCompressed();
+  return a;
+}
+
+struct Cell {
+  bool ran = false;
+  double median_us = 0.0;
+  double analyze_us = 0.0;
+  int samples = 0;
+  std::string note;
+};
+
+Cell Measure(const std::string& name, const SparseMatrix& a, const Vec& rhs, int bandwidth,
+             double min_sample_us, double budget_s) {
+  Cell cell;
+  std::string error;
+  auto solver = MakeLinearSolver(name, static_cast<int>(a.rows()), bandwidth, &error);
+  if (solver == nullptr) {
+    cell.note = error;
+    return cell;
+  }
+  const auto t0 = Clock::now();
+  if (solver->Analyze(a) != LinearSolverStatus::kSuccess) {
+    cell.note = solver->message();
+    return cell;
+  }
+  cell.analyze_us = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+  Vec x(a.rows());
+  // Warm-up (first-call allocations) and the batch size.
+  int batch = 1;
+  for (;;) {
+    const auto start = Clock::now();
+    for (int k = 0; k < batch; ++k) {
+      if (solver->Factorize(a) != LinearSolverStatus::kSuccess ||
+          solver->Solve(rhs, &x) != LinearSolverStatus::kSuccess) {
+        cell.note = "failed: " + solver->message();
+        return cell;
+      }
+    }
+    const double us = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+    if (us >= min_sample_us || batch >= (1 << 20)) break;
+    batch *= 2;
+  }
+  const double residual = (a * x - rhs).norm() / rhs.norm();
+  if (!(residual < 1e-10)) {
+    cell.note = "wrong solution (relative residual " + std::to_string(residual) + ")";
+    return cell;
+  }
+  std::vector<double> samples;
+  const auto begin = Clock::now();
+  while (samples.size() < 5 ||
+         (samples.size() < 201 &&
+          std::chrono::duration<double>(Clock::now() - begin).count() < budget_s)) {
+    const auto start = Clock::now();
+    for (int k = 0; k < batch; ++k) {
+      solver->Factorize(a);
+      solver->Solve(rhs, &x);
+    }
+    samples.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count() /
+                      batch);
+  }
+  std::nth_element(samples.begin(), samples.begin() + samples.size() / 2, samples.end());
+  cell.median_us = samples[samples.size() / 2];
+  cell.samples = static_cast<int>(samples.size());
+  cell.ran = true;
+  return cell;
+}
+
+}  // namespace
+}  // namespace snapthread
+
+int main(int argc, char** argv) {
+  using namespace snapthread;
+  CLI::App app{"Factorize+Solve time of the LDL^T backends on banded SPD matrices"};
+  int bandwidth = 8;
+  std::vector<int> sizes = {10, 30, 100, 300, 1000, 3000};
+  int dense_max = 1000;
+  double min_sample_us = 200.0;
+  double budget_s = 0.5;
+  bool csv = false;
+  app.add_option("--bandwidth", bandwidth, "half-bandwidth b (thread3d: 8)")->check(CLI::NonNegativeNumber);
+  app.add_option("--sizes", sizes, "matrix sizes n");
+  app.add_option("--dense-max", dense_max, "largest n for the O(n^3) dense backend");
+  app.add_option("--min-sample-us", min_sample_us, "shortest timed batch, microseconds");
+  app.add_option("--budget-s", budget_s, "time budget per cell, seconds (>= 5 samples)");
+  app.add_flag("--csv", csv, "print CSV instead of a table");
+  CLI11_PARSE(app, argc, argv);
+
+  const std::vector<std::string> backends = {"cholmod", "dense", "banded", "auto"};
+  if (csv) {
+    std::printf("n,bandwidth,backend,chosen,median_us,analyze_us,samples\n");
+  } else {
+    std::printf("Factorize+Solve, median us (half-bandwidth %d, full band, SPD)\n", bandwidth);
+    std::printf("%8s", "n");
+    for (const auto& b : backends) std::printf(" %14s", b.c_str());
+    std::printf("  auto picks\n");
+  }
+  std::mt19937 rng(12345);
+  for (int n : sizes) {
+    const int b = std::min(bandwidth, n - 1);
+    const SparseMatrix a = RandomSpdBand(n, b, &rng);
+    Vec rhs = Vec::Ones(n);
+    std::string chosen;
+    {
+      std::string error;
+      auto solver = MakeLinearSolver("auto", n, b, &error);
+      chosen = solver ? std::string(solver->Name()) : error;
+    }
+    if (!csv) std::printf("%8d", n);
+    for (const auto& name : backends) {
+      Cell cell;
+      if (name == "dense" && n > dense_max) {
+        cell.note = "skipped";
+      } else {
+        cell = Measure(name, a, rhs, b, min_sample_us, budget_s);
+      }
+      if (csv) {
+        if (cell.ran) {
+          std::printf("%d,%d,%s,%s,%.3f,%.3f,%d\n", n, b, name.c_str(),
+                      name == "auto" ? chosen.c_str() : name.c_str(), cell.median_us,
+                      cell.analyze_us, cell.samples);
+        }
+      } else if (cell.ran) {
+        std::printf(" %14.2f", cell.median_us);
+      } else {
+        std::printf(" %14s", cell.note.substr(0, 14).c_str());
+      }
+      std::fflush(stdout);
+    }
+    if (!csv) std::printf("  %s\n", chosen.c_str());
+  }
+  return 0;
+}
