@@ -1,0 +1,27 @@
+// delta backend: Force Dimension delta / omega / sigma through the DHD SDK.
+// UNTESTED: compiled only when CMake finds dhdc.h and libdhd, and neither the SDK nor a
+// device was available where this was written. DHD calls are synchronous USB
+// transactions (~0.1-0.2 ms), made directly from the servo thread.
+#pragma once
+
+#include "haptic_device.h"
+
+namespace snapthread::device {
+
+class DeltaDevice final : public HapticDevice {
+ public:
+  DeltaDevice();
+  ~DeltaDevice() override;
+
+  bool Open(std::string* error) override;
+  const DeviceCapabilities& capabilities() const override { return caps_; }
+  bool Read(DeviceState* state) override;
+  bool Command(const double force_n[3], const double torque_nm[3]) override;
+  void Close() override;
+
+ private:
+  DeviceCapabilities caps_;
+  int id_ = -1;
+};
+
+}  // namespace snapthread::device

@@ -1,0 +1,47 @@
+// snapthread-device as a library: options, argument parsing and the process that wires
+// a backend, the servo loop, LCM and the statistics together (shared/DESIGN.md). Threads:
+//   servo   ServoLoop: 1 kHz ticks, never touches LCM, logs or allocates
+//   lcm     handleTimeout loop: force_model_t -> DecodeAndValidate -> PrepareModel ->
+//           LatestValue (wait-free for the servo)
+//   io      drains the pose / trace / lateness rings: publishes device_state_t, writes
+//           the trace CSV, publishes device_status_t at 2 Hz and logs a summary
+//   main    waits for --duration or SIGINT/SIGTERM, then stops everything, writes the
+//           summary JSON
+#pragma once
+
+#include <string>
+
+namespace snapthread::device {
+
+struct DeviceClientOptions {
+  std::string backend = "virtual-hand";  // sim-path | virtual-hand | phantom | delta
+  std::string scene_file;                // scene YAML: DeviceMapping + grasp path
+  std::string path_csv;                  // alternative scripted path, metres
+  std::string session = "SNAPTHREAD";
+  std::string lcm_url;                   // empty: LCM_DEFAULT_URL or the udpm default
+  double duration_s = 0.0;               // 0 = until SIGINT / SIGTERM
+  double rate_hz = 1000.0;
+  int publish_divisor = 1;               // publish every k-th pose
+  double model_timeout_ms = 50.0;
+  double fade_ms = 100.0;
+  double speed_m_per_s = 0.02;           // scripted path speed
+  bool realtime = true;                  // --no-rt turns off SCHED_FIFO / mlockall
+  std::string log_level = "info";
+  std::string trace_file;                // CSV, empty = none
+  int trace_divisor = 1;
+  std::string summary_file;              // JSON at exit, empty = none
+};
+
+// Exit codes of snapthread-device.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitRuntimeFailure = 1;
+inline constexpr int kExitBadArguments = 2;
+
+// Parses argv into *options. Returns -1 to continue, or an exit code (0 after --help,
+// kExitBadArguments with a message on stderr naming the argument).
+int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* options);
+
+// Runs the client until the duration elapses or a signal arrives; returns an exit code.
+int RunDeviceClient(const DeviceClientOptions& options);
+
+}  // namespace snapthread::device

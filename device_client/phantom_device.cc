@@ -1,0 +1,110 @@
+// UNTESTED (no OpenHaptics SDK or device here): see phantom_device.h.
+#include "phantom_device.h"
+
+#include <cmath>
+
+namespace snapthread::device {
+
+PhantomDevice::PhantomDevice() { caps_.model_name = "phantom"; }
+
+PhantomDevice::~PhantomDevice() { Close(); }
+
+bool PhantomDevice::Open(std::string* error) {
+  handle_ = hdInitDevice(HD_DEFAULT_DEVICE);
+  HDErrorInfo err = hdGetError();
+  if (HD_DEVICE_ERROR(err)) {
+    if (error) *error = std::string("hdInitDevice: ") + hdGetErrorString(err.errorCode);
+    return false;
+  }
+  hdMakeCurrentDevice(handle_);
+  // Capabilities in HD units (mm, N, N/mm) converted to metres.
+  HDdouble max_force = 0, max_stiffness = 0, max_damping = 0, workspace[6] = {0, 0, 0, 0, 0, 0};
+  hdGetDoublev(HD_NOMINAL_MAX_CONTINUOUS_FORCE, &max_force);
+  hdGetDoublev(HD_NOMINAL_MAX_STIFFNESS, &max_stiffness);
+  hdGetDoublev(HD_NOMINAL_MAX_DAMPING, &max_damping);
+  hdGetDoublev(HD_USABLE_WORKSPACE_DIMENSIONS, workspace);
+  caps_.model_name = std::string("phantom:") + hdGetString(HD_DEVICE_MODEL_TYPE);
+  caps_.max_force_n = max_force;
+  caps_.max_stiffness_n_per_m = 1000.0 * max_stiffness;           // N/mm -> N/m
+  caps_.max_linear_damping_n_per_m_per_s = 1000.0 * max_damping;  // N s/mm -> N s/m
+  double r = 0.0;
+  for (int k = 0; k < 3; ++k) r = std::max(r, 0.5e-3 * std::abs(workspace[k + 3] - workspace[k]));
+  caps_.workspace_radius_m = r;
+  caps_.max_velocity_m_per_s = 1.0;
+  caps_.has_orientation = false;  // the grip is sensed but not torqued (3-DOF output)
+  hdEnable(HD_FORCE_OUTPUT);
+  hdEnable(HD_MAX_FORCE_CLAMPING);
+  callback_ = hdScheduleAsynchronous(&PhantomDevice::ServoCallback, this,
+                                     HD_DEFAULT_SCHEDULER_PRIORITY);
+  hdStartScheduler();
+  err = hdGetError();
+  if (HD_DEVICE_ERROR(err)) {
+    if (error) *error = std::string("hdStartScheduler: ") + hdGetErrorString(err.errorCode);
+    Close();
+    return false;
+  }
+  open_ = true;
+  return true;
+}
+
+HDCallbackCode HDCALLBACK PhantomDevice::ServoCallback(void* self_ptr) {
+  auto* self = static_cast<PhantomDevice*>(self_ptr);
+  hdBeginFrame(self->handle_);
+  HDdouble pos_mm[3], vel_mm_s[3], transform[16];
+  HDint buttons = 0;
+  hdGetDoublev(HD_CURRENT_POSITION, pos_mm);
+  hdGetDoublev(HD_CURRENT_VELOCITY, vel_mm_s);
+  hdGetDoublev(HD_CURRENT_TRANSFORM, transform);
+  hdGetIntegerv(HD_CURRENT_BUTTONS, &buttons);
+  DeviceState s;
+  for (int k = 0; k < 3; ++k) {
+    s.position_m[k] = 1e-3 * pos_mm[k];
+    s.velocity_m_per_s[k] = 1e-3 * vel_mm_s[k];
+  }
+  // Rotation (column-major 4x4) -> quaternion (w, x, y, z).
+  const double m00 = transform[0], m11 = transform[5], m22 = transform[10];
+  const double w = 0.5 * std::sqrt(std::max(0.0, 1.0 + m00 + m11 + m22));
+  s.orientation[0] = w;
+  if (w > 1e-6) {
+    s.orientation[1] = (transform[6] - transform[9]) / (4.0 * w);
+    s.orientation[2] = (transform[8] - transform[2]) / (4.0 * w);
+    s.orientation[3] = (transform[1] - transform[4]) / (4.0 * w);
+  }
+  s.buttons = buttons;
+  self->state_.Write(s);
+  Force f{{0.0, 0.0, 0.0}};
+  self->force_.Read(&f);
+  hdSetDoublev(HD_CURRENT_FORCE, f.force_n);
+  hdEndFrame(self->handle_);
+  HDErrorInfo err = hdGetError();
+  if (HD_DEVICE_ERROR(err)) {
+    self->fault_.store(true);
+    return HD_CALLBACK_DONE;
+  }
+  return HD_CALLBACK_CONTINUE;
+}
+
+bool PhantomDevice::Read(DeviceState* state) {
+  if (!open_ || fault_.load(std::memory_order_relaxed)) return false;
+  return state_.Read(state);
+}
+
+bool PhantomDevice::Command(const double force_n[3], const double /*torque_nm*/[3]) {
+  if (!open_ || fault_.load(std::memory_order_relaxed)) return false;
+  force_.Write(Force{{force_n[0], force_n[1], force_n[2]}});
+  return true;
+}
+
+void PhantomDevice::Close() {
+  if (handle_ == HD_INVALID_HANDLE) return;
+  force_.Write(Force{{0.0, 0.0, 0.0}});
+  hdStopScheduler();
+  if (callback_ != HD_INVALID_HANDLE) hdUnschedule(callback_);
+  hdDisable(HD_FORCE_OUTPUT);
+  hdDisableDevice(handle_);
+  handle_ = HD_INVALID_HANDLE;
+  callback_ = HD_INVALID_HANDLE;
+  open_ = false;
+}
+
+}  // namespace snapthread::device

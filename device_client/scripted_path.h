@@ -1,0 +1,47 @@
+// A scripted grasp path in device metres, traversed back and forth at constant speed:
+// the input of the simulated backends (sim-path follows it exactly, virtual-hand is
+// pulled along it by a spring).
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "snapthread/scene.h"
+
+namespace snapthread::device {
+
+class ScriptedPath {
+ public:
+  // waypoints in metres (>= 1), speed > 0. Throws std::invalid_argument otherwise.
+  ScriptedPath(std::vector<std::array<double, 3>> waypoints_m, double speed_m_per_s);
+
+  // The scene's grasp.path (or grasp.start when it has no path), model units, mapped to
+  // device metres with the inverse of model = model_origin + model_units_per_metre * u.
+  static ScriptedPath FromScene(const Scene& scene, double speed_m_per_s);
+  // A CSV file of positions in metres, one "x,y,z" (or "x,y") per line; lines starting
+  // with '#' and a non-numeric header line are skipped. Throws std::runtime_error with the
+  // file and line on a bad file.
+  static ScriptedPath FromCsv(const std::string& path, double speed_m_per_s);
+
+  // Position and velocity at time t_s >= 0 since the start (back and forth forever).
+  // No allocation.
+  void Evaluate(double t_s, double position_m[3], double velocity_m_per_s[3]) const;
+
+  double length_m() const { return total_length_m_; }
+  const std::vector<std::array<double, 3>>& waypoints_m() const { return waypoints_; }
+  // Largest distance of a waypoint from the origin, metres.
+  double max_radius_m() const;
+
+ private:
+  std::vector<std::array<double, 3>> waypoints_;
+  std::vector<double> cumulative_m_;  // arc length at each waypoint
+  double total_length_m_ = 0.0;
+  double speed_m_per_s_;
+};
+
+// Device metres -> model units (DeviceMapping), and back.
+std::array<double, 3> DeviceToModel(const DeviceMapping& mapping, const double device_m[3]);
+std::array<double, 3> ModelToDevice(const DeviceMapping& mapping, const double model[3]);
+
+}  // namespace snapthread::device

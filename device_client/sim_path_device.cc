@@ -1,0 +1,50 @@
+#include "sim_path_device.h"
+
+namespace snapthread::device {
+
+SimPathDevice::SimPathDevice(ScriptedPath path, MicrosClock clock)
+    : path_(std::move(path)), clock_(clock) {
+  // Generous limits: a simulated device is limited by the scene's DeviceMapping.
+  caps_.model_name = "sim-path";
+  caps_.max_force_n = 10.0;
+  caps_.max_stiffness_n_per_m = 2000.0;
+  caps_.max_linear_damping_n_per_m_per_s = 20.0;
+  caps_.workspace_radius_m = 0.25;
+  caps_.max_velocity_m_per_s = 2.0;
+  caps_.has_orientation = false;
+}
+
+bool SimPathDevice::Open(std::string* error) {
+  if (clock_ == nullptr) {
+    if (error) *error = "sim-path: no clock";
+    return false;
+  }
+  open_ = true;
+  start_us_ = -1;
+  return true;
+}
+
+bool SimPathDevice::Read(DeviceState* state) {
+  if (!open_) return false;
+  const int64_t now = clock_();
+  if (start_us_ < 0) start_us_ = now;
+  path_.Evaluate(1e-6 * static_cast<double>(now - start_us_), state->position_m,
+                 state->velocity_m_per_s);
+  state->orientation[0] = 1.0;
+  state->orientation[1] = state->orientation[2] = state->orientation[3] = 0.0;
+  state->buttons = 1;  // the scripted hand always holds the grasp
+  return true;
+}
+
+bool SimPathDevice::Command(const double force_n[3], const double /*torque_nm*/[3]) {
+  if (!open_) return false;
+  for (int k = 0; k < 3; ++k) last_force_n_[k] = force_n[k];
+  return true;
+}
+
+void SimPathDevice::Close() {
+  for (double& f : last_force_n_) f = 0.0;
+  open_ = false;
+}
+
+}  // namespace snapthread::device

@@ -1,0 +1,52 @@
+// virtual-hand backend: a simulated hand holding the grasp. A point mass pulled toward
+// the scripted path by a spring with near-critical damping and pushed by the rendered
+// force: it closes the haptic loop, so a force model that would be unstable on a real
+// device (negative stiffness, too stiff for the tick) shows up as oscillation here.
+#pragma once
+
+#include <cstdint>
+
+#include "haptic_device.h"
+#include "scripted_path.h"
+#include "sim_clock.h"
+
+namespace snapthread::device {
+
+struct VirtualHandParams {
+  double mass_kg = 0.1;                // hand + device effective mass
+  double spring_n_per_m = 200.0;       // the arm's pull toward the intended path
+  double damping_ratio = 1.0;          // of the hand alone (1 = critical)
+  double max_substep_s = 0.0005;       // integration step bound (semi-implicit Euler)
+  double max_dt_s = 0.05;              // longer gaps (stalls) are integrated as this long
+};
+
+class VirtualHandDevice final : public HapticDevice {
+ public:
+  VirtualHandDevice(ScriptedPath path, VirtualHandParams params, MicrosClock clock);
+
+  bool Open(std::string* error) override;
+  const DeviceCapabilities& capabilities() const override { return caps_; }
+  // Advances the hand by the time since the previous Read under the last commanded
+  // force, then reports it.
+  bool Read(DeviceState* state) override;
+  bool Command(const double force_n[3], const double torque_nm[3]) override;
+  void Close() override;
+
+  // Steps the hand by dt_s with the current force (also used by Read); public for tests.
+  void Integrate(double t_s, double dt_s);
+  const double* position_m() const { return x_; }
+
+ private:
+  ScriptedPath path_;
+  VirtualHandParams params_;
+  MicrosClock clock_;
+  DeviceCapabilities caps_;
+  bool open_ = false;
+  int64_t start_us_ = -1;
+  int64_t last_us_ = -1;
+  double x_[3] = {0.0, 0.0, 0.0};
+  double v_[3] = {0.0, 0.0, 0.0};
+  double force_n_[3] = {0.0, 0.0, 0.0};
+};
+
+}  // namespace snapthread::device
