@@ -1,0 +1,281 @@
+// End-to-end: snapthread-viewer runs as a real process under xvfb-run, receives shapes over
+// udpm loopback, and its screenshot must show the thread where the camera projects it.
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include "hud_layout.h"
+#include "orbit_camera.h"
+#include "snapthread/thread_shape_t.hpp"
+#include "snapthread/transport/channels.h"
+#include "spline.h"
+#include "test_support.h"
+
+namespace snapthread::viewer_test {
+namespace {
+
+using viewer::CatmullRomCurve;
+using viewer::OrbitCamera;
+using viewer::Point3;
+
+constexpr char kLoopbackUrl[] = "udpm://239.255.76.67:7667?ttl=0";
+constexpr int kWidth = 640;
+constexpr int kHeight = 480;
+constexpr int kNodes = 21;
+
+// A half circle of radius 1 from (1, 0) over (0, 1) to (-1, 0), in the z = 0 plane.
+std::vector<Point3> ArcNodes() {
+  std::vector<Point3> nodes;
+  for (int i = 0; i < kNodes; ++i) {
+    const double a = M_PI * i / (kNodes - 1);
+    nodes.emplace_back(std::cos(a), std::sin(a), 0.0);
+  }
+  return nodes;
+}
+
+thread_shape_t ArcShape(int64_t seq) {
+  thread_shape_t s{};
+  s.utime = seq * 16000;
+  s.seq = seq;
+  s.scene = "test-arc";
+  s.model = "curve2d";
+  s.num_nodes = kNodes;
+  for (const auto& p : ArcNodes()) s.positions.push_back({p.x(), p.y(), p.z()});
+  const auto& last = s.positions.back();
+  for (int i = 0; i < 3; ++i) {
+    s.grasp[i] = last[i];
+    s.grip_direction[i] = 0.0;  // free grip: no direction arrow
+    s.force[i] = 0.0;           // no force arrow, so only the thread, clamp and grasp are drawn
+    s.force_newtons[i] = 0.0;
+  }
+  s.status = 0;
+  s.snaps = 0;
+  return s;
+}
+
+// Publishes the arc every 20 ms (plus malformed packets when asked) until stopped.
+class ShapePublisher {
+ public:
+  ShapePublisher(const std::string& session, bool with_garbage)
+      : channel_(transport::Channels(session).shape), garbage_(with_garbage) {}
+  ~ShapePublisher() { Stop(); }
+  bool Start() {
+    if (!lcm_.good()) return false;
+    thread_ = std::thread([this] { Loop(); });
+    return true;
+  }
+  void Stop() {
+    running_ = false;
+    if (thread_.joinable()) thread_.join();
+  }
+  int64_t garbage_sent() const { return garbage_sent_; }
+
+ private:
+  void Loop() {
+    std::mt19937 rng(42);
+    int64_t seq = 0;
+    while (running_) {
+      if (garbage_) PublishGarbage(seq, &rng);
+      thread_shape_t s = ArcShape(++seq);
+      lcm_.publish(channel_, &s);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+  void PublishGarbage(int64_t seq, std::mt19937* rng) {
+    thread_shape_t s = ArcShape(seq);
+    std::vector<uint8_t> buf(s.getEncodedSize());
+    s.encode(buf.data(), 0, int(buf.size()));
+    switch (seq % 5) {
+      case 0: {  // random bytes
+        std::vector<uint8_t> junk(100 + (*rng)() % 400);
+        for (auto& b : junk) b = uint8_t((*rng)());
+        lcm_.publish(channel_, junk.data(), junk.size());
+        break;
+      }
+      case 1:  // truncated mid-positions
+        lcm_.publish(channel_, buf.data(), buf.size() / 2);
+        break;
+      case 2: {  // num_nodes claims far more nodes than the buffer holds
+        // fingerprint 8, utime 8, seq 8, scene (4 + 9), model (4 + 8), then num_nodes.
+        const size_t at = 8 + 8 + 8 + 4 + s.scene.size() + 1 + 4 + s.model.size() + 1;
+        const uint8_t huge[4] = {0x7f, 0xff, 0xff, 0xff};
+        std::memcpy(&buf[at], huge, 4);
+        lcm_.publish(channel_, buf.data(), buf.size());
+        break;
+      }
+      case 3: {  // string length INT32_MIN
+        const uint8_t neg[4] = {0x80, 0, 0, 0};
+        std::memcpy(&buf[24], neg, 4);
+        lcm_.publish(channel_, buf.data(), buf.size());
+        break;
+      }
+      default: {  // a NaN node position: decodes, must be refused by validation
+        thread_shape_t bad = ArcShape(seq);
+        bad.positions[3][1] = std::nan("");
+        lcm_.publish(channel_, &bad);
+        break;
+      }
+    }
+    garbage_sent_++;
+  }
+
+  lcm::LCM lcm_{kLoopbackUrl};
+  std::string channel_;
+  bool garbage_;
+  std::atomic<bool> running_{true};
+  std::atomic<int64_t> garbage_sent_{0};
+  std::thread thread_;
+};
+
+struct ViewerRun {
+  ProcessResult result;
+  std::string png;
+};
+
+ViewerRun RunViewerScreenshot(const std::string& session, const std::string& dir,
+                              int after_shapes, double timeout_s) {
+  ViewerRun run;
+  run.png = dir + "/shot.png";
+  std::random_device rd;
+  const std::string server_num = std::to_string(100 + rd() % 800);
+  const std::vector<std::string> argv = {
+      "xvfb-run", "-a", "-n", server_num, "-s", "-screen 0 1280x720x24",
+      BinDir() + "/snapthread-viewer", "--session", session, "--lcm-url", kLoopbackUrl,
+      "--screenshot", run.png, "--after-shapes", std::to_string(after_shapes), "--timeout-s",
+      std::to_string(timeout_s), "--width", std::to_string(kWidth), "--height",
+      std::to_string(kHeight)};
+  const int pid = StartProcess(argv, dir + "/out.txt", dir + "/err.txt");
+  EXPECT_GT(pid, 0) << "cannot start xvfb-run";
+  if (pid > 0) run.result = WaitProcess(pid, timeout_s + 40.0, dir + "/out.txt", dir + "/err.txt");
+  return run;
+}
+
+bool IsBackground(const uint8_t* p) {
+  // Renderer's kBackground (0.11, 0.12, 0.15) in 8 bits, a few levels of tolerance.
+  return std::abs(p[0] - 28) <= 4 && std::abs(p[1] - 31) <= 4 && std::abs(p[2] - 38) <= 4;
+}
+
+bool InOverlay(double x, double y, double margin) {
+  const viewer::HudLayout l = viewer::MakeHudLayout(kWidth, kHeight);
+  auto inside = [&](const viewer::PixelRect& r) {
+    return x >= r.x - margin && x < r.x + r.width + margin && y >= r.y - margin &&
+           y < r.y + r.height + margin;
+  };
+  return inside(l.text) || inside(l.chart);
+}
+
+// Checks the screenshot against the projection of the arc with the viewer's camera fit.
+void ExpectArcDrawn(const Image& img) {
+  ASSERT_EQ(img.width, kWidth);
+  ASSERT_EQ(img.height, kHeight);
+  const std::vector<Point3> nodes = ArcNodes();
+  Eigen::Vector3d lo = nodes[0], hi = nodes[0];
+  for (const auto& p : nodes) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  OrbitCamera camera;
+  camera.Fit(lo, hi, double(kWidth) / kHeight);
+  std::vector<Eigen::Vector2d> path;
+  for (const auto& p : CatmullRomCurve(nodes, 8)) {
+    path.push_back(camera.ProjectToPixel(p, kWidth, kHeight));
+  }
+  // 1) Along the projected path the tube is drawn (not background).
+  int on = 0, checked = 0;
+  for (const auto& q : path) {
+    if (InOverlay(q.x(), q.y(), 4)) continue;
+    const int x = int(std::lround(q.x())), y = int(std::lround(q.y()));
+    ASSERT_TRUE(x >= 0 && x < kWidth && y >= 0 && y < kHeight) << "arc projects off screen";
+    checked++;
+    on += !IsBackground(img.At(x, y));
+  }
+  ASSERT_GE(checked, 60) << "too few path samples outside the overlays";
+  EXPECT_GE(on, int(0.95 * checked)) << on << " of " << checked << " path pixels drawn";
+  // The path spans the window: the arc is 2 units wide, the fit fills ~70% of the height.
+  double min_x = 1e9, max_x = -1e9;
+  for (const auto& q : path) {
+    min_x = std::min(min_x, q.x());
+    max_x = std::max(max_x, q.x());
+  }
+  EXPECT_GT(max_x - min_x, 0.4 * kWidth);
+  // 2) Far from the path (and outside the overlays) everything is background: this includes
+  //    the inside of the arc, so a filled blob or a straight line would fail.
+  int far = 0, far_background = 0;
+  for (int y = 2; y < kHeight - 2; y += 6) {
+    for (int x = 2; x < kWidth - 2; x += 6) {
+      if (InOverlay(x, y, 2)) continue;
+      double d = 1e9;
+      for (const auto& q : path) d = std::min(d, std::hypot(q.x() - x, q.y() - y));
+      if (d < 30) continue;
+      far++;
+      far_background += IsBackground(img.At(x, y));
+    }
+  }
+  ASSERT_GT(far, 1000);
+  EXPECT_GE(far_background, int(0.995 * far)) << far - far_background << " of " << far
+                                               << " pixels far from the thread are not background";
+  // 3) A point just inside the arc's apex is background, a point on the apex is not.
+  const Eigen::Vector2d apex = camera.ProjectToPixel({0.0, 1.0, 0.0}, kWidth, kHeight);
+  const Eigen::Vector2d centre = camera.ProjectToPixel({0.0, 0.5, 0.0}, kWidth, kHeight);
+  EXPECT_FALSE(IsBackground(img.At(int(apex.x()), int(apex.y()))));
+  EXPECT_TRUE(IsBackground(img.At(int(centre.x()), int(centre.y()))));
+}
+
+TEST(ViewerScreenshotTest, ShowsTheThreadAlongTheProjectedArc) {
+  const std::string session = UniqueSession("VIEWARC");
+  const std::string dir = TempDir("viewer-arc");
+  ShapePublisher publisher(session, /*with_garbage=*/false);
+  ASSERT_TRUE(publisher.Start()) << "LCM publisher failed on " << kLoopbackUrl
+                                 << " (no multicast route? see deploy/multicast-route.sh)";
+  const ViewerRun run = RunViewerScreenshot(session, dir, 5, 30.0);
+  publisher.Stop();
+  ASSERT_TRUE(run.result.exited) << "viewer did not exit; stderr:\n" << run.result.err;
+  ASSERT_EQ(run.result.exit_code, 0) << run.result.out << run.result.err;
+  EXPECT_NE(run.result.out.find("wrote " + run.png), std::string::npos) << run.result.out;
+  Image img;
+  std::string error;
+  ASSERT_TRUE(ReadPng(run.png, &img, &error)) << error;
+  ExpectArcDrawn(img);
+}
+
+TEST(ViewerScreenshotTest, MalformedShapePacketsAreDroppedAndCounted) {
+  const std::string session = UniqueSession("VIEWBAD");
+  const std::string dir = TempDir("viewer-bad");
+  ShapePublisher publisher(session, /*with_garbage=*/true);
+  ASSERT_TRUE(publisher.Start());
+  // 20 valid shapes: by then garbage of every kind has arrived between them.
+  const ViewerRun run = RunViewerScreenshot(session, dir, 20, 30.0);
+  publisher.Stop();
+  ASSERT_TRUE(run.result.exited) << run.result.err;
+  ASSERT_EQ(run.result.exit_code, 0) << "viewer crashed or failed on malformed packets:\n"
+                                     << run.result.out << run.result.err;
+  // "... after N shapes, B bad messages": the bad ones were seen and dropped.
+  const auto at = run.result.out.find("shapes, ");
+  ASSERT_NE(at, std::string::npos) << run.result.out;
+  const long bad = std::atol(run.result.out.c_str() + at + 8);
+  EXPECT_GE(bad, 5) << run.result.out;
+  EXPECT_GE(publisher.garbage_sent(), bad);
+  Image img;
+  std::string error;
+  ASSERT_TRUE(ReadPng(run.png, &img, &error)) << error;
+  ExpectArcDrawn(img);  // the valid shapes still render correctly
+}
+
+TEST(ViewerScreenshotTest, TimesOutWithAClearMessageWhenNothingArrives) {
+  const std::string session = UniqueSession("VIEWNONE");
+  const std::string dir = TempDir("viewer-none");
+  const ViewerRun run = RunViewerScreenshot(session, dir, 1, 1.5);
+  ASSERT_TRUE(run.result.exited) << run.result.err;
+  EXPECT_EQ(run.result.exit_code, 2);
+  EXPECT_NE(run.result.err.find("timeout"), std::string::npos) << run.result.err;
+  EXPECT_NE(run.result.err.find(session + "_SHAPE"), std::string::npos) << run.result.err;
+}
+
+}  // namespace
+}  // namespace snapthread::viewer_test

@@ -1,0 +1,114 @@
+#include "session_receiver.h"
+
+#include <cmath>
+
+#include "shape_check.h"
+#include "snapthread/transport/channels.h"
+
+namespace snapthread::viewer {
+
+SessionReceiver::SessionReceiver(lcm::LCM* lcm, const std::string& session)
+    : lcm_(lcm),
+      shape_channel_(transport::Channels(session).shape),
+      status_channel_(transport::Channels(session).solver_status) {
+  subscriptions_.push_back(lcm_->subscribe(shape_channel_, &SessionReceiver::OnShape, this));
+  subscriptions_.push_back(lcm_->subscribe(status_channel_, &SessionReceiver::OnStatus, this));
+  for (auto* s : subscriptions_) {
+    // Latest wins: a viewer never needs a backlog of stale shapes.
+    if (s != nullptr) s->setQueueCapacity(4);
+  }
+}
+
+SessionReceiver::~SessionReceiver() {
+  Stop();
+  for (auto* s : subscriptions_) {
+    if (s != nullptr) lcm_->unsubscribe(s);
+  }
+}
+
+void SessionReceiver::Start() {
+  if (running_.exchange(true)) return;
+  thread_ = std::thread(&SessionReceiver::Loop, this);
+}
+
+void SessionReceiver::Stop() {
+  running_ = false;
+  if (thread_.joinable()) thread_.join();
+}
+
+void SessionReceiver::Loop() {
+  while (running_) {
+    // Bounded wait so Stop() is honoured within 50 ms.
+    if (lcm_->handleTimeout(50) < 0) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      last_error_ = "lcm handle failed";
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }
+}
+
+double SessionReceiver::NowS() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+void SessionReceiver::OnShape(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  thread_shape_t shape;
+  std::string why;
+  if (!DecodeShape(rbuf->data, static_cast<int>(rbuf->data_size), &shape, &why)) {
+    bad_messages_++;
+    std::lock_guard<std::mutex> lock(mutex_);
+    latest_.bad_messages = bad_messages_.load();
+    last_error_ = shape_channel_ + ": " + why;
+    return;
+  }
+  const double now = NowS();
+  const double f = std::sqrt(shape.force_newtons[0] * shape.force_newtons[0] +
+                             shape.force_newtons[1] * shape.force_newtons[1] +
+                             shape.force_newtons[2] * shape.force_newtons[2]);
+  std::lock_guard<std::mutex> lock(mutex_);
+  latest_.shape = std::move(shape);
+  latest_.has_shape = true;
+  latest_.shapes_received = ++shapes_received_;
+  shape_times_s_.push_back(now);
+  while (!shape_times_s_.empty() && shape_times_s_.front() < now - 1.0) shape_times_s_.pop_front();
+  history_.push_back({now, f});
+  while (!history_.empty() && history_.front().time_s < now - kHistorySeconds) {
+    history_.pop_front();
+  }
+}
+
+void SessionReceiver::OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  solver_status_t status;
+  std::string why;
+  if (!DecodeSolverStatus(rbuf->data, static_cast<int>(rbuf->data_size), &status, &why)) {
+    bad_messages_++;
+    std::lock_guard<std::mutex> lock(mutex_);
+    latest_.bad_messages = bad_messages_.load();
+    last_error_ = status_channel_ + ": " + why;
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  latest_.status = std::move(status);
+  latest_.has_status = true;
+  latest_.statuses_received++;
+}
+
+SessionSnapshot SessionReceiver::Snapshot(bool with_history) const {
+  const double now = NowS();
+  std::lock_guard<std::mutex> lock(mutex_);
+  SessionSnapshot s = latest_;
+  s.bad_messages = bad_messages_.load();
+  s.now_s = now;
+  int recent = 0;
+  for (double t : shape_times_s_) recent += (t >= now - 1.0);
+  s.shape_rate_hz = recent;
+  if (with_history) s.force_history.assign(history_.begin(), history_.end());
+  return s;
+}
+
+std::string SessionReceiver::last_error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_error_;
+}
+
+}  // namespace snapthread::viewer

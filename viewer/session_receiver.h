@@ -1,0 +1,84 @@
+// The viewer's LCM side: subscribes to <SESSION>_SHAPE and <SESSION>_SOLVER_STATUS, vets
+// every message (bad ones are dropped and counted; handlers never throw) and keeps the latest
+// of each for the render loop. LCM is handled on its own thread, so rendering never blocks
+// on the network.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "snapthread/solver_status_t.hpp"
+#include "snapthread/thread_shape_t.hpp"
+
+namespace snapthread::viewer {
+
+struct ForceSample {
+  double time_s;   // receive time, seconds since the receiver started
+  double force_n;  // |force_newtons|
+};
+
+struct SessionSnapshot {
+  bool has_shape = false;
+  thread_shape_t shape;
+  bool has_status = false;
+  solver_status_t status;
+  int64_t shapes_received = 0;   // valid shapes since start
+  int64_t statuses_received = 0;
+  int64_t bad_messages = 0;      // malformed messages dropped (both channels)
+  double shape_rate_hz = 0.0;    // valid shapes over the last second
+  std::vector<ForceSample> force_history;  // last kHistorySeconds
+  double now_s = 0.0;            // seconds since the receiver started
+};
+
+class SessionReceiver {
+ public:
+  static constexpr double kHistorySeconds = 10.0;
+
+  // Subscribes on `lcm` (which must be good()). Call Start() to begin handling.
+  // `session` must be a valid session name (transport::Channels throws otherwise).
+  SessionReceiver(lcm::LCM* lcm, const std::string& session);
+  ~SessionReceiver();
+  SessionReceiver(const SessionReceiver&) = delete;
+  SessionReceiver& operator=(const SessionReceiver&) = delete;
+
+  void Start();
+  void Stop();
+  // Copies the current state; `with_history` false skips the force history copy.
+  SessionSnapshot Snapshot(bool with_history = true) const;
+  int64_t shapes_received() const { return shapes_received_.load(); }
+  int64_t bad_messages() const { return bad_messages_.load(); }
+  std::string last_error() const;
+  const std::string& shape_channel() const { return shape_channel_; }
+
+ private:
+  void OnShape(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void Loop();
+  double NowS() const;
+
+  lcm::LCM* lcm_;
+  std::string shape_channel_;
+  std::string status_channel_;
+  std::vector<lcm::Subscription*> subscriptions_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::thread thread_;
+  std::atomic<bool> running_{false};
+  std::atomic<int64_t> shapes_received_{0};
+  std::atomic<int64_t> bad_messages_{0};
+
+  mutable std::mutex mutex_;  // guards everything below
+  SessionSnapshot latest_;
+  std::deque<double> shape_times_s_;
+  std::deque<ForceSample> history_;
+  std::string last_error_;
+};
+
+}  // namespace snapthread::viewer
