@@ -14,9 +14,7 @@ void SmallestEigenpair::Resize(int n) {
 
 void SmallestEigenpair::Reset() { initialized_ = false; }
 
-double SmallestEigenpair::Update(const SymmetricLinearSolver& factor, const SparseMatrix& h,
-                                 int iterations) {
-  const int n = static_cast<int>(h.rows());
+void SmallestEigenpair::EnsureInitialized(int n) {
   Resize(n);
   if (!initialized_) {
     // A deterministic start with components on every mode of a chain.
@@ -24,6 +22,11 @@ double SmallestEigenpair::Update(const SymmetricLinearSolver& factor, const Spar
     v_.normalize();
     initialized_ = true;
   }
+}
+
+double SmallestEigenpair::Update(const SymmetricLinearSolver& factor, const SparseMatrix& h,
+                                 int iterations) {
+  EnsureInitialized(static_cast<int>(h.rows()));
   for (int k = 0; k < iterations; ++k) {
     if (factor.Solve(v_, &w_) != LinearSolverStatus::kSuccess) break;
     const double norm = w_.norm();

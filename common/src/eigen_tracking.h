@@ -21,6 +21,8 @@ class SmallestEigenpair {
   const Vec& vector() const { return v_; }
   double value() const { return lambda_; }
   void Reset();
+  // Sets the deterministic start vector if no eigenvector has been tracked yet.
+  void EnsureInitialized(int n);
 
  private:
   Vec v_, w_;

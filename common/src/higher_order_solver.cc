@@ -263,11 +263,15 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       }
       xr -= dx_;
     } else {
+      // A factorisation that failed on an exactly singular E_xx still allows the
+      // reduction: it needs only the restricted factor and the last eigenvector.
+      const bool many_negative = st == LinearSolverStatus::kSuccess && factor_->NegativePivots() > 1;
       StepResult res = StepResult::kFailed;
-      if (st == LinearSolverStatus::kSuccess && factor_->NegativePivots() <= 1) {
+      if (!many_negative) {
+        eig_.EnsureInitialized(n_);
         res = ReductionStep(u, &xr, &s);
       }
-      if (res == StepResult::kSnap || factor_->NegativePivots() > 1) {
+      if (res == StepResult::kSnap || many_negative) {
         if (!FinishSnap(u, &xr, &s)) {
           s.termination = Termination::kLinearSolverFailed;
           s.message = "snap minimiser did not converge";

@@ -53,7 +53,7 @@ class SolverBase : public EquilibriumSolver {
   double lambda_ref_ = -1.0;  // lambda_0 at the last regular converged state
   std::vector<int> diag_index_;  // position of (i,i) in h_.valuePtr()
   SmallestEigenpair eig_;
-  Vec g_, dx_, trial_, last_good_;
+  Vec g_, dx_, trial_, last_good_, dx_scratch_;
   Clock::time_point start_;
 };
 
