@@ -1,0 +1,232 @@
+// Unit tests of the server's message building (units, planar constraint, torque, status
+// flags, never NaN) and pose mapping, without any transport.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "pose_mapping.h"
+#include "server_messages.h"
+#include "snapthread/models.h"
+#include "snapthread/transport/validate.h"
+
+namespace snapthread::server {
+namespace {
+
+DeviceMapping TestMapping() {
+  DeviceMapping m;
+  m.model_units_per_metre = 50.0;
+  m.newtons_per_model_force = 2.0;
+  m.max_stiffness_n_per_m = 800.0;
+  m.model_origin = {9.0, 1.0, 0.25};
+  return m;
+}
+
+TrackResult FakeResult(int nu, double scale) {
+  TrackResult r;
+  r.summary.termination = Termination::kConverged;
+  r.force = Vec::LinSpaced(nu, 1.0 * scale, nu * scale);
+  r.stiffness = Mat::Zero(nu, nu);
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nu; ++j) r.stiffness(i, j) = -(1.0 + i + j) * scale;
+  }
+  return r;
+}
+
+TEST(PoseMappingTest, PlanarAndSpatialControls) {
+  const DeviceMapping map = TestMapping();
+  ModelParams p;
+  p.model = "curve2d";
+  auto curve = MakeModel(p);
+  const Eigen::Vector3d pos(0.01, -0.02, 0.3);
+  const Eigen::Vector4d q(1, 0, 0, 0);
+  const Vec u = PoseToControls(map, *curve, pos, q);
+  ASSERT_EQ(u.size(), 2);
+  EXPECT_DOUBLE_EQ(u[0], 9.0 + 50.0 * 0.01);
+  EXPECT_DOUBLE_EQ(u[1], 1.0 - 50.0 * 0.02);
+  // Inverse: x, y back, z on the model plane.
+  const Eigen::Vector3d back = ControlsToPosition(map, *curve, u);
+  EXPECT_NEAR(back[0], 0.01, 1e-15);
+  EXPECT_NEAR(back[1], -0.02, 1e-15);
+  EXPECT_DOUBLE_EQ(back[2], PlanarZ0(map));
+  EXPECT_DOUBLE_EQ(PlanarZ0(map), -0.25 / 50.0);
+
+  p.model = "thread3d";
+  p.grip_direction = true;
+  auto thread = MakeModel(p);
+  ASSERT_EQ(thread->NumControls(), 6);
+  // 90 degrees about z: (1,0,0) -> (0,1,0).
+  const double h = std::sqrt(0.5);
+  const Vec u3 = PoseToControls(map, *thread, pos, Eigen::Vector4d(h, 0, 0, h));
+  EXPECT_DOUBLE_EQ(u3[2], 0.25 + 50.0 * 0.3);
+  EXPECT_NEAR(u3[3], 0.0, 1e-15);
+  EXPECT_NEAR(u3[4], 1.0, 1e-15);
+  EXPECT_NEAR(u3[5], 0.0, 1e-15);
+  // A non-unit quaternion is normalised; 180 degrees about z gives -x.
+  const Eigen::Vector3d d = GripDirection(Eigen::Vector4d(0, 0, 0, 1.7));
+  EXPECT_NEAR(d[0], -1.0, 1e-15);
+  EXPECT_NEAR(d.norm(), 1.0, 1e-15);
+}
+
+TEST(ServerMessagesTest, PlanarForceModelUnitsAndPlane) {
+  const DeviceMapping map = TestMapping();
+  ModelParams p;
+  p.model = "curve2d";
+  auto model = MakeModel(p);
+  const TrackResult r = FakeResult(2, 0.5);
+  ForceModelInputs in;
+  in.mapping = &map;
+  in.model = model.get();
+  in.u = Vec::Zero(2);
+  in.position_m = Eigen::Vector3d(0.01, 0.02, 0.003);
+  in.result = &r;
+  in.device_seq = 41;
+  in.device_utime = 123456;
+  in.server_receive_utime = 777;
+  in.solve_us = 12.4;
+  in.seq = 5;
+  in.utime = 999;
+  const force_model_t m = BuildForceModel(in);
+  EXPECT_EQ(m.status, force_model_t::STATUS_REGULAR);
+  EXPECT_EQ(m.device_seq, 41);
+  EXPECT_EQ(m.device_utime, 123456);
+  EXPECT_EQ(m.server_receive_utime, 777);
+  EXPECT_EQ(m.solve_us, 12);
+  EXPECT_EQ(m.seq, 5);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_DOUBLE_EQ(m.f0[i], 2.0 * r.force[i]);
+    for (int j = 0; j < 2; ++j) EXPECT_DOUBLE_EQ(m.K[i][j], 2.0 * 50.0 * r.stiffness(i, j));
+    EXPECT_DOUBLE_EQ(m.K[i][2], 0.0);
+    EXPECT_DOUBLE_EQ(m.K[2][i], 0.0);
+  }
+  // Planar constraint: f_z = -k (z - z0), k = max stiffness / 2.
+  const double k = 400.0;
+  EXPECT_DOUBLE_EQ(m.K[2][2], -k);
+  EXPECT_NEAR(m.f0[2], -k * (0.003 - PlanarZ0(map)), 1e-12);
+  EXPECT_EQ(m.has_torque, 0);
+  for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(m.u0[i], in.position_m[i]);
+  std::string why;
+  EXPECT_TRUE(transport::Validate(m, &why)) << why;
+}
+
+TEST(ServerMessagesTest, GripTorque) {
+  const DeviceMapping map = TestMapping();
+  ModelParams p;
+  p.model = "thread3d";
+  p.grip_direction = true;
+  auto model = MakeModel(p);
+  TrackResult r = FakeResult(6, 1.0);
+  r.force.segment<3>(3) = Eigen::Vector3d(0.0, 3.0, 0.0);  // F_d
+  ForceModelInputs in;
+  in.mapping = &map;
+  in.model = model.get();
+  in.u = Vec::Zero(6);
+  in.u.segment<3>(3) = Eigen::Vector3d(2.0, 0.0, 0.0);  // d (normalised inside)
+  in.result = &r;
+  const force_model_t m = BuildForceModel(in);
+  EXPECT_EQ(m.has_torque, 1);
+  // tau = d x F_d = (1,0,0) x (0,3,0) = (0,0,3), model energy -> N m: * 2 / 50.
+  EXPECT_NEAR(m.torque0[0], 0.0, 1e-15);
+  EXPECT_NEAR(m.torque0[1], 0.0, 1e-15);
+  EXPECT_NEAR(m.torque0[2], 3.0 * 2.0 / 50.0, 1e-15);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_DOUBLE_EQ(m.f0[i], 2.0 * r.force[i]);
+    for (int j = 0; j < 3; ++j) EXPECT_DOUBLE_EQ(m.K[i][j], 100.0 * r.stiffness(i, j));
+  }
+}
+
+TEST(ServerMessagesTest, StatusFlags) {
+  TrackResult r = FakeResult(2, 1.0);
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_REGULAR);
+  r.stiffness_regularized = true;
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_NEAR_FOLD);
+  r.stiffness_regularized = false;
+  r.summary.status = EquilibriumStatus::kNearFold;
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_NEAR_FOLD);
+  r.snapped = true;
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_SNAPPED);
+  r.summary.termination = Termination::kBudgetSpent;
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_SNAPPED);
+  r.summary.termination = Termination::kLinearSolverFailed;
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_INVALID);
+  EXPECT_EQ(ClassifyStatus(nullptr), force_model_t::STATUS_INVALID);
+}
+
+TEST(ServerMessagesTest, NonFiniteResultBecomesInvalidZeroModel) {
+  const DeviceMapping map = TestMapping();
+  ModelParams p;
+  p.model = "curve2d";
+  auto model = MakeModel(p);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int variant = 0; variant < 4; ++variant) {
+    TrackResult r = FakeResult(2, 1.0);
+    if (variant == 0) r.force[1] = nan;
+    if (variant == 1) r.stiffness(0, 1) = inf;
+    if (variant == 2) r.summary.termination = Termination::kNonFinite;
+    if (variant == 3) r.summary.residual = nan;
+    ForceModelInputs in;
+    in.mapping = &map;
+    in.model = model.get();
+    in.u = Vec::Zero(2);
+    in.position_m = Eigen::Vector3d(0.01, 0.0, 0.0);
+    in.result = &r;
+    const force_model_t m = BuildForceModel(in);
+    EXPECT_TRUE(IsFinite(m)) << "variant " << variant;
+    std::string why;
+    EXPECT_TRUE(transport::Validate(m, &why)) << why;
+    if (variant < 3) {
+      EXPECT_EQ(m.status, force_model_t::STATUS_INVALID) << "variant " << variant;
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_EQ(m.f0[i], 0.0);
+        for (int j = 0; j < 3; ++j) EXPECT_EQ(m.K[i][j], 0.0);
+      }
+    } else {
+      // A NaN residual alone does not invalidate a finite force: it is reported as 0.
+      EXPECT_EQ(m.status, force_model_t::STATUS_REGULAR);
+      EXPECT_EQ(m.residual, 0.0);
+    }
+  }
+  // A failed update (no result) is INVALID too, with the pose echoed.
+  ForceModelInputs in;
+  in.mapping = &map;
+  in.model = model.get();
+  in.u = Vec::Zero(2);
+  in.position_m = Eigen::Vector3d(0.01, 0.02, 0.0);
+  const force_model_t m = BuildForceModel(in);
+  EXPECT_EQ(m.status, force_model_t::STATUS_INVALID);
+  EXPECT_EQ(m.u0[1], 0.02);
+}
+
+TEST(ServerMessagesTest, ShapeCountsMatchAndValidate) {
+  const DeviceMapping map = TestMapping();
+  ModelParams p;
+  p.model = "curve2d";
+  p.n = 7;
+  auto model = MakeModel(p);
+  const Vec u = (Vec(2) << 6.0, 0.5).finished();
+  ShapeInputs in;
+  in.scene = "s";
+  in.mapping = &map;
+  in.model = model.get();
+  in.u = u;
+  in.x = model->InitialState(u);
+  in.force_model_units = (Vec(2) << 1.5, -2.0).finished();
+  in.force_newtons = Eigen::Vector3d(3.0, -4.0, 0.0);
+  in.status = force_model_t::STATUS_SNAPPED;
+  in.snaps = 3;
+  const thread_shape_t s = BuildShape(in);
+  EXPECT_EQ(s.model, "curve2d");
+  EXPECT_EQ(s.num_nodes, static_cast<int>(s.positions.size()));
+  EXPECT_EQ(s.num_nodes, 8);  // n + 1 nodes
+  EXPECT_DOUBLE_EQ(s.grasp[0], 6.0);
+  EXPECT_DOUBLE_EQ(s.grasp[1], 0.5);
+  EXPECT_DOUBLE_EQ(s.force[0], 1.5);
+  EXPECT_DOUBLE_EQ(s.force_newtons[1], -4.0);
+  EXPECT_EQ(s.snaps, 3);
+  std::string why;
+  EXPECT_TRUE(transport::Validate(s, &why)) << why;
+}
+
+}  // namespace
+}  // namespace snapthread::server
