@@ -1,1 +1,429 @@
+// Analytic derivatives of every model against central finite differences, one test body
+// per model configuration (TEST_P), plus the no-allocation contract of the evaluation
+// calls on presized outputs.
+//
+// Central differences with step h ~ 1e-6 have truncation error O(h²) ~ 1e-12 and
+// round-off ~ eps |E| / h ~ 1e-9 relative to the derivatives checked here, so the
+// relative-norm tolerance 1e-6 passes with margin while any wrong term (a missing
+// factor, sign, transpose or chain-rule piece) is off by O(1).
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <cstdlib>
+#include <ostream>
+#include <random>
+#include <string>
+#include <vector>
+
 #include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "snapthread/models.h"
+
+// ---------------------------------------------------------------------------------
+// Allocation counting (Drake's LimitMalloc idea): this test binary interposes glibc's
+// malloc family and counts calls while a guard is active. Eigen's dynamic objects and
+// operator new all end in these functions.
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
+#define SNAPTHREAD_COUNT_MALLOC 1
+namespace {
+std::atomic<bool> g_count_allocations{false};
+std::atomic<long> g_allocations{0};
+void NoteAllocation() {
+  if (g_count_allocations.load(std::memory_order_relaxed)) {
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+}  // namespace
+extern "C" {
+void* __libc_malloc(std::size_t size);
+void* __libc_calloc(std::size_t count, std::size_t size);
+void* __libc_realloc(void* ptr, std::size_t size);
+void* __libc_memalign(std::size_t alignment, std::size_t size);
+void* malloc(std::size_t size) {
+  NoteAllocation();
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t count, std::size_t size) {
+  NoteAllocation();
+  return __libc_calloc(count, size);
+}
+void* realloc(void* ptr, std::size_t size) {
+  NoteAllocation();
+  return __libc_realloc(ptr, size);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t size) {
+  NoteAllocation();
+  return __libc_memalign(alignment, size);
+}
+int posix_memalign(void** out, std::size_t alignment, std::size_t size) {
+  NoteAllocation();
+  *out = __libc_memalign(alignment, size);
+  return *out == nullptr ? 12 /* ENOMEM */ : 0;
+}
+}
+#endif
+
+namespace snapthread {
+namespace {
+
+struct Case {
+  std::string name;
+  ModelParams params;
+};
+
+// gtest prints parameters on failure: the name, not the object's bytes.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
+std::vector<Case> AllCases() {
+  std::vector<Case> cases;
+  cases.push_back({"zeeman", {.model = "zeeman"}});
+  cases.push_back({"cusp", {.model = "cusp"}});
+  // Non-default lengths and stiffnesses so that a coefficient mix-up cannot cancel.
+  for (int n : {2, 3, 5, 10, 23}) {
+    ModelParams p;
+    p.model = "curve2d";
+    p.n = n;
+    p.segment_length = 0.7;
+    p.bending = 1.3;
+    p.stretching = 40.0;
+    cases.push_back({"curve2d_n" + std::to_string(n), p});
+  }
+  for (bool grip : {false, true}) {
+    for (int n : {2, 3, 5, 10, 17}) {
+      if (grip && n < 3) continue;
+      ModelParams p;
+      p.model = "thread3d";
+      p.n = n;
+      p.segment_length = 0.8;
+      p.bending = 2.1;
+      p.stretching = 60.0;
+      p.reference_bend = 0.3;
+      p.grip_direction = grip;
+      cases.push_back({"thread3d_n" + std::to_string(n) + (grip ? "_grip" : ""), p});
+    }
+  }
+  return cases;
+}
+
+// A state/control pair to differentiate at.
+struct Point {
+  Vec x;
+  Vec u;
+};
+
+// Random states: for chains, controls near a compressed chord (|chord| = 0.8 n l, random
+// direction, out of plane too in 3D), a grip direction roughly along the chord with a
+// non-unit length, and the InitialState perturbed by ~0.1 l per coordinate.
+std::vector<Point> RandomPoints(const Model& model, const ModelParams& p, int count,
+                                unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<Point> points;
+  for (int k = 0; k < count; ++k) {
+    Point pt;
+    pt.u.resize(model.NumControls());
+    if (p.model == "zeeman") {
+      pt.u << 1.5 * unit(rng), 2.25 + 1.75 * unit(rng);
+      pt.x = Vec::Constant(1, 3.14 * unit(rng));
+    } else if (p.model == "cusp") {
+      pt.u << 2.0 * unit(rng), 2.0 * unit(rng);
+      pt.x = Vec::Constant(1, 2.0 * unit(rng));
+    } else {
+      const double total = p.n * p.segment_length;
+      Eigen::Vector3d dir(1.0, 0.4 * unit(rng), 0.4 * unit(rng));
+      if (p.model == "curve2d") dir.z() = 0.0;
+      dir.normalize();
+      const Eigen::Vector3d chord = 0.8 * total * dir;
+      pt.u.head(model.SpatialDimension()) = chord.head(model.SpatialDimension());
+      if (p.grip_direction) {
+        const Eigen::Vector3d d =
+            1.7 * dir + 0.3 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+        pt.u.tail<3>() = d;
+      }
+      pt.x = model.InitialState(pt.u);
+      for (int i = 0; i < pt.x.size(); ++i) pt.x[i] += 0.1 * p.segment_length * unit(rng);
+    }
+    points.push_back(pt);
+  }
+  return points;
+}
+
+constexpr double kStep = 1e-6;
+constexpr double kRelTol = 1e-6;
+
+// |a - b| <= tol (|b| + floor): relative in norm, with a small absolute floor for blocks
+// that are exactly zero (e.g. E_uu of the cusp, rows of E_xu away from the grasp).
+::testing::AssertionResult RelClose(const Mat& analytic, const Mat& fd, double floor) {
+  const double err = (analytic - fd).norm();
+  const double bound = kRelTol * (fd.norm() + floor);
+  if (err <= bound) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "error " << err << " > bound " << bound
+                                       << "\nanalytic:\n" << analytic << "\nfinite difference:\n"
+                                       << fd;
+}
+
+Vec FdEnergyX(const Model& m, const Vec& x, const Vec& u) {
+  Vec out(x.size());
+  for (int i = 0; i < x.size(); ++i) {
+    Vec xp = x, xm = x;
+    xp[i] += kStep;
+    xm[i] -= kStep;
+    out[i] = (m.Energy(xp, u) - m.Energy(xm, u)) / (2.0 * kStep);
+  }
+  return out;
+}
+Vec FdEnergyU(const Model& m, const Vec& x, const Vec& u) {
+  Vec out(u.size());
+  for (int i = 0; i < u.size(); ++i) {
+    Vec up = u, um = u;
+    up[i] += kStep;
+    um[i] -= kStep;
+    out[i] = (m.Energy(x, up) - m.Energy(x, um)) / (2.0 * kStep);
+  }
+  return out;
+}
+// Column j: central difference of the gradient along x_j (E_xx) or u_j (E_xu).
+Mat FdGradient(const Model& m, const Vec& x, const Vec& u, bool along_u) {
+  const int cols = along_u ? static_cast<int>(u.size()) : static_cast<int>(x.size());
+  Mat out(x.size(), cols);
+  Vec gp, gm;
+  for (int j = 0; j < cols; ++j) {
+    Vec xp = x, xm = x, up = u, um = u;
+    (along_u ? up : xp)[j] += kStep;
+    (along_u ? um : xm)[j] -= kStep;
+    m.Gradient(xp, up, &gp);
+    m.Gradient(xm, um, &gm);
+    out.col(j) = (gp - gm) / (2.0 * kStep);
+  }
+  return out;
+}
+Mat FdControlGradientU(const Model& m, const Vec& x, const Vec& u) {
+  Mat out(u.size(), u.size());
+  Vec gp, gm;
+  for (int j = 0; j < u.size(); ++j) {
+    Vec up = u, um = u;
+    up[j] += kStep;
+    um[j] -= kStep;
+    m.ControlGradient(x, up, &gp);
+    m.ControlGradient(x, um, &gm);
+    out.col(j) = (gp - gm) / (2.0 * kStep);
+  }
+  return out;
+}
+
+class ModelDerivativeTest : public ::testing::TestWithParam<Case> {
+ protected:
+  void SetUp() override { model_ = MakeModel(GetParam().params); }
+  std::unique_ptr<Model> model_;
+};
+
+TEST_P(ModelDerivativeTest, SizesAndPatternAreConsistent) {
+  const Model& m = *model_;
+  const ModelParams& p = GetParam().params;
+  if (p.model == "curve2d") {
+    EXPECT_EQ(m.NumStates(), 2 * p.n - 3);
+    EXPECT_EQ(m.NumControls(), 2);
+  } else if (p.model == "thread3d") {
+    EXPECT_EQ(m.NumStates(), p.grip_direction ? 3 * p.n - 7 : 3 * p.n - 5);
+    EXPECT_EQ(m.NumControls(), p.grip_direction ? 6 : 3);
+  } else {
+    EXPECT_EQ(m.NumStates(), 1);
+    EXPECT_EQ(m.NumControls(), 2);
+  }
+  const SparseMatrix& pattern = m.HessianPattern();
+  ASSERT_EQ(pattern.rows(), m.NumStates());
+  ASSERT_EQ(pattern.cols(), m.NumStates());
+  EXPECT_TRUE(pattern.isCompressed());
+  // Structurally symmetric, and the advertised bandwidth is the pattern's.
+  int bandwidth = 0;
+  for (int col = 0; col < pattern.cols(); ++col) {
+    for (SparseMatrix::InnerIterator it(pattern, col); it; ++it) {
+      bandwidth = std::max(bandwidth, std::abs(static_cast<int>(it.row()) - col));
+      bool found = false;
+      for (SparseMatrix::InnerIterator jt(pattern, it.row()); jt; ++jt) found |= jt.row() == col;
+      EXPECT_TRUE(found) << "(" << it.row() << "," << col << ") without its transpose";
+    }
+  }
+  EXPECT_EQ(m.HessianBandwidth(), bandwidth);
+  // O(n) non-zeros for chains: at most 3 nodes per term, so a row couples at most 5
+  // nodes' coordinates.
+  EXPECT_LE(pattern.nonZeros(), 5L * m.SpatialDimension() * m.NumStates());
+}
+
+TEST_P(ModelDerivativeTest, DerivativesMatchFiniteDifferences) {
+  const Model& m = *model_;
+  const ModelParams& p = GetParam().params;
+  for (const Point& pt : RandomPoints(m, p, 4, 12345u)) {
+    const Vec& x = pt.x;
+    const Vec& u = pt.u;
+    ASSERT_TRUE(std::isfinite(m.Energy(x, u)));
+
+    Vec g;
+    m.Gradient(x, u, &g);
+    ASSERT_EQ(g.size(), m.NumStates());
+    EXPECT_TRUE(RelClose(g, FdEnergyX(m, x, u), 1e-6)) << "E_x";
+
+    SparseMatrix h;
+    m.Hessian(x, u, &h);
+    ASSERT_EQ(h.rows(), m.NumStates());
+    // Exactly HessianPattern()'s structure.
+    const SparseMatrix& pattern = m.HessianPattern();
+    ASSERT_EQ(h.nonZeros(), pattern.nonZeros());
+    for (int j = 0; j <= h.cols(); ++j) ASSERT_EQ(h.outerIndexPtr()[j], pattern.outerIndexPtr()[j]);
+    for (int k = 0; k < h.nonZeros(); ++k) ASSERT_EQ(h.innerIndexPtr()[k], pattern.innerIndexPtr()[k]);
+    const Mat hd = Mat(h);
+    EXPECT_LE((hd - hd.transpose()).norm(), 1e-12 * hd.norm()) << "E_xx not symmetric";
+    EXPECT_TRUE(RelClose(hd, FdGradient(m, x, u, false), 1e-6)) << "E_xx";
+
+    Vec eu;
+    m.ControlGradient(x, u, &eu);
+    ASSERT_EQ(eu.size(), m.NumControls());
+    EXPECT_TRUE(RelClose(eu, FdEnergyU(m, x, u), 1e-6)) << "E_u";
+
+    Mat exu;
+    m.MixedHessian(x, u, &exu);
+    ASSERT_EQ(exu.rows(), m.NumStates());
+    ASSERT_EQ(exu.cols(), m.NumControls());
+    EXPECT_TRUE(RelClose(exu, FdGradient(m, x, u, true), 1e-6)) << "E_xu";
+
+    Mat euu;
+    m.ControlHessian(x, u, &euu);
+    ASSERT_EQ(euu.rows(), m.NumControls());
+    ASSERT_EQ(euu.cols(), m.NumControls());
+    EXPECT_TRUE(RelClose(euu, FdControlGradientU(m, x, u), 1e-6)) << "E_uu";
+
+    if (p.grip_direction) {
+      // Only d/|d| enters: scaling d changes nothing, so E_d is orthogonal to d.
+      const Eigen::Vector3d d = u.tail<3>();
+      EXPECT_LE(std::abs(eu.tail<3>().dot(d)), 1e-9 * (eu.norm() + 1.0) * d.norm());
+    }
+  }
+}
+
+TEST_P(ModelDerivativeTest, PresizedOutputsAreReusedWithoutAllocation) {
+  const Model& m = *model_;
+  const Point pt = RandomPoints(m, GetParam().params, 1, 777u).front();
+  SparseMatrix h = m.HessianPattern();
+  Vec g(m.NumStates()), eu(m.NumControls());
+  Mat exu(m.NumStates(), m.NumControls()), euu(m.NumControls(), m.NumControls());
+  const double* values = h.valuePtr();
+  const int* inner = h.innerIndexPtr();
+  const int* outer = h.outerIndexPtr();
+  const double* g_data = g.data();
+  const double* exu_data = exu.data();
+
+#ifdef SNAPTHREAD_COUNT_MALLOC
+  // Sanity check of the counter itself, so a broken interposition cannot pass silently.
+  g_allocations = 0;
+  g_count_allocations = true;
+  { Vec scratch(1000); scratch.setZero(); }
+  g_count_allocations = false;
+  ASSERT_GE(g_allocations.load(), 1) << "malloc counter is not counting";
+  g_allocations = 0;
+  g_count_allocations = true;
+#endif
+  double e = 0.0;
+  for (int rep = 0; rep < 3; ++rep) {
+    e += m.Energy(pt.x, pt.u);
+    m.Gradient(pt.x, pt.u, &g);
+    m.Hessian(pt.x, pt.u, &h);
+    m.ControlGradient(pt.x, pt.u, &eu);
+    m.MixedHessian(pt.x, pt.u, &exu);
+    m.ControlHessian(pt.x, pt.u, &euu);
+  }
+#ifdef SNAPTHREAD_COUNT_MALLOC
+  g_count_allocations = false;
+  EXPECT_EQ(g_allocations.load(), 0) << "evaluation allocated on presized outputs";
+#endif
+  EXPECT_TRUE(std::isfinite(e));
+  EXPECT_EQ(h.valuePtr(), values);
+  EXPECT_EQ(h.innerIndexPtr(), inner);
+  EXPECT_EQ(h.outerIndexPtr(), outer);
+  EXPECT_EQ(g.data(), g_data);
+  EXPECT_EQ(exu.data(), exu_data);
+  // And the values were written (not left at the pattern's zeros).
+  EXPECT_GT(Mat(h).norm(), 0.0);
+}
+
+TEST_P(ModelDerivativeTest, WrongSizedOutputsAreResized) {
+  const Model& m = *model_;
+  const Point pt = RandomPoints(m, GetParam().params, 1, 99u).front();
+  SparseMatrix h;  // empty: must receive the pattern
+  Vec g, eu;
+  Mat exu(7, 1), euu;
+  m.Gradient(pt.x, pt.u, &g);
+  m.Hessian(pt.x, pt.u, &h);
+  m.ControlGradient(pt.x, pt.u, &eu);
+  m.MixedHessian(pt.x, pt.u, &exu);
+  m.ControlHessian(pt.x, pt.u, &euu);
+  EXPECT_EQ(g.size(), m.NumStates());
+  EXPECT_EQ(h.rows(), m.NumStates());
+  EXPECT_EQ(h.nonZeros(), m.HessianPattern().nonZeros());
+  EXPECT_EQ(eu.size(), m.NumControls());
+  EXPECT_EQ(exu.rows(), m.NumStates());
+  EXPECT_EQ(exu.cols(), m.NumControls());
+  EXPECT_EQ(euu.rows(), m.NumControls());
+  // Same values as with a presized matrix.
+  SparseMatrix h2 = m.HessianPattern();
+  m.Hessian(pt.x, pt.u, &h2);
+  EXPECT_EQ((Mat(h) - Mat(h2)).norm(), 0.0);
+}
+
+TEST_P(ModelDerivativeTest, NodesProbeAndInitialStateAreConsistent) {
+  const Model& m = *model_;
+  const ModelParams& p = GetParam().params;
+  const Point pt = RandomPoints(m, p, 1, 4242u).front();
+  Eigen::Matrix3Xd nodes;
+  m.NodePositions(pt.x, pt.u, &nodes);
+  ASSERT_GE(nodes.cols(), 1);
+  EXPECT_TRUE(nodes.allFinite());
+  EXPECT_GT(m.ForceScale(), 0.0);
+  if (p.model == "curve2d" || p.model == "thread3d") {
+    ASSERT_EQ(nodes.cols(), p.n + 1);
+    EXPECT_EQ(nodes.col(0).norm(), 0.0);                       // p_0 clamped at 0
+    EXPECT_EQ(nodes.col(1).tail<2>().norm(), 0.0);             // y_1 = z_1 = 0
+    const int dim = m.SpatialDimension();
+    EXPECT_EQ((nodes.col(p.n).head(dim) - pt.u.head(dim)).norm(), 0.0);  // p_n is the grasp
+    EXPECT_EQ(m.Probe(pt.x, pt.u), nodes(1, p.n / 2));
+    if (p.grip_direction) {
+      // Node N-1 sits on the grip line at distance s behind p_N.
+      const Eigen::Vector3d d = pt.u.tail<3>().normalized();
+      const Eigen::Vector3d back = nodes.col(p.n) - nodes.col(p.n - 1);
+      EXPECT_NEAR(back.dot(d), pt.x[m.NumStates() - 1], 1e-12);
+      EXPECT_LE((back - back.dot(d) * d).norm(), 1e-12);
+    }
+    // The initial state spans the chord: evenly spaced along it, off it only by the
+    // 1e-3 l symmetry-breaking bump.
+    const Vec x0 = m.InitialState(pt.u);
+    ASSERT_EQ(x0.size(), m.NumStates());
+    Eigen::Matrix3Xd n0;
+    m.NodePositions(x0, pt.u, &n0);
+    const Eigen::Vector3d chord = n0.col(p.n);
+    for (int i = 1; i < p.n; ++i) {
+      if (p.grip_direction && i == p.n - 1) continue;
+      const Eigen::Vector3d expected = chord * (static_cast<double>(i) / p.n);
+      const double tol = 1e-3 * p.segment_length + 1e-12;
+      if (i == 1) {
+        EXPECT_LE(std::abs(n0(0, 1) - expected.x()), tol);  // its y, z are clamped to 0
+      } else {
+        EXPECT_LE((n0.col(i) - expected).norm(), tol) << "node " << i;
+        EXPECT_GT((n0.col(i) - expected).norm(), 0.0) << "no symmetry-breaking bump at " << i;
+      }
+    }
+  } else if (p.model == "zeeman") {
+    ASSERT_EQ(nodes.cols(), 4);
+    EXPECT_NEAR(nodes.col(1).norm(), 1.0, 1e-15);               // wheel point on the unit wheel
+    EXPECT_EQ(nodes.col(2), Eigen::Vector3d(0.0, -3.0, 0.0));   // anchor
+    EXPECT_EQ(m.Probe(pt.x, pt.u), pt.x[0]);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllModels, ModelDerivativeTest, ::testing::ValuesIn(AllCases()),
+                         [](const ::testing::TestParamInfo<Case>& info) { return info.param.name; });
+
+}  // namespace
+}  // namespace snapthread
