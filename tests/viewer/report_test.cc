@@ -1,0 +1,280 @@
+// snapthread-report on logs written here with lcm::LogFile: known messages with sequence
+// gaps, a repeat, a snap and clamps; then the same log truncated or damaged.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include "snapthread/device_state_t.hpp"
+#include "snapthread/device_status_t.hpp"
+#include "snapthread/force_model_t.hpp"
+#include "snapthread/solver_status_t.hpp"
+#include "snapthread/thread_shape_t.hpp"
+#include "test_support.h"
+
+namespace snapthread::viewer_test {
+namespace {
+
+constexpr int64_t kT0 = 1700000000000000;  // log time origin, us
+constexpr int kModels = 200;
+// Force-model sequence numbers left out of the log: one gap of 3 and one of 1.
+bool Dropped(int seq) { return (seq >= 50 && seq <= 52) || seq == 120; }
+
+class LogWriter {
+ public:
+  explicit LogWriter(const std::string& path) : log_(path, "w") {}
+  bool good() const { return log_.good(); }
+  template <class T>
+  void Write(const std::string& channel, int64_t t_us, const T& msg) {
+    std::vector<uint8_t> buf(msg.getEncodedSize());
+    msg.encode(buf.data(), 0, int(buf.size()));
+    WriteRaw(channel, t_us, buf);
+  }
+  void WriteRaw(const std::string& channel, int64_t t_us, std::vector<uint8_t> data) {
+    lcm::LogEvent e;
+    e.timestamp = t_us;
+    e.channel = channel;
+    e.datalen = int32_t(data.size());
+    e.data = data.data();
+    log_.writeEvent(&e);
+  }
+
+ private:
+  lcm::LogFile log_;
+};
+
+force_model_t Model(int seq) {
+  force_model_t m{};
+  m.utime = kT0 + seq * 1000 + 500;
+  m.seq = seq;
+  m.device_seq = seq;
+  m.device_utime = seq * 1000;
+  m.server_receive_utime = kT0 + seq * 1000 + 100;
+  m.solve_us = 200 + seq % 7;
+  m.status = seq == 100 ? force_model_t::STATUS_SNAPPED : force_model_t::STATUS_REGULAR;
+  m.f0[0] = 0.01 * seq;  // |F| grows to 2.0 N at seq 200
+  m.f0[1] = 0.0;
+  m.f0[2] = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    m.u0[i] = 0.0;
+    m.torque0[i] = 0.0;
+    for (int j = 0; j < 3; ++j) m.K[i][j] = i == j ? -50.0 : 0.0;
+  }
+  m.has_torque = 0;
+  m.iterations = 2 + (seq == 100 ? 17 : 0);
+  m.residual = 1e-11;
+  return m;
+}
+
+// Writes the reference log and returns its path.
+std::string WriteReferenceLog(const std::string& dir) {
+  const std::string path = dir + "/session.lcmlog";
+  LogWriter log(path);
+  EXPECT_TRUE(log.good());
+  for (int k = 1; k <= kModels; ++k) {
+    const int64_t t = kT0 + k * 1000;
+    device_state_t pose{};
+    pose.utime = k * 1000;
+    pose.seq = k;
+    pose.device_id = "test";
+    pose.position[0] = pose.position[1] = pose.position[2] = 0.0;
+    pose.orientation[0] = 1.0;
+    pose.orientation[1] = pose.orientation[2] = pose.orientation[3] = 0.0;
+    pose.buttons = 1;
+    log.Write("RPT_DEVICE_STATE", t, pose);
+    if (!Dropped(k)) log.Write("RPT_FORCE_MODEL", t + 700, Model(k));  // 700 us round trip
+    if (k == 11) log.Write("RPT_FORCE_MODEL", t + 800, Model(10));   // a late repeat
+    if (k % 10 == 0) {
+      thread_shape_t s{};
+      s.utime = t;
+      s.seq = k / 10;
+      s.scene = "test";
+      s.model = "curve2d";
+      s.num_nodes = 2;
+      s.positions = {{0, 0, 0}, {1, 0, 0}};
+      for (int i = 0; i < 3; ++i) {
+        s.grasp[i] = s.grip_direction[i] = s.force[i] = s.force_newtons[i] = 0.0;
+      }
+      s.snaps = k > 100 ? 1 : 0;
+      log.Write("RPT_SHAPE", t + 10, s);
+      solver_status_t st{};
+      st.utime = t;
+      st.seq = k / 10;
+      st.scene = "test";
+      st.method = k <= 100 ? "newton" : "higher-order";
+      st.iterations = 2;
+      st.residual = 1e-11;
+      st.lambda_min = 0.5;
+      st.update_rate_hz = 1000;
+      st.solve_us_p50 = 200;
+      st.solve_us_p99 = 300;
+      st.updates = k;
+      log.Write("RPT_SOLVER_STATUS", t + 20, st);
+    }
+    if (k % 40 == 0) {
+      device_status_t d{};
+      d.utime = k * 1000;
+      d.seq = k / 40;
+      d.device_id = "test";
+      d.tick_rate_hz = 1000;
+      d.lateness_us_p50 = 5 + k / 40;
+      d.lateness_us_p99 = 40 + k / 10;
+      d.lateness_us_max = 90 + k / 10;
+      d.model_age_ms = 0.7;
+      d.round_trip_us_p50 = 700;
+      d.round_trip_us_p99 = 900;
+      d.force_norm_n = 0.01 * k;
+      d.ticks = k;
+      d.force_clamps = k / 40 - 1;  // 0 .. 4 over the five statuses
+      log.Write("RPT_DEVICE_STATUS", t + 30, d);
+    }
+  }
+  log.WriteRaw("OTHER_CHANNEL", kT0 + (kModels + 1) * 1000, {1, 2, 3});
+  return path;
+}
+
+ProcessResult RunReport(const std::string& log, const std::string& out_dir) {
+  const std::vector<std::string> argv = {BinDir() + "/snapthread-report", log, "--out", out_dir};
+  const int pid = StartProcess(argv, out_dir + ".stdout", out_dir + ".stderr");
+  EXPECT_GT(pid, 0);
+  return WaitProcess(pid, 120.0, out_dir + ".stdout", out_dir + ".stderr");
+}
+
+std::string Line(const std::string& text, const std::string& start) {
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind(start, 0) == 0) return line;
+  }
+  return "";
+}
+
+// A PNG with real content: valid, plot-sized, many colours and a good share of ink.
+void ExpectNonTrivialPng(const std::string& path) {
+  Image img;
+  std::string error;
+  ASSERT_TRUE(ReadPng(path, &img, &error)) << path << ": " << error;
+  EXPECT_GE(img.width, 400);
+  EXPECT_GE(img.height, 300);
+  std::set<uint32_t> colours;
+  size_t ink = 0;
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) {
+      const uint8_t* p = img.At(x, y);
+      colours.insert(uint32_t(p[0]) << 16 | uint32_t(p[1]) << 8 | p[2]);
+      ink += (p[0] < 200 || p[1] < 200 || p[2] < 200);
+    }
+  }
+  EXPECT_GE(colours.size(), 8u) << path;
+  EXPECT_GT(ink, size_t(img.width) * img.height / 100) << path << " is nearly blank";
+}
+
+TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
+  const std::string dir = TempDir("report");
+  const std::string log = WriteReferenceLog(dir);
+  const ProcessResult r = RunReport(log, dir + "/out");
+  ASSERT_TRUE(r.exited);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string summary = ReadFile(dir + "/out/summary.txt");
+  ASSERT_FALSE(summary.empty());
+  EXPECT_NE(summary.find("session: RPT"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("read: COMPLETE"), std::string::npos) << summary;
+  // 200 models - 4 dropped + 1 repeat; gaps 49->53 (3 missing) and 119->121 (1 missing).
+  EXPECT_NE(Line(summary, "channel RPT_FORCE_MODEL ")
+                .find("messages 197 rate_hz"), std::string::npos) << summary;
+  EXPECT_NE(Line(summary, "channel RPT_FORCE_MODEL ")
+                .find("seq 1..200 missing 4 gaps 2 out_of_order 1"), std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("gap RPT_FORCE_MODEL 49 -> 53: 3"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("gap RPT_FORCE_MODEL 119 -> 121: 1"), std::string::npos) << summary;
+  EXPECT_NE(Line(summary, "channel RPT_DEVICE_STATE ")
+                .find("messages 200 rate_hz"), std::string::npos) << summary;
+  EXPECT_NE(Line(summary, "channel RPT_DEVICE_STATE ").find("missing 0 gaps 0 out_of_order 0"),
+            std::string::npos) << summary;
+  EXPECT_NE(Line(summary, "channel RPT_SHAPE ").find("messages 20 "), std::string::npos);
+  EXPECT_NE(Line(summary, "channel RPT_SOLVER_STATUS ").find("messages 20 "), std::string::npos);
+  EXPECT_NE(Line(summary, "channel OTHER_CHANNEL ").find("messages 1 "), std::string::npos);
+  EXPECT_NE(summary.find("max_force_n: 2.0000"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("snaps: 1 "), std::string::npos) << summary;
+  EXPECT_NE(summary.find("shapes count 1"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("clamps: force 4 "), std::string::npos) << summary;
+  EXPECT_NE(summary.find("methods: newton, higher-order"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("duration_s: 0.200"), std::string::npos) << summary;
+  // Round trip as logged: every answered pose took 700 us (the repeat answers pose 10 late).
+  EXPECT_NE(summary.find("round_trip_us (pose logged -> model logged) p50 700"), std::string::npos)
+      << summary;
+  // The CSV carries every force model in log order.
+  std::ifstream csv(dir + "/out/force.csv");
+  int rows = -1;
+  for (std::string line; std::getline(csv, line);) rows++;
+  EXPECT_EQ(rows, 197);
+  for (const char* png : {"force.png", "solver.png", "device.png", "latency_hist.png"}) {
+    SCOPED_TRACE(png);
+    ExpectNonTrivialPng(dir + "/out/" + png);
+  }
+}
+
+TEST(ReportTest, TruncatedLogGivesAPartialReportWithAWarning) {
+  const std::string dir = TempDir("report-trunc");
+  const std::string log = WriteReferenceLog(dir);
+  const auto size = std::filesystem::file_size(log);
+  // Cut inside the last event (the 3-byte OTHER_CHANNEL message).
+  std::filesystem::resize_file(log, size - 5);
+  const ProcessResult r = RunReport(log, dir + "/out");
+  ASSERT_TRUE(r.exited);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("WARNING: partial report"), std::string::npos) << r.err;
+  const std::string summary = ReadFile(dir + "/out/summary.txt");
+  EXPECT_NE(summary.find("read: PARTIAL"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("truncated log"), std::string::npos) << summary;
+  // Everything before the cut is reported.
+  EXPECT_NE(Line(summary, "channel RPT_FORCE_MODEL ").find("messages 197 "), std::string::npos)
+      << summary;
+  EXPECT_EQ(Line(summary, "channel OTHER_CHANNEL "), "") << summary;
+  ExpectNonTrivialPng(dir + "/out/force.png");
+}
+
+TEST(ReportTest, DamagedMiddleIsSkippedAndTheRestStillRead) {
+  const std::string dir = TempDir("report-damage");
+  const std::string log = WriteReferenceLog(dir);
+  const auto size = std::filesystem::file_size(log);
+  {
+    std::fstream f(log, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(std::streamoff(size / 2));
+    const std::string junk(300, '\xAB');
+    f.write(junk.data(), std::streamsize(junk.size()));
+  }
+  const ProcessResult r = RunReport(log, dir + "/out");
+  ASSERT_TRUE(r.exited);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("WARNING: partial report"), std::string::npos) << r.err;
+  const std::string summary = ReadFile(dir + "/out/summary.txt");
+  EXPECT_NE(summary.find("read: PARTIAL"), std::string::npos) << summary;
+  // The last event (after the damage) is still there; a few in the middle are lost.
+  EXPECT_NE(Line(summary, "channel OTHER_CHANNEL ").find("messages 1 "), std::string::npos)
+      << summary;
+  const std::string fm = Line(summary, "channel RPT_FORCE_MODEL ");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(fm, m, std::regex("messages (\\d+) ")));
+  const int n = std::stoi(m[1]);
+  EXPECT_LT(n, 197);
+  EXPECT_GT(n, 170);
+}
+
+TEST(ReportTest, NothingReadableExitsNonZero) {
+  const std::string dir = TempDir("report-junk");
+  const std::string log = dir + "/junk.lcmlog";
+  std::ofstream(log) << std::string(4000, 'x');
+  const ProcessResult r = RunReport(log, dir + "/out");
+  ASSERT_TRUE(r.exited);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("no readable events"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace snapthread::viewer_test

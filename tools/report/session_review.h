@@ -1,0 +1,85 @@
+// Analysis of one session's messages in an LCM log: counts and sequence gaps per channel,
+// force against time with snaps, solver statistics, device timing. Fed event by event
+// (ReadLog), then written out as CSV files and a summary.txt.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "log_reader.h"
+#include "sequence_tracker.h"
+
+namespace snapthread::report {
+
+struct ChannelStats {
+  std::string type;            // message type by channel suffix, "" for foreign channels
+  int64_t messages = 0;
+  int64_t bytes = 0;
+  int64_t rejected = 0;        // failed decode or validation (reason of the first in note)
+  std::string first_rejection;
+  bool has_seq = false;
+  SequenceTracker seq;
+  double first_s = 0.0, last_s = 0.0;  // log time of first / last message
+};
+
+struct ForceRow { double t_s; double f[3]; double norm_n; int status; int64_t seq; };
+struct SolveRow { double t_s; int iterations; double residual; int solve_us; int status; };
+struct StatusRow {
+  double t_s; std::string method; int iterations; double residual; double lambda_min;
+  int negative_pivots; double update_rate_hz; double solve_us_p50; double solve_us_p99;
+  int64_t dropped_poses;
+};
+struct DeviceRow {
+  double t_s; double tick_rate_hz; double lateness_p50_us; double lateness_p99_us;
+  double lateness_max_us; double model_age_ms; double rt_p50_us; double rt_p99_us;
+  double force_norm_n; int64_t force_clamps; int64_t stiffness_clamps; int64_t slew_limits;
+  int64_t fades; int64_t snaps_felt;
+};
+struct RoundTripRow { double t_s; double loop_us; double server_us; };
+
+// Picks the session with the most messages among channels named <SESSION>_<KNOWN SUFFIX>;
+// "" when there is none.
+std::string InferSession(const std::map<std::string, int64_t>& channel_counts);
+
+class SessionReview {
+ public:
+  explicit SessionReview(std::string session);
+  void Add(const lcm::LogEvent& event);
+
+  // Writes the CSV files into `dir` (which must exist); returns the file names written.
+  std::vector<std::string> WriteCsv(const std::string& dir) const;
+  // summary.txt text; `plots` lists PNGs written and `notes` anything worth saying.
+  std::string Summary(const std::string& log_path, const LogReadStats& read,
+                      const std::vector<std::string>& plots,
+                      const std::vector<std::string>& notes) const;
+
+  const std::map<std::string, ChannelStats>& channels() const { return channels_; }
+  bool HasForce() const { return !force_.empty(); }
+  bool HasSolverStatus() const { return !status_.empty(); }
+  bool HasDevice() const { return !device_.empty(); }
+  bool HasRoundTrip() const { return !round_trip_.empty(); }
+  bool HasSolve() const { return !solve_.empty(); }
+  const std::string& session() const { return session_; }
+
+ private:
+  double TimeS(int64_t utime) const { return (utime - t0_us_) * 1e-6; }
+
+  std::string session_;
+  int64_t t0_us_ = -1;
+  double last_s_ = 0.0;
+  std::map<std::string, ChannelStats> channels_;
+  std::vector<ForceRow> force_;
+  std::vector<double> snap_times_s_;
+  std::vector<SolveRow> solve_;
+  std::vector<StatusRow> status_;
+  std::vector<DeviceRow> device_;
+  std::vector<RoundTripRow> round_trip_;
+  std::map<int64_t, int64_t> pose_log_time_us_;  // device seq -> log time (recent poses)
+  int64_t shape_snaps_first_ = -1, shape_snaps_last_ = -1;
+};
+
+}  // namespace snapthread::report
