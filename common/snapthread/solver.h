@@ -67,7 +67,9 @@ struct SolverSummary {
   double energy = 0.0;
   double lambda_min = 0.0;   // smallest eigenvalue estimate of E_xx at the returned state
   int negative_pivots = 0;   // inertia of E_xx at the returned state
-  bool snapped = false;      // the followed minimum vanished and the state moved to another
+  // higher-order: the reduction found that the followed minimum had vanished and the
+  // snap minimiser ran (whether the state really changed branch is the tracker's call).
+  bool snapped = false;
   bool used_reduction = false;  // higher-order: the one-direction reduction was used
   double solve_us = 0.0;
   std::string message;

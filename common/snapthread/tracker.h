@@ -57,6 +57,7 @@ class EquilibriumTracker {
   std::unique_ptr<EquilibriumSolver> solver_;
   Vec x_, x_prev_, u_, u_prev_;
   bool have_prev_ = false;
+  bool have_tangent_ = false;  // sol_ holds E_xx^-1 E_xu of the current state
   double snap_threshold_ = 0.1;
   double lambda_ref_ = -1.0;
   TrackResult result_;

@@ -19,6 +19,7 @@ class SmallestEigenpair {
   // situations near a fold where it matters.
   double Update(const SymmetricLinearSolver& factor, const SparseMatrix& h, int iterations);
   const Vec& vector() const { return v_; }
+  bool initialized() const { return initialized_; }
   double value() const { return lambda_; }
   void Reset();
   // Sets the deterministic start vector if no eigenvector has been tracked yet.

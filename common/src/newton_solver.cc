@@ -45,8 +45,8 @@ void SolverBase::Classify(SolverSummary* s) {
   const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : s->lambda_min;
   const bool near_fold = indefinite || !(s->lambda_min > options_.degeneracy_ratio * ref);
   if (!near_fold && (s->IsConverged() || s->snapped)) lambda_ref_ = s->lambda_min;
-  s->status = s->snapped ? EquilibriumStatus::kSnapped
-                         : (near_fold ? EquilibriumStatus::kNearFold : EquilibriumStatus::kRegular);
+  // kSnapped is decided by the caller from the jump of the state (EquilibriumTracker).
+  s->status = near_fold ? EquilibriumStatus::kNearFold : EquilibriumStatus::kRegular;
 }
 
 int SolverBase::Budget() const {
@@ -148,7 +148,8 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s) {
   const LinearSolverStatus st = FactorAt(x, u, s);
   if (st == LinearSolverStatus::kSuccess) {
     s->negative_pivots = factor_->NegativePivots();
-    s->lambda_min = eig_.Update(*factor_, h_, 2);
+    // Two warm-started steps track the eigenpair; a cold start needs more.
+    s->lambda_min = eig_.Update(*factor_, h_, eig_.initialized() ? 2 : 40);
   } else {
     s->negative_pivots = -1;
     s->lambda_min = 0.0;  // singular to working precision

@@ -48,6 +48,7 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   result_.summary = solver_->Solve(u, &x_);
   result_.snapped = false;
   have_prev_ = false;
+  have_tangent_ = false;
   x_prev_ = x_;
   u_prev_ = u_;
   ComputeForces();
@@ -60,6 +61,9 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   // DESIGN.md #5: warm start from the secant 2 x_{i-1} - x_{i-2}, scaled by how much of
   // the previous control step the new one repeats (exactly the secant for equal steps),
   // and reset after a snap.
+  // Without a secant (after a reset or a snap) use the tangent dx/du = -E_xx^-1 E_xu
+  // from the last implicit differentiation (sol_, regularised near folds): a warm start
+  // that leaves the grasped segment stretched makes E_xx indefinite there.
   x_pred_ = x_;
   if (options_.secant_predictor && have_prev_) {
     const double d2 = (u_ - u_prev_).squaredNorm();
@@ -67,16 +71,22 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
       const double a = std::clamp((u - u_).dot(u_ - u_prev_) / d2, 0.0, 2.0);
       x_pred_ += a * (x_ - x_prev_);
     }
+  } else if (options_.secant_predictor && have_tangent_) {
+    scratch_.noalias() = sol_ * (u - u_);
+    const double step = scratch_.lpNorm<Eigen::Infinity>();
+    const double cap = 5.0 * snap_threshold_;
+    x_pred_ -= (step > cap ? cap / step : 1.0) * scratch_;
   }
   x_prev_ = x_;
   u_prev_ = u_;
   x_ = x_pred_;
   u_ = u;
   result_.summary = solver_->Solve(u, &x_);
+  // A snap is a jump to another branch: the state left the predicted one by more than
+  // the threshold (for every method alike, so the charts compare like with like).
   const double jump = (x_ - x_pred_).lpNorm<Eigen::Infinity>();
-  result_.snapped = result_.summary.snapped || jump > snap_threshold_;
-  if (result_.snapped && result_.summary.status != EquilibriumStatus::kSnapped)
-    result_.summary.status = EquilibriumStatus::kSnapped;
+  result_.snapped = jump > snap_threshold_;
+  if (result_.snapped) result_.summary.status = EquilibriumStatus::kSnapped;
   // After a snap the secant would point along the jump: restart it.
   have_prev_ = !result_.snapped;
   ComputeForces();
@@ -119,6 +129,7 @@ void EquilibriumTracker::ComputeForces() {
       result_.stiffness_regularized = true;
     }
   }
+  have_tangent_ = ok;
   if (ok) {
     result_.stiffness = -(euu_ - exu_.transpose() * sol_);
   }
