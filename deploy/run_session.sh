@@ -1,0 +1,100 @@
+#!/usr/bin/env bash
+# The full local session on loopback: lcm-logger, snapthread-server, snapthread-device
+# (virtual-hand backend) and a viewer (a window when $DISPLAY is set, otherwise under
+# xvfb-run taking a screenshot), for ~10 s; then snapthread-report on the log.
+# Outputs: out/session-<UTC time>/ (log, report/, summaries, viewer.png, process logs).
+#
+# usage: deploy/run_session.sh [--duration S] [--scene FILE] [--session NAME]
+#                              [--lcm-url URL] [--bin-dir DIR] [--out-root DIR]
+set -euo pipefail
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+duration=10
+scene="$here/scenes/curve2d_snap.yaml"
+session="RUN_$(date -u +%Y%m%d_%H%M%S)_$$"
+url="udpm://239.255.76.67:7667?ttl=0"   # loopback only: a local session never leaves the host
+bin="${SNAPTHREAD_BIN_DIR:-$here/build/bin}"
+out_root="$here/out"
+while (($#)); do
+  case "$1" in
+    --duration) duration=$2; shift 2 ;;
+    --scene) scene=$2; shift 2 ;;
+    --session) session=$2; shift 2 ;;
+    --lcm-url) url=$2; shift 2 ;;
+    --bin-dir) bin=$2; shift 2 ;;
+    --out-root) out_root=$2; shift 2 ;;
+    -h|--help) sed -n '2,9p' "${BASH_SOURCE[0]}"; exit 0 ;;
+    *) echo "run_session: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+for b in snapthread-server snapthread-device snapthread-viewer snapthread-report; do
+  [ -x "$bin/$b" ] || { echo "run_session: $bin/$b missing (build first: deploy/setup.sh)" >&2; exit 1; }
+done
+command -v lcm-logger >/dev/null || { echo "run_session: lcm-logger missing (liblcm-bin)" >&2; exit 1; }
+"$here/deploy/multicast-route.sh" >/dev/null 2>&1 || true
+
+out="$out_root/session-$(date -u +%Y%m%d-%H%M%S)"
+mkdir -p "$out"
+log="$out/session.lcmlog"
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+}
+trap cleanup EXIT
+
+echo "run_session: session $session on $url, ${duration} s, outputs in $out"
+# Logger first, so the log holds every sequence number from 1.
+lcm-logger -q -c "${session}_.*" --lcm-url="$url" -f "$log" > "$out/logger.txt" 2>&1 &
+logger_pid=$!
+pids+=("$logger_pid")
+sleep 0.3
+"$bin/snapthread-server" --scene "$scene" --session "$session" --lcm-url "$url" \
+    --duration $((duration + 3)) --summary "$out/server.json" > "$out/server.txt" 2>&1 &
+server_pid=$!
+pids+=("$server_pid")
+sleep 0.5
+
+if [ -n "${DISPLAY:-}" ]; then
+  "$bin/snapthread-viewer" --session "$session" --lcm-url "$url" --duration-s "$((duration + 2))" \
+      > "$out/viewer.txt" 2>&1 &
+  viewer_mode="window on $DISPLAY"
+else
+  # Headless: a screenshot about a third of the way in (shapes come at ~60 Hz).
+  xvfb-run -a -s "-screen 0 1280x720x24" "$bin/snapthread-viewer" --session "$session" \
+      --lcm-url "$url" --screenshot "$out/viewer.png" --after-shapes $((20 * duration)) \
+      --timeout-s $((duration + 5)) > "$out/viewer.txt" 2>&1 &
+  viewer_mode="xvfb screenshot"
+fi
+viewer_pid=$!
+pids+=("$viewer_pid")
+
+device_rc=0
+"$bin/snapthread-device" --backend virtual-hand --scene "$scene" --session "$session" \
+    --lcm-url "$url" --duration "$duration" --no-rt --summary "$out/device.json" \
+    --trace "$out/device_trace.csv" > "$out/device.txt" 2>&1 || device_rc=$?
+server_rc=0
+wait "$server_pid" || server_rc=$?
+viewer_rc=0
+wait "$viewer_pid" || viewer_rc=$?
+kill -INT "$logger_pid" 2>/dev/null || true
+wait "$logger_pid" 2>/dev/null || true
+
+report_rc=0
+"$bin/snapthread-report" "$log" --out "$out/report" --session "$session" > "$out/report.txt" 2>&1 \
+    || report_rc=$?
+
+echo
+echo "run_session: exit codes: device $device_rc, server $server_rc, viewer ($viewer_mode) $viewer_rc, report $report_rc"
+echo "  log:            $log"
+echo "  report:         $out/report/summary.txt"
+echo "  plots:          $(cd "$out/report" 2>/dev/null && ls -1 *.png 2>/dev/null | tr '\n' ' ')"
+[ -f "$out/viewer.png" ] && echo "  viewer:         $out/viewer.png"
+echo "  summaries:      $out/server.json $out/device.json"
+echo "  process output: $out/{server,device,viewer,report,logger}.txt"
+echo
+sed -n '/^channels/,/^$/p' "$out/report/summary.txt" 2>/dev/null || true
+if ((device_rc || server_rc || viewer_rc || report_rc)); then
+  echo "run_session: FAILED (see the process output files above)" >&2
+  exit 1
+fi
+echo "run_session: OK"
