@@ -1,0 +1,460 @@
+// snapthread-device as a real process against a fake server in this test process, over
+// udpm on loopback with a unique session per test. The fake server answers every pose
+// with the local model of a linear spring anchored at the device origin,
+//   F(u) = -k u  ->  f0 = -k u0, K = -k I,
+// which the device's local model reproduces exactly, so the trace's force must follow
+// the spring law. The server is then killed (the force must fade to zero within the
+// timeout + fade window), restarted (the force must come back), and malformed, oversized
+// and NaN packets are thrown at the FORCE_MODEL channel (counted, dropped, no crash,
+// no non-finite output).
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "snapthread/transport/channels.h"
+#include "snapthread/transport/validate.h"
+
+extern char** environ;
+
+namespace snapthread::device {
+namespace {
+
+constexpr const char* kUrl = "udpm://239.255.76.67:7667?ttl=0";
+constexpr double kSpringNPerM = 40.0;
+
+std::string UniqueSession(const std::string& tag) {
+  static std::atomic<int> counter{0};
+  return "DEVTEST_" + tag + "_" + std::to_string(getpid()) + "_" + std::to_string(counter++) +
+         "_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count() % 100000);
+}
+
+std::string TempDir() {
+  char tmpl[] = "/tmp/snapthread_device_test_XXXXXX";
+  const char* d = mkdtemp(tmpl);
+  EXPECT_NE(d, nullptr);
+  return d ? d : "/tmp";
+}
+
+// A temporary directory, removed at the end of a passing test (kept for a failing one).
+struct ScopedDir {
+  ScopedDir() : path(TempDir()) {}
+  ~ScopedDir() {
+    if (!::testing::Test::HasFailure() && path.rfind("/tmp/snapthread_device_test_", 0) == 0) {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  }
+  std::string path;
+};
+
+std::string DeviceBinary() {
+  const char* bin = std::getenv("SNAPTHREAD_BIN_DIR");
+  return bin ? std::string(bin) + "/snapthread-device" : std::string();
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A child process with stdout/stderr in files.
+class Process {
+ public:
+  Process(const std::vector<std::string>& args, const std::string& out_prefix)
+      : out_(out_prefix + ".out"), err_(out_prefix + ".err") {
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&fa, 2, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int rc = posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0) pid_ = -1;
+  }
+  ~Process() {
+    if (pid_ > 0 && !exited_) {
+      kill(pid_, SIGKILL);
+      int status;
+      waitpid(pid_, &status, 0);
+    }
+  }
+  bool started() const { return pid_ > 0; }
+  void Signal(int sig) {
+    if (pid_ > 0 && !exited_) kill(pid_, sig);
+  }
+  // Exit code, or -1 on a timeout (then the process is killed) or a signal death.
+  int Wait(double timeout_s) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < deadline) {
+      int status = 0;
+      const pid_t r = waitpid(pid_, &status, WNOHANG);
+      if (r == pid_) {
+        exited_ = true;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    kill(pid_, SIGKILL);
+    int status;
+    waitpid(pid_, &status, 0);
+    exited_ = true;
+    return -1;
+  }
+  std::string out() const { return ReadFile(out_); }
+  std::string err() const { return ReadFile(err_); }
+
+ private:
+  pid_t pid_ = -1;
+  bool exited_ = false;
+  std::string out_, err_;
+};
+
+// "key": number from the summary JSON (NaN when absent).
+double JsonNumber(const std::string& json, const std::string& key) {
+  const std::string k = "\"" + key + "\":";
+  const size_t p = json.find(k);
+  if (p == std::string::npos) return std::numeric_limits<double>::quiet_NaN();
+  return std::strtod(json.c_str() + p + k.size(), nullptr);
+}
+
+struct TraceSample {
+  double t_s, seq, x[3], f[3], model_age_ms;
+  int model_status, clamped, fading;
+};
+
+std::vector<TraceSample> ReadTrace(const std::string& path, std::string* header) {
+  std::ifstream in(path);
+  std::vector<TraceSample> rows;
+  std::string line;
+  std::getline(in, line);
+  *header = line;
+  while (std::getline(in, line)) {
+    TraceSample s{};
+    if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d", &s.t_s, &s.seq,
+                    &s.x[0], &s.x[1], &s.x[2], &s.f[0], &s.f[1], &s.f[2], &s.model_age_ms,
+                    &s.model_status, &s.clamped, &s.fading) == 12) {
+      rows.push_back(s);
+    }
+  }
+  return rows;
+}
+
+// The fake server: answers each device pose with the spring's local model.
+class FakeServer {
+ public:
+  explicit FakeServer(const std::string& session) : channels_(session), lcm_(kUrl) {
+    if (!lcm_.good()) return;
+    lcm_.subscribe(channels_.device_state, &FakeServer::OnPose, this);
+    thread_ = std::thread([this] {
+      while (!stop_.load()) lcm_.handleTimeout(10);
+    });
+  }
+  ~FakeServer() { Stop(); }
+  bool good() { return lcm_.good(); }
+  void Stop() {
+    stop_.store(true);
+    if (thread_.joinable()) thread_.join();
+  }
+  int poses() const { return poses_.load(); }
+
+ private:
+  void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    device_state_t pose;
+    if (!transport::DecodeAndValidate(rbuf, &pose, nullptr)) return;
+    poses_.fetch_add(1);
+    force_model_t m{};
+    m.utime = 0;
+    m.seq = ++seq_;
+    m.device_seq = pose.seq;
+    m.device_utime = pose.utime;
+    m.status = force_model_t::STATUS_REGULAR;
+    for (int i = 0; i < 3; ++i) {
+      m.u0[i] = pose.position[i];
+      m.f0[i] = -kSpringNPerM * pose.position[i];
+      m.K[i][i] = -kSpringNPerM;
+    }
+    lcm_.publish(channels_.force_model, &m);
+  }
+
+  transport::Channels channels_;
+  lcm::LCM lcm_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> poses_{0};
+  int64_t seq_ = 0;
+};
+
+std::string WriteScene(const std::string& dir) {
+  const std::string path = dir + "/scene.yaml";
+  std::ofstream f(path);
+  // Path from (-2, 3) to (2, 1.5) model units = (-2, 0.5) cm to (2, -1) cm on the device.
+  f << "name: device_process_test\nmodel: zeeman\n"
+       "grasp:\n  start: [0, 2.5]\n  path: [[-2, 3.0], [2, 1.5]]\n"
+       "device:\n  model_units_per_metre: 100\n  model_origin: [0, 2.5, 0]\n";
+  return path;
+}
+
+void SleepUntil(std::chrono::steady_clock::time_point t0, double s) {
+  std::this_thread::sleep_until(t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                         std::chrono::duration<double>(s)));
+}
+
+TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
+  const std::string bin = DeviceBinary();
+  ASSERT_FALSE(bin.empty()) << "SNAPTHREAD_BIN_DIR not set (run through ctest)";
+  const ScopedDir scoped;
+  const std::string& dir = scoped.path;
+  const std::string session = UniqueSession("SPRING");
+  const std::string scene = WriteScene(dir);
+  const transport::Channels channels(session);
+
+  auto server = std::make_unique<FakeServer>(session);
+  ASSERT_TRUE(server->good()) << "udpm on loopback unavailable: " << kUrl;
+
+  const double duration_s = 5.0;
+  Process device({bin, "--backend", "sim-path", "--scene", scene, "--session", session,
+                  "--lcm-url", kUrl, "--duration", std::to_string(duration_s), "--speed-m-per-s",
+                  "0.04", "--no-rt", "--log-level", "warn", "--trace", dir + "/trace.csv",
+                  "--summary", dir + "/summary.json"},
+                 dir + "/device");
+  ASSERT_TRUE(device.started());
+  const auto t0 = std::chrono::steady_clock::now();
+
+  // 0 - 1.8 s: server up. 1.8 - 3.0 s: server dead. 3.0 s on: server back.
+  SleepUntil(t0, 1.8);
+  const int poses_first = server->poses();
+  server.reset();
+  SleepUntil(t0, 3.0);
+  server = std::make_unique<FakeServer>(session);
+  ASSERT_TRUE(server->good());
+  SleepUntil(t0, 3.6);
+
+  // Bad packets on the FORCE_MODEL channel.
+  lcm::LCM attacker(kUrl);
+  ASSERT_TRUE(attacker.good());
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> byte(0, 255);
+  int injected = 0;
+  // Paced so that a burst does not overflow the socket buffer (that would test the
+  // kernel, not the device).
+  auto Pace = [] { std::this_thread::sleep_for(std::chrono::milliseconds(3)); };
+  for (int i = 0; i < 40; ++i) {  // random garbage, some with the right type hash
+    std::vector<uint8_t> buf(1 + (i * 37) % 400);
+    for (auto& b : buf) b = static_cast<uint8_t>(byte(rng));
+    if (i % 2 == 0 && buf.size() >= 8) {
+      force_model_t ref{};
+      std::vector<uint8_t> enc(ref.getEncodedSize());
+      ref.encode(enc.data(), 0, static_cast<int>(enc.size()));
+      std::copy(enc.begin(), enc.begin() + 8, buf.begin());
+      if (buf.size() == enc.size()) buf.push_back(0);  // never accidentally valid
+    }
+    attacker.publish(channels.force_model, buf.data(), static_cast<unsigned>(buf.size()));
+    ++injected;
+    Pace();
+  }
+  for (int i = 0; i < 10; ++i) {  // NaN / Inf models
+    force_model_t m{};
+    m.status = force_model_t::STATUS_REGULAR;
+    m.device_utime = 1;
+    if (i % 3 == 0) m.f0[i % 3] = std::numeric_limits<double>::quiet_NaN();
+    if (i % 3 == 1) m.K[1][1] = std::numeric_limits<double>::infinity();
+    if (i % 3 == 2) m.u0[2] = -std::numeric_limits<double>::infinity();
+    attacker.publish(channels.force_model, &m);
+    ++injected;
+    Pace();
+  }
+  for (int i = 0; i < 10; ++i) {  // oversized: a valid spring model plus trailing bytes
+    force_model_t m{};
+    m.status = force_model_t::STATUS_REGULAR;
+    std::vector<uint8_t> enc(m.getEncodedSize() + 64, 0x5A);
+    m.encode(enc.data(), 0, m.getEncodedSize());
+    attacker.publish(channels.force_model, enc.data(), static_cast<unsigned>(enc.size()));
+    ++injected;
+    Pace();
+  }
+  for (int i = 0; i < 2; ++i) {  // huge: 100 kB (fragmented by LCM)
+    std::vector<uint8_t> big(100000, static_cast<uint8_t>(0xA0 + i));
+    attacker.publish(channels.force_model, big.data(), static_cast<unsigned>(big.size()));
+    ++injected;
+    Pace();
+  }
+
+  const int code = device.Wait(duration_s + 20.0);
+  const int poses_second = server->poses();
+  server.reset();
+  ASSERT_EQ(code, 0) << device.err();
+
+  const std::string summary = ReadFile(dir + "/summary.json");
+  ASSERT_FALSE(summary.empty());
+  for (const char* key : {"ticks", "tick_rate_hz", "lateness_us_p50", "lateness_us_p99",
+                          "lateness_us_max", "round_trip_us_p50", "round_trip_us_p99",
+                          "models_received", "models_rejected", "poses_rejected", "force_clamps",
+                          "stiffness_clamps", "slew_limits", "fade_ticks", "snaps_felt",
+                          "max_force_n", "nonfinite_outputs"}) {
+    EXPECT_TRUE(std::isfinite(JsonNumber(summary, key))) << key << "\n" << summary;
+  }
+  // The loop ran near its rate (generous: the machine is shared).
+  EXPECT_GT(JsonNumber(summary, "ticks"), 0.5 * 1000 * duration_s) << summary;
+  EXPECT_GT(poses_first, 300);
+  EXPECT_GT(poses_second, 300);
+  // Models arrived and the round trip was measured.
+  EXPECT_GT(JsonNumber(summary, "models_received"), 500) << summary;
+  const double rt50 = JsonNumber(summary, "round_trip_us_p50");
+  EXPECT_GT(rt50, 0.0) << summary;
+  EXPECT_LT(rt50, 1e6) << summary;
+  EXPECT_GE(JsonNumber(summary, "round_trip_us_p99"), rt50) << summary;
+  // Bad packets: counted and dropped (udpm on loopback may lose a few), nothing else is
+  // rejected, and the device never output a non-finite force.
+  const double rejected = JsonNumber(summary, "models_rejected");
+  EXPECT_GE(rejected, 0.8 * injected) << summary;
+  EXPECT_LE(rejected, injected) << summary;
+  EXPECT_EQ(JsonNumber(summary, "nonfinite_outputs"), 0.0) << summary;
+  EXPECT_GT(JsonNumber(summary, "fade_ticks"), 500) << summary;
+
+  std::string header;
+  const auto rows = ReadTrace(dir + "/trace.csv", &header);
+  EXPECT_EQ(header, "t_s,seq,x_m,y_m,z_m,fx_n,fy_n,fz_n,model_age_ms,model_status,clamped,fading");
+  ASSERT_GT(rows.size(), 2500u);
+
+  // Spring law over the bulk of the fresh-model samples (the 100 ms fade-ins after the
+  // start and the restart are the expected exceptions).
+  const double timeout_ms = 50.0, fade_ms = 100.0;
+  int fresh = 0, lawful = 0;
+  for (const auto& r : rows) {
+    if (r.model_age_ms < 0.0 || r.model_age_ms > 20.0 || r.fading) continue;
+    ++fresh;
+    double err2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double e = r.f[k] - (-kSpringNPerM * r.x[k]);
+      err2 += e * e;
+    }
+    if (std::sqrt(err2) < 1e-3) ++lawful;
+  }
+  EXPECT_GT(fresh, 2000);
+  EXPECT_GT(lawful, 0.85 * fresh) << lawful << " of " << fresh;
+
+  // Fade: once the model is older than timeout + fade (+ a tick), the force is exactly 0;
+  // between timeout and that, the device says it is fading.
+  int dead = 0, dead_nonzero = 0, fading_flagged = 0, fading_window = 0;
+  size_t last_dead = 0;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    const double fn = std::sqrt(r.f[0] * r.f[0] + r.f[1] * r.f[1] + r.f[2] * r.f[2]);
+    if (r.model_age_ms > timeout_ms + fade_ms + 2.0) {
+      ++dead;
+      last_dead = i;
+      if (fn != 0.0) ++dead_nonzero;
+    } else if (r.model_age_ms > timeout_ms + 1.0) {
+      ++fading_window;
+      if (r.fading) ++fading_flagged;
+    }
+  }
+  EXPECT_GT(dead, 500) << "the server's absence should show as > 0.5 s of stale model";
+  EXPECT_EQ(dead_nonzero, 0);
+  EXPECT_GT(fading_window, 50);
+  EXPECT_EQ(fading_flagged, fading_window);
+
+  // Recovery after the restart: fresh models again and the spring felt again.
+  int recovered = 0;
+  for (size_t i = last_dead + 1; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    const double fn = std::sqrt(r.f[0] * r.f[0] + r.f[1] * r.f[1] + r.f[2] * r.f[2]);
+    if (r.model_age_ms >= 0.0 && r.model_age_ms < 20.0 && fn > 0.05) ++recovered;
+  }
+  EXPECT_GT(recovered, 500);
+}
+
+TEST(DeviceProcessTest, SigtermStopsCleanlyAndWritesSummary) {
+  const std::string bin = DeviceBinary();
+  ASSERT_FALSE(bin.empty());
+  const ScopedDir scoped;
+  const std::string& dir = scoped.path;
+  Process device({bin, "--backend", "virtual-hand", "--scene", WriteScene(dir), "--session",
+                  UniqueSession("TERM"), "--lcm-url", kUrl, "--duration", "0", "--no-rt",
+                  "--summary", dir + "/summary.json"},
+                 dir + "/device");
+  ASSERT_TRUE(device.started());
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  device.Signal(SIGTERM);
+  ASSERT_EQ(device.Wait(10.0), 0) << device.err();
+  const std::string summary = ReadFile(dir + "/summary.json");
+  EXPECT_GT(JsonNumber(summary, "ticks"), 100) << summary;
+  EXPECT_EQ(JsonNumber(summary, "models_received"), 0.0) << summary;  // no server
+  EXPECT_EQ(JsonNumber(summary, "nonfinite_outputs"), 0.0);
+}
+
+TEST(DeviceProcessTest, BadArgumentsExitTwoNamingTheArgument) {
+  const std::string bin = DeviceBinary();
+  ASSERT_FALSE(bin.empty());
+  const ScopedDir scoped;
+  const std::string& dir = scoped.path;
+  const std::string scene = WriteScene(dir);
+  struct Case {
+    std::vector<std::string> args;
+    std::string mention;
+  };
+  const std::vector<Case> cases = {
+      {{"--rate-hz", "5"}, "--rate-hz"},
+      {{"--backend", "joystick"}, "--backend"},
+      {{"--session", "bad name"}, "--session"},
+      {{"--scene", dir + "/missing.yaml"}, "--scene"},
+      {{"--publish-divisor", "0"}, "--publish-divisor"},
+      {{"--backend", "sim-path"}, "path"},  // no --scene / --path-csv
+      {{"--backend", "phantom", "--no-rt"}, "not built"},
+      {{"--backend", "delta", "--no-rt"}, "not built"},
+  };
+  for (const auto& c : cases) {
+    std::vector<std::string> args = {bin};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    Process p(args, dir + "/bad");
+    ASSERT_TRUE(p.started());
+    EXPECT_EQ(p.Wait(10.0), 2) << c.args[0] << " " << c.args[1];
+    const std::string msg = p.err() + p.out();
+    EXPECT_NE(msg.find(c.mention), std::string::npos) << msg;
+  }
+}
+
+TEST(DeviceProcessTest, LcmFailureExitsOneWithUrlAndHint) {
+  const std::string bin = DeviceBinary();
+  ASSERT_FALSE(bin.empty());
+  const ScopedDir scoped;
+  const std::string& dir = scoped.path;
+  const std::string url = "udpm://239.255.76.67:99999999?ttl=0";
+  Process p({bin, "--backend", "sim-path", "--scene", WriteScene(dir), "--lcm-url", url, "--no-rt",
+             "--duration", "1"},
+            dir + "/lcmfail");
+  ASSERT_TRUE(p.started());
+  EXPECT_EQ(p.Wait(10.0), 1);
+  const std::string err = p.err();
+  EXPECT_NE(err.find(url), std::string::npos) << err;
+  EXPECT_NE(err.find("ip route add 224.0.0.0/4 dev lo"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace snapthread::device
