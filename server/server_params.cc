@@ -28,6 +28,14 @@ bool ServerParams::IsValid(std::string* error) const {
   if (!transport::IsValidSessionName(session)) {
     return Fail(error, "--session: '" + session + "' is not a valid session name ([A-Za-z0-9_]+)");
   }
+  // LCM refuses channel names longer than 63 bytes at publish time (logging "channel
+  // name too long" for every message, sending nothing); the longest suffix is
+  // "_SOLVER_STATUS" / "_DEVICE_STATUS" (14 bytes).
+  if (session.size() > kMaxSessionLength) {
+    return Fail(error, "--session: '" + session + "' is longer than " +
+                           std::to_string(kMaxSessionLength) +
+                           " characters (LCM channel names are at most 63 bytes)");
+  }
   // A rate of 0 would make the publish period infinite; 10 kHz is far above any viewer.
   if (!std::isfinite(shape_rate_hz) || shape_rate_hz <= 0.0 || shape_rate_hz > 10000.0) {
     return Fail(error, "--shape-rate-hz: must be in (0, 10000], got " + std::to_string(shape_rate_hz));

@@ -1,0 +1,485 @@
+// snapthread-server and snapthread-device as real, separate processes over UDP multicast
+// on loopback (ttl=0), one unique session per test. The machine is shared (2 cores, other
+// builds and tests running): timeouts are generous and assertions are on distributions
+// over thousands of servo ticks, never on single timings.
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include "pose_mapping.h"
+#include "snapthread/models.h"
+#include "snapthread/scene.h"
+#include "snapthread/tracker.h"
+
+extern char** environ;
+
+namespace snapthread::server {
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kUrl = "udpm://239.255.76.67:7667?ttl=0";
+
+std::string Env(const char* name) {
+  const char* v = std::getenv(name);
+  return v != nullptr ? v : "";
+}
+
+// A child process with stdout+stderr in a log file; killed (SIGKILL) if still running
+// when the handle goes away, so a failing test never leaks processes.
+class Child {
+ public:
+  Child(const std::vector<std::string>& argv, const std::string& log_path) : log_(log_path) {
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    posix_spawn_file_actions_addclose(&actions, 0);
+    const int rc = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) pid_ = -1;
+  }
+  ~Child() {
+    if (running()) {
+      kill(pid_, SIGKILL);
+      int status;
+      waitpid(pid_, &status, 0);
+    }
+  }
+  bool started() const { return pid_ > 0; }
+  bool running() const { return pid_ > 0 && !exited_; }
+  void Signal(int sig) {
+    if (running()) kill(pid_, sig);
+  }
+  // Waits for the exit; true with *code (exit status, or 128 + signal) when it exited.
+  bool Wait(std::chrono::seconds timeout, int* code) {
+    const auto deadline = Clock::now() + timeout;
+    while (!exited_) {
+      int status = 0;
+      const pid_t r = waitpid(pid_, &status, WNOHANG);
+      if (r == pid_) {
+        exited_ = true;
+        code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        break;
+      }
+      if (Clock::now() > deadline) return false;
+      std::this_thread::sleep_for(10ms);
+    }
+    if (code) *code = code_;
+    return true;
+  }
+  std::string Log() const {
+    std::ifstream in(log_);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+  // Waits until the log contains `text`.
+  bool WaitForLog(const std::string& text, std::chrono::seconds timeout) const {
+    const auto deadline = Clock::now() + timeout;
+    while (Clock::now() < deadline) {
+      if (Log().find(text) != std::string::npos) return true;
+      if (exited_) return false;
+      std::this_thread::sleep_for(20ms);
+    }
+    return false;
+  }
+
+ private:
+  std::string log_;
+  pid_t pid_ = -1;
+  bool exited_ = false;
+  int code_ = -1;
+};
+
+struct TraceRow {
+  double t_s, x, y, z, fx, fy, fz, model_age_ms;
+  int64_t seq;
+  int status, clamped, fading;
+  double force_norm() const { return std::sqrt(fx * fx + fy * fy + fz * fz); }
+};
+
+std::vector<TraceRow> ReadTrace(const std::string& path) {
+  std::vector<TraceRow> rows;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    TraceRow r{};
+    long long seq = 0;
+    if (std::sscanf(line.c_str(), "%lf,%lld,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d", &r.t_s, &seq,
+                    &r.x, &r.y, &r.z, &r.fx, &r.fy, &r.fz, &r.model_age_ms, &r.status, &r.clamped,
+                    &r.fading) == 12) {
+      r.seq = seq;
+      rows.push_back(r);
+    }
+  }
+  return rows;
+}
+
+// The numbers of a flat JSON object ({"key": number, ...}).
+std::map<std::string, double> ReadJsonNumbers(const std::string& path) {
+  std::map<std::string, double> out;
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  size_t pos = 0;
+  while ((pos = text.find('"', pos)) != std::string::npos) {
+    const size_t end = text.find('"', pos + 1);
+    if (end == std::string::npos) break;
+    const std::string key = text.substr(pos + 1, end - pos - 1);
+    size_t colon = text.find_first_not_of(" \t", end + 1);
+    pos = end + 1;
+    if (colon == std::string::npos || text[colon] != ':') continue;
+    const char* start = text.c_str() + colon + 1;
+    char* stop = nullptr;
+    const double v = std::strtod(start, &stop);
+    if (stop != start) out[key] = v;
+  }
+  return out;
+}
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
+  return v[k];
+}
+
+class ProcessTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    bin_ = Env("SNAPTHREAD_BIN_DIR");
+    source_ = Env("SNAPTHREAD_SOURCE_DIR");
+    ASSERT_FALSE(bin_.empty() || source_.empty())
+        << "SNAPTHREAD_BIN_DIR / SNAPTHREAD_SOURCE_DIR not set (run through ctest)";
+    ASSERT_TRUE(fs::exists(bin_ + "/snapthread-server")) << bin_ << "/snapthread-server not built";
+    ASSERT_TRUE(fs::exists(bin_ + "/snapthread-device")) << bin_ << "/snapthread-device not built";
+    {
+      lcm::LCM probe(kUrl);
+      ASSERT_TRUE(probe.good()) << "LCM udpm does not start here: no multicast route? "
+                                   "Run deploy/multicast-route.sh (ip route add 224.0.0.0/4 dev lo)";
+    }
+    // Unique per process, test and run: parallel ctest jobs share the multicast group.
+    // (LCM channel names are at most 63 bytes: keep it short.)
+    static int counter = 0;
+    std::random_device rd;
+    session_ = "PT" + std::to_string(getpid()) + "_" + std::to_string(rd() % 100000) + "_" +
+               std::to_string(counter++);
+    dir_ = ::testing::TempDir() + "/snapthread_" + session_;
+    fs::create_directories(dir_);
+    scene_path_ = source_ + "/scenes/curve2d_snap.yaml";
+    scene_ = LoadScene(scene_path_);
+  }
+
+  // A path through the strip's snap: from the scene's start (bent up, y = -3) up to
+  // y = 3.8 (the bent-up branch ends at y ~ 3.42 and the strip snaps to bent down), and
+  // back. Written as device metres for the device's --path-csv.
+  std::string WriteSnapPath() {
+    auto model = MakeModel(scene_.params);
+    const Vec a = scene_.grasp_start;
+    const Vec b = (Vec(2) << a[0], 3.8).finished();
+    const std::string path = dir_ + "/path.csv";
+    std::ofstream out(path);
+    for (const Vec& u : {a, b}) {
+      const Eigen::Vector3d p = ControlsToPosition(scene_.device, *model, u);
+      out << p[0] << "," << p[1] << "," << p[2] << "\n";
+    }
+    return path;
+  }
+
+  std::unique_ptr<Child> StartServer(const std::string& tag) {
+    auto child = std::make_unique<Child>(
+        std::vector<std::string>{bin_ + "/snapthread-server", "--scene", scene_path_, "--session",
+                                 session_, "--lcm-url", kUrl, "--summary",
+                                 dir_ + "/server_" + tag + ".json", "--log-level", "info"},
+        dir_ + "/server_" + tag + ".log");
+    EXPECT_TRUE(child->started());
+    // Up when it has logged its session line (scene loaded, LCM started, subscribed).
+    EXPECT_TRUE(child->WaitForLog("server: session", 30s)) << child->Log();
+    return child;
+  }
+
+  std::unique_ptr<Child> StartDevice(double duration_s, const std::string& path_csv,
+                                     double speed) {
+    std::ostringstream dur, spd;
+    dur << duration_s;
+    spd << speed;
+    auto child = std::make_unique<Child>(
+        std::vector<std::string>{bin_ + "/snapthread-device", "--backend", "sim-path", "--scene",
+                                 scene_path_, "--path-csv", path_csv, "--speed-m-per-s", spd.str(),
+                                 "--session", session_, "--lcm-url", kUrl, "--duration", dur.str(),
+                                 "--rate-hz", "1000", "--publish-divisor", "1",
+                                 "--model-timeout-ms", std::to_string(kTimeoutMs), "--fade-ms",
+                                 std::to_string(kFadeMs), "--no-rt", "--trace",
+                                 dir_ + "/trace.csv", "--summary", dir_ + "/device.json"},
+        dir_ + "/device.log");
+    EXPECT_TRUE(child->started());
+    return child;
+  }
+
+  // The force the device should feel at each traced position: an EquilibriumTracker run
+  // offline along the recorded positions in order, mapped to newtons (x, y).
+  std::vector<Eigen::Vector2d> Reference(const std::vector<TraceRow>& rows, int* snaps) {
+    EquilibriumTracker tracker(MakeModel(scene_.params), scene_.solver);
+    tracker.Reset(scene_.grasp_start);
+    std::vector<Eigen::Vector2d> ref;
+    *snaps = 0;
+    for (const TraceRow& r : rows) {
+      const Vec u = PoseToControls(scene_.device, tracker.model(), Eigen::Vector3d(r.x, r.y, r.z),
+                                   Eigen::Vector4d(1, 0, 0, 0));
+      const TrackResult& t = tracker.Update(u);
+      if (t.snapped) ++*snaps;
+      ref.emplace_back(scene_.device.newtons_per_model_force * t.force[0],
+                       scene_.device.newtons_per_model_force * t.force[1]);
+    }
+    return ref;
+  }
+
+  static constexpr int kTimeoutMs = 50;
+  static constexpr int kFadeMs = 100;
+  std::string bin_, source_, session_, dir_, scene_path_;
+  Scene scene_;
+};
+
+TEST_F(ProcessTest, DeviceFeelsTheServersForceThroughTheSnap) {
+  const std::string path = WriteSnapPath();
+  auto server = StartServer("a");
+  // 0.136 m up at 0.03 m/s: the snap (y = 3.42) comes at ~4.3 s, then part of the way back.
+  auto device = StartDevice(7.0, path, 0.03);
+  int code = -1;
+  ASSERT_TRUE(device->Wait(120s, &code)) << "device did not finish";
+  EXPECT_EQ(code, 0) << device->Log();
+  server->Signal(SIGTERM);
+  ASSERT_TRUE(server->Wait(60s, &code)) << "server did not stop on SIGTERM";
+  EXPECT_EQ(code, 0) << server->Log();
+  EXPECT_NE(server->Log().find("final: updates="), std::string::npos) << server->Log();
+
+  auto dev = ReadJsonNumbers(dir_ + "/device.json");
+  auto srv = ReadJsonNumbers(dir_ + "/server_a.json");
+  ASSERT_GT(dev.count("ticks"), 0u) << device->Log();
+  ASSERT_GT(srv.count("updates"), 0u) << server->Log();
+  // The device got models for the bulk of its ticks (poses are superseded when the
+  // server is busy, so not one per tick).
+  EXPECT_GT(dev["ticks"], 3000);
+  EXPECT_GT(dev["models_received"], 0.5 * dev["ticks"]);
+  EXPECT_EQ(dev["models_rejected"], 0);
+  EXPECT_EQ(dev["nonfinite_outputs"], 0);
+  EXPECT_GT(dev["round_trip_us_p50"], 0.0);
+  EXPECT_GE(dev["round_trip_us_p99"], dev["round_trip_us_p50"]);
+  EXPECT_GE(dev["snaps_felt"], 1);
+  EXPECT_GE(srv["snaps"], 1);
+  EXPECT_EQ(srv["rejected_messages"], 0);
+  EXPECT_GT(srv["updates"], 0.5 * dev["ticks"]);
+  EXPECT_GT(srv["solve_us_p50"], 0.0);
+  // Every pose the server saw was answered or superseded.
+  EXPECT_EQ(srv["updates"] + srv["dropped_poses"], srv["poses_received"]);
+
+  const auto rows = ReadTrace(dir_ + "/trace.csv");
+  ASSERT_GT(rows.size(), 3000u);
+  int ref_snaps = 0;
+  const auto ref = Reference(rows, &ref_snaps);
+  EXPECT_GE(ref_snaps, 1) << "the path must cross the snap";
+  // Compare where the device renders the model as is: a fresh model, no fade, no clamp.
+  std::vector<double> errors;
+  double max_ref = 0.0;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const TraceRow& r = rows[i];
+    EXPECT_TRUE(std::isfinite(r.fx) && std::isfinite(r.fy) && std::isfinite(r.fz));
+    if (r.fading || r.clamped || r.status < 0 || r.model_age_ms > kTimeoutMs || r.t_s < 0.5) continue;
+    errors.push_back(std::hypot(r.fx - ref[i][0], r.fy - ref[i][1]));
+    max_ref = std::max(max_ref, ref[i].norm());
+  }
+  ASSERT_GT(errors.size(), rows.size() / 2) << "too few ticks with a fresh model";
+  // The device's linearisation (K clamped to the stable range) and a few ms of latency
+  // make small differences; the snap itself is a few ticks of large ones.
+  const double p50 = Percentile(errors, 0.5), p95 = Percentile(errors, 0.95);
+  EXPECT_GT(max_ref, 0.2) << "the reference force should be felt";
+  EXPECT_LT(p50, 0.01) << "median |F_device - F_reference| in N";
+  EXPECT_LT(p95, 0.05) << "95th percentile |F_device - F_reference| in N";
+  std::printf("compared %zu ticks: |dF| p50 %.4f N, p95 %.4f N, max %.3f N; max |F_ref| %.3f N\n",
+              errors.size(), p50, p95, Percentile(errors, 1.0), max_ref);
+  std::printf("device: round trip p50 %.0f us p99 %.0f us, models %0.f of %0.f ticks; server: "
+              "%0.f updates, solve p50 %.1f us p99 %.1f us\n",
+              dev["round_trip_us_p50"], dev["round_trip_us_p99"], dev["models_received"],
+              dev["ticks"], srv["updates"], srv["solve_us_p50"], srv["solve_us_p99"]);
+}
+
+TEST_F(ProcessTest, ServerKilledForceFadesThenRecoversWithANewServer) {
+  const std::string path = WriteSnapPath();
+  auto server_a = StartServer("a");
+  auto device = StartDevice(9.0, path, 0.01);
+  std::this_thread::sleep_for(3s);
+  ASSERT_TRUE(server_a->running());
+  server_a->Signal(SIGKILL);
+  int code = -1;
+  ASSERT_TRUE(server_a->Wait(30s, &code));
+  EXPECT_EQ(code, 128 + SIGKILL);
+  std::this_thread::sleep_for(1500ms);
+  auto server_b = StartServer("b");
+  ASSERT_TRUE(device->Wait(120s, &code)) << "device did not finish";
+  EXPECT_EQ(code, 0) << device->Log();
+  server_b->Signal(SIGTERM);
+  ASSERT_TRUE(server_b->Wait(60s, &code));
+  EXPECT_EQ(code, 0) << server_b->Log();
+
+  auto dev = ReadJsonNumbers(dir_ + "/device.json");
+  EXPECT_EQ(dev["nonfinite_outputs"], 0);
+  const auto rows = ReadTrace(dir_ + "/trace.csv");
+  ASSERT_GT(rows.size(), 3000u);
+
+  // The outage: the first stale tick after the device had settled on server A's models.
+  size_t first_stale = rows.size();
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].t_s > 1.0 && rows[i].model_age_ms > kTimeoutMs) {
+      first_stale = i;
+      break;
+    }
+  }
+  ASSERT_LT(first_stale, rows.size()) << "the device never noticed the killed server";
+  // When the last model of server A arrived (device clock).
+  const double t_last_model = rows[first_stale].t_s - 1e-3 * rows[first_stale].model_age_ms;
+  // Just before the outage the device rendered a real force.
+  double before = 0.0;
+  for (size_t i = first_stale; i-- > 0 && rows[i].t_s > t_last_model - 0.2;) {
+    before = std::max(before, rows[i].force_norm());
+  }
+  EXPECT_GT(before, 0.1) << "a force to fade";
+  // The end of the outage: the first tick with a fresh model again (server B).
+  size_t recovered = rows.size();
+  for (size_t i = first_stale; i < rows.size(); ++i) {
+    if (rows[i].model_age_ms >= 0.0 && rows[i].model_age_ms < kTimeoutMs) {
+      recovered = i;
+      break;
+    }
+  }
+  ASSERT_LT(recovered, rows.size()) << "the device never got a model from the new server";
+  const double outage_s = rows[recovered].t_s - t_last_model;
+  EXPECT_GT(outage_s, 1.0) << "the outage lasts from the kill to server B's first model";
+
+  // Faded to exactly zero within timeout + fade (+ 50 ms for late servo ticks on a loaded
+  // machine: the fade runs on the device clock, a late tick only delays its sample) and
+  // zero from then on until server B answered.
+  const double deadline = t_last_model + 1e-3 * (kTimeoutMs + kFadeMs) + 0.050;
+  size_t first_zero = rows.size();
+  for (size_t i = first_stale; i < recovered; ++i) {
+    if (rows[i].force_norm() == 0.0) {
+      first_zero = i;
+      break;
+    }
+  }
+  ASSERT_LT(first_zero, recovered) << "the force never reached zero during the outage";
+  EXPECT_LE(rows[first_zero].t_s, deadline)
+      << "zero at " << rows[first_zero].t_s - t_last_model << " s after the last model";
+  for (size_t i = first_zero; i < recovered; ++i) {
+    ASSERT_EQ(rows[i].force_norm(), 0.0) << "force came back without a model at t = " << rows[i].t_s;
+    ASSERT_EQ(rows[i].fading, 1);
+  }
+  // The fade never increased the force while stale.
+  for (size_t i = first_stale + 1; i < first_zero; ++i) {
+    EXPECT_LE(rows[i].force_norm(), rows[i - 1].force_norm() + 1e-9) << "t = " << rows[i].t_s;
+  }
+
+  // Recovery: fresh models and a real force again, after the fade-in.
+  int fresh_with_force = 0;
+  for (size_t i = recovered; i < rows.size(); ++i) {
+    if (rows[i].fading == 0 && rows[i].model_age_ms < kTimeoutMs && rows[i].force_norm() > 0.05) {
+      ++fresh_with_force;
+    }
+  }
+  EXPECT_GT(fresh_with_force, 500) << "force did not recover after the new server started";
+  auto srv_b = ReadJsonNumbers(dir_ + "/server_b.json");
+  EXPECT_GT(srv_b["updates"], 500);
+  std::printf("outage %.3f s; zero force %.1f ms after the last model (limit %d + %d ms); "
+              "%d fresh ticks with force after recovery\n",
+              outage_s, 1e3 * (rows[first_zero].t_s - t_last_model), kTimeoutMs, kFadeMs,
+              fresh_with_force);
+}
+
+// The server's command line: exit codes and messages that name the argument.
+TEST_F(ProcessTest, ServerCommandLine) {
+  const std::string server = bin_ + "/snapthread-server";
+  auto run = [&](std::vector<std::string> args, int* code) {
+    args.insert(args.begin(), server);
+    Child c(args, dir_ + "/cli.log");
+    EXPECT_TRUE(c.Wait(60s, code));
+    return c.Log();
+  };
+  int code = -1;
+  std::string log = run({"--help"}, &code);
+  EXPECT_EQ(code, 0);
+  EXPECT_NE(log.find("--scene"), std::string::npos);
+  EXPECT_NE(log.find("--shape-rate-hz"), std::string::npos);
+
+  log = run({}, &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(log.find("--scene"), std::string::npos) << log;
+
+  log = run({"--scene", dir_ + "/missing.yaml"}, &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(log.find("missing.yaml"), std::string::npos) << log;
+
+  log = run({"--scene", scene_path_, "--method", "gradient-descent"}, &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(log.find("--method"), std::string::npos) << log;
+
+  log = run({"--scene", scene_path_, "--shape-rate-hz", "0"}, &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(log.find("--shape-rate-hz"), std::string::npos) << log;
+
+  log = run({"--scene", scene_path_, "--session", "bad session!"}, &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(log.find("--session"), std::string::npos) << log;
+
+  log = run({"--scene", scene_path_, "--session", std::string(60, 'S')}, &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(log.find("--session"), std::string::npos) << log;
+
+  log = run({"--scene", scene_path_, "--lcm-url", "udpm://300.1.2.3:7667"}, &code);
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(log.find("udpm://300.1.2.3:7667"), std::string::npos) << log;
+  EXPECT_NE(log.find("ip route add 224.0.0.0/4 dev lo"), std::string::npos) << log;
+
+  // A clean timed run writes the summary with every key the demo reads.
+  const std::string summary = dir_ + "/cli.json";
+  log = run({"--scene", scene_path_, "--session", session_, "--lcm-url", kUrl, "--duration", "0.5",
+             "--summary", summary},
+            &code);
+  EXPECT_EQ(code, 0) << log;
+  const auto s = ReadJsonNumbers(summary);
+  for (const char* key : {"updates", "update_rate_hz", "solve_us_p50", "solve_us_p99", "snaps",
+                          "dropped_poses", "rejected_messages"}) {
+    EXPECT_EQ(s.count(key), 1u) << key;
+  }
+  EXPECT_GT(s.at("shapes_published"), 5);  // 60 Hz for 0.5 s, even with no device
+  EXPECT_NE(log.find("final: updates=0"), std::string::npos) << log;
+}
+
+}  // namespace
+}  // namespace snapthread::server
