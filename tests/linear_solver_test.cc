@@ -281,6 +281,26 @@ TEST_P(LinearSolverTest, RefactorizesWithNewValuesOnTheSamePattern) {
   }
 }
 
+// Every backend reads the lower triangle only, so they agree on a (wrongly) asymmetric
+// input: the answer is that of the matrix symmetrised from its lower triangle.
+TEST_P(LinearSolverTest, ReadsOnlyTheLowerTriangle) {
+  std::mt19937 rng(12);
+  const int n = 20, b = 3;
+  const Mat lower_spd = RandomSpdBand(n, b, &rng);
+  Mat skewed = lower_spd;
+  const Mat junk = RandomSymmetricBand(n, b, &rng);
+  skewed.triangularView<Eigen::StrictlyUpper>() = junk.triangularView<Eigen::StrictlyUpper>();
+  ASSERT_GT((skewed - lower_spd).norm(), 0.1);
+  auto solver = Make();
+  const SparseMatrix a = BandToSparse(skewed, b);
+  ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess);
+  ASSERT_EQ(solver->Factorize(a), LinearSolverStatus::kSuccess);
+  const Vec rhs = RandomVector(n, &rng);
+  Vec x;
+  ASSERT_EQ(solver->Solve(rhs, &x), LinearSolverStatus::kSuccess);
+  EXPECT_LT(RelativeError(x, Eigen::FullPivLU<Mat>(lower_spd).solve(rhs)), 1e-12);
+}
+
 TEST_P(LinearSolverTest, UncompressedStorageGivesTheSameSolution) {
   std::mt19937 rng(6);
   const int n = 30, b = 2;

@@ -26,10 +26,12 @@ class SymmetricLinearSolver {
   virtual ~SymmetricLinearSolver() = default;
   virtual std::string_view Name() const = 0;
 
-  // Symbolic analysis of a full symmetric pattern (both triangles stored).
+  // Symbolic analysis of a full symmetric pattern (both triangles stored; a pattern that
+  // is not structurally symmetric is kInvalidInput). Allocates.
   virtual LinearSolverStatus Analyze(const SparseMatrix& a) = 0;
-  // Numeric LDL^T of a matrix with the analysed pattern. Does not allocate after the
-  // first call for a pattern (backends that cannot promise this say so in Name()).
+  // Numeric LDL^T of a matrix with the analysed pattern. Every backend reads only the
+  // values of the lower triangle. Does not allocate after the first call for a pattern
+  // (backends that cannot promise this say so in Name()).
   virtual LinearSolverStatus Factorize(const SparseMatrix& a) = 0;
   // x = A^-1 b with the last successful factorisation. x may alias nothing.
   virtual LinearSolverStatus Solve(const Vec& b, Vec* x) const = 0;
