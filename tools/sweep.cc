@@ -33,6 +33,24 @@ std::vector<Vec> SweepControls(const Scene& scene, const SweepSpec& spec) {
   return us;
 }
 
+std::vector<Vec> PathControls(const Scene& scene, int steps_per_leg) {
+  if (scene.path.size() < 2) throw std::invalid_argument("sweep: the scene has no grasp.path with two or more points");
+  if (steps_per_leg < 1) throw std::invalid_argument("sweep: --steps must be >= 1");
+  const bool grip = scene.params.grip_direction;
+  std::vector<Vec> us{scene.path.front()};
+  for (size_t k = 1; k < scene.path.size(); ++k) {
+    const Vec& a = scene.path[k - 1];
+    const Vec& b = scene.path[k];
+    for (int i = 1; i <= steps_per_leg; ++i) {
+      const double t = static_cast<double>(i) / steps_per_leg;
+      Vec u = a + t * (b - a);
+      if (grip) u.tail(3).normalize();
+      us.push_back(u);
+    }
+  }
+  return us;
+}
+
 std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls) {
   std::vector<SweepRow> rows;
   rows.reserve(controls.size());

@@ -32,6 +32,10 @@ struct SweepRow {
 // scene stays at the scene's grasp direction).
 std::vector<Vec> SweepControls(const Scene& scene, const SweepSpec& spec);
 
+// The scene's grasp.path, each leg cut into `steps_per_leg` equal steps (positions
+// linear, grip directions normalised-linear); first waypoint first.
+std::vector<Vec> PathControls(const Scene& scene, int steps_per_leg);
+
 // Resets a tracker at the first control (solved to the cutoff) and updates it along
 // the path. Row 0 is the reset state.
 std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls);

@@ -16,9 +16,14 @@ int main(int argc, char** argv) {
   bool back = false;
   std::vector<std::string> sets;
   app.add_option("--scene", scene_file, "scene YAML file")->required();
-  app.add_option("--from", from, "start grasp X,Y[,Z] (model units)")->required();
-  app.add_option("--to", to, "end grasp X,Y[,Z] (model units)")->required();
-  app.add_option("--steps", steps, "number of equal steps N (rows 0..N)");
+  bool use_path = false;
+  auto* from_opt = app.add_option("--from", from, "start grasp X,Y[,Z] (model units)");
+  auto* to_opt = app.add_option("--to", to, "end grasp X,Y[,Z] (model units)");
+  auto* path_opt = app.add_flag("--path", use_path, "follow the scene's grasp.path instead (N steps per leg)");
+  from_opt->needs(to_opt);
+  to_opt->needs(from_opt);
+  path_opt->excludes(from_opt)->excludes(to_opt);
+  app.add_option("--steps", steps, "number of equal steps N (rows 0..N), or per leg with --path");
   app.add_flag("--back", back, "continue N more steps back to --from (2N+1 rows)");
   app.add_option("--method", method, "newton | newton-ls | higher-order (default: the scene's)");
   app.add_option("--cutoff", cutoff, "stop when |E_x| < cutoff (default: the scene's)");
@@ -46,14 +51,22 @@ int main(int argc, char** argv) {
       scene.solver.max_iterations = max_iterations;
     }
     if (steps < 1) throw std::invalid_argument("--steps: expected an integer >= 1");
-    const int dim = scene.params.model == "thread3d" ? 3 : 2;
-    SweepSpec spec;
-    spec.from = ParsePoint(from, dim, "--from");
-    spec.to = ParsePoint(to, dim, "--to");
-    spec.steps = steps;
-    spec.back = back;
+    std::vector<Vec> controls;
+    if (use_path) {
+      if (back) throw std::invalid_argument("--back: not with --path (write the way back into the path)");
+      controls = PathControls(scene, steps);
+    } else {
+      if (from.empty()) throw std::invalid_argument("--from/--to or --path: one of them is required");
+      const int dim = scene.params.model == "thread3d" ? 3 : 2;
+      SweepSpec spec;
+      spec.from = ParsePoint(from, dim, "--from");
+      spec.to = ParsePoint(to, dim, "--to");
+      spec.steps = steps;
+      spec.back = back;
+      controls = SweepControls(scene, spec);
+    }
     auto tracker = MakeTracker(scene);
-    const auto rows = RunSweep(tracker.get(), SweepControls(scene, spec));
+    const auto rows = RunSweep(tracker.get(), controls);
     if (out_file.empty()) {
       WriteSweepCsv(rows, scene.solver.method, std::cout);
     } else {

@@ -10,8 +10,6 @@ namespace {
 // Step for the central differences of the analytic gradient along v' (|v'|_inf = 1 in
 // model units): r = D^3E[v',v'] to O(h^2) with round-off ~ eps |E_x| / h^2.
 constexpr double kDifferenceStep = 1e-2;
-// Iterations of the snap minimiser before it gives up (it converges in ~10-20).
-constexpr int kMaxSnapIterations = 400;
 
 double QuarticSlope(const ReducedQuartic& q, double s) {
   return q.phi1 + s * (2.0 * q.phi2 + s * (3.0 * q.phi3 + s * 4.0 * q.phi4));
@@ -208,18 +206,7 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
 
 bool HigherOrderSolver::FinishSnap(const Vec& u, Vec* x, SolverSummary* s) {
   s->snapped = true;
-  double r = EvalGradient(*x, u, &g_, s);
-  for (int it = 0; it < kMaxSnapIterations; ++it) {
-    if (r < options_.cutoff) return true;
-    ++s->iterations;
-    if (!GlobalizedStep(u, x, &g_, s)) {
-      // Already at a stationary point to round-off: accept if the residual is tiny.
-      r = EvalGradient(*x, u, &g_, s);
-      return r < 1e3 * options_.cutoff;
-    }
-    r = EvalGradient(*x, u, &g_, s);
-  }
-  return r < options_.cutoff;
+  return MinimizeFully(u, x, s);
 }
 
 SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
@@ -229,7 +216,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   last_good_ = xr;
   double r = EvalGradient(xr, u, &g_, &s);
   s.termination = Termination::kBudgetSpent;
-  bool regular_at_end = true;
+  bool newton_stalled = false;
   while (true) {
     if (!std::isfinite(r)) {
       xr = last_good_;
@@ -253,16 +240,35 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       // largest diagonal entry (stretching sets the diagonal).
       const bool indefinite = factor_->NegativePivots() > 0;
       const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : lambda0;
-      degenerate = indefinite || !(lambda0 > options_.degeneracy_ratio * ref);
+      degenerate = indefinite || !(lambda0 > options_.degeneracy_ratio * ref) || newton_stalled;
     }
-    regular_at_end = !degenerate;
     if (!degenerate) {
       // Regular: the Newton step (2.18).
       if (factor_->Solve(g_, &dx_) != LinearSolverStatus::kSuccess) {
         s.termination = Termination::kLinearSolverFailed;
         break;
       }
+      // A Newton step longer than the reduction's cap leaves the region where the
+      // quadratic model holds: the control step has carried the state over a fold while
+      // lambda_0 still looked regular (DESIGN.md's open case). Finish it as a snap.
+      if (dx_.lpNorm<Eigen::Infinity>() > options_.max_reduction_step) {
+        if (!FinishSnap(u, &xr, &s)) {
+          s.termination = Termination::kLinearSolverFailed;
+          s.message = "snap minimiser did not converge";
+        }
+        r = EvalGradient(xr, u, &g_, &s);
+        if (s.termination != Termination::kLinearSolverFailed && r < options_.cutoff)
+          s.termination = Termination::kConverged;
+        break;
+      }
       xr -= dx_;
+      // Where E_xx is regular Newton converges quadratically; a step that does not
+      // even halve |E_x| says the quadratic model has failed (a fold is close): the
+      // next iteration uses the reduction.
+      const double r_before = r;
+      r = EvalGradient(xr, u, &g_, &s);
+      newton_stalled = !(r < 0.5 * r_before);
+      continue;
     } else {
       // A factorisation that failed on an exactly singular E_xx still allows the
       // reduction: it needs only the restricted factor and the last eigenvector.
@@ -280,7 +286,6 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
         r = EvalGradient(xr, u, &g_, &s);
         if (s.termination != Termination::kLinearSolverFailed && r < options_.cutoff)
           s.termination = Termination::kConverged;
-        regular_at_end = true;
         break;
       }
       if (res == StepResult::kFailed) {
@@ -299,7 +304,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
     s.termination = Termination::kNonFinite;
   }
   Finish(xr, u, &s);
-  (void)regular_at_end;
+  LeaveSaddle(u, &xr, &s);
   Classify(&s);
   return s;
 }

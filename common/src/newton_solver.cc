@@ -99,6 +99,13 @@ bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s) 
     double max_diag = 0.0;
     for (int i = 0; i < n_; ++i) max_diag = std::max(max_diag, std::abs(h_.valuePtr()[diag_index_[i]]));
     double tau = std::max(1e-3 * max_diag, 1e-8);
+    if (st == LinearSolverStatus::kSuccess) {
+      // Indefinite but factorised: shift by twice the most negative eigenvalue's size
+      // (tracked by inverse iteration), so the step along that mode is as long as a
+      // Newton step, not a creeping gradient step (escaping a symmetric saddle).
+      const double lambda0 = eig_.Update(*factor_, h_, 4);
+      if (lambda0 < 0.0) tau = std::max(2.0 * std::abs(lambda0), 1e-10 * max_diag);
+    }
     bool ok = false;
     for (int k = 0; k < 60; ++k) {
       if (FactorShifted(tau, s) == LinearSolverStatus::kSuccess && alt_factor_->NegativePivots() == 0) {
@@ -157,6 +164,55 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s) {
   s->solve_us = std::chrono::duration<double, std::micro>(Clock::now() - start_).count();
 }
 
+bool SolverBase::MinimizeFully(const Vec& u, Vec* x, SolverSummary* s) {
+  constexpr int kMaxIterations = 400;  // the snap minimiser converges in ~10-20
+  double r = EvalGradient(*x, u, &g_, s);
+  for (int it = 0; it < kMaxIterations; ++it) {
+    if (!std::isfinite(r)) return false;
+    if (r < options_.cutoff) {
+      // Stationary: a minimum only if E_xx has no negative pivot.
+      if (FactorAt(*x, u, s) != LinearSolverStatus::kSuccess || factor_->NegativePivots() == 0) return true;
+      eig_.Update(*factor_, h_, 8);
+      const Vec& v = eig_.vector();
+      const double e0 = model_.Energy(*x, u);
+      // Along the negative mode E falls as lambda s^2 / 2 for small s, and may rise
+      // again at once (a pitchfork's quartic): halve the step until E decreases.
+      double step = 0.2 * options_.max_reduction_step / std::max(v.lpNorm<Eigen::Infinity>(), 1e-300);
+      bool moved = false;
+      for (int k = 0; k < 30 && !moved; ++k, step *= 0.5) {
+        trial_ = *x + step * v;
+        const double ep = model_.Energy(trial_, u);
+        trial_ = *x - step * v;
+        const double em = model_.Energy(trial_, u);
+        if (std::min(ep, em) < e0) {
+          *x += (ep < em ? step : -step) * v;
+          moved = true;
+        }
+      }
+      if (!moved) return true;  // flat to round-off: accept
+      r = EvalGradient(*x, u, &g_, s);
+      continue;
+    }
+    ++s->iterations;
+    if (!GlobalizedStep(u, x, &g_, s)) {
+      r = EvalGradient(*x, u, &g_, s);
+      return r < 1e3 * options_.cutoff;
+    }
+    r = EvalGradient(*x, u, &g_, s);
+  }
+  return r < options_.cutoff;
+}
+
+void SolverBase::LeaveSaddle(const Vec& u, Vec* x, SolverSummary* s) {
+  if (!s->IsConverged() || s->negative_pivots <= 0) return;
+  s->snapped = true;
+  if (!MinimizeFully(u, x, s)) {
+    s->termination = Termination::kLinearSolverFailed;
+    s->message = "could not leave a saddle point";
+  }
+  Finish(*x, u, s);
+}
+
 NewtonSolver::NewtonSolver(const Model& model, const SolverOptions& options)
     : SolverBase(model, options) {}
 
@@ -206,6 +262,9 @@ SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
     s.termination = Termination::kNonFinite;
   }
   Finish(x_ref, u, &s);
+  // Plain Newton (2.18) is kept as the seed's baseline: it may sit on a maximum or a
+  // saddle (Fig 2.5). The globalised variant may not.
+  if (line_search) LeaveSaddle(u, &x_ref, &s);
   Classify(&s);
   return s;
 }

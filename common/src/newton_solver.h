@@ -40,6 +40,13 @@ class SolverBase : public EquilibriumSolver {
   // with gradient g. Returns false if no decrease could be found.
   bool GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s);
   int Budget() const;
+  // Globalised minimisation to the cutoff past the iteration budget (a snap is finished
+  // inside its control step, DESIGN.md #4). From a saddle, where the gradient vanishes,
+  // it first leaves along the negative mode of E_xx (the side that lowers E).
+  bool MinimizeFully(const Vec& u, Vec* x, SolverSummary* s);
+  // After Finish(): a "converged" state with negative pivots is a saddle, not the
+  // followed minimum. Leave it and minimise (counted as a snap); then Finish again.
+  void LeaveSaddle(const Vec& u, Vec* x, SolverSummary* s);
   // Sets summary.status from the final eigenvalue against the reference lambda_0 of
   // the last regular converged state (DESIGN.md #1), and updates that reference.
   void Classify(SolverSummary* s);

@@ -187,9 +187,17 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
     const YAML::Node path = g["path"];
     if (!path.IsSequence() || path.size() < 1) rd.Fail("grasp.path", "expected a list of points");
     for (size_t i = 0; i < path.size(); ++i) {
+      const std::string key = "grasp.path[" + std::to_string(i) + "]";
       Vec p(m);
-      p.head(pos_dim) = rd.Vector(path[i], "grasp.path[" + std::to_string(i) + "]", pos_dim);
-      if (sc.params.grip_direction) p.tail(3) = dir;
+      // With a grip direction a waypoint may also turn the grip: X,Y,Z,dx,dy,dz.
+      if (sc.params.grip_direction && path[i].IsSequence() && path[i].size() == 6) {
+        p = rd.Vector(path[i], key, 6);
+        if (!(p.tail(3).norm() > 1e-9)) rd.Fail(key, "expected a non-zero grip direction");
+        p.tail(3).normalize();
+      } else {
+        p.head(pos_dim) = rd.Vector(path[i], key, pos_dim);
+        if (sc.params.grip_direction) p.tail(3) = dir;
+      }
       sc.path.push_back(p);
     }
   }

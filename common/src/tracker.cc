@@ -44,6 +44,15 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   strict.method = Method::kNewtonLineSearch;
   auto start_solver = MakeSolver(*model_, strict);
   result_.summary = start_solver->Solve(u, &x_);
+  // The globalised solve can still stop on a saddle when the start is symmetric (a
+  // straight compressed thread): leave along the negative mode until the inertia says
+  // it is a minimum (no negative pivot).
+  for (int k = 0; k < 8 && result_.summary.negative_pivots > 0; ++k) {
+    const Vec& v = start_solver->LowestEigenvector();
+    if (v.size() != x_.size()) break;
+    x_ += (0.1 * snap_threshold_ / std::max(v.lpNorm<Eigen::Infinity>(), 1e-300)) * v;
+    result_.summary = start_solver->Solve(u, &x_);
+  }
   // Re-solve with the tracking solver so its factorisation and eigenpair are current.
   result_.summary = solver_->Solve(u, &x_);
   result_.snapped = false;
