@@ -11,6 +11,9 @@ function(snapthread_add_test name)
   include(GoogleTest)
   gtest_discover_tests(${name}
     PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}"
-               ENVIRONMENT "SNAPTHREAD_SOURCE_DIR=${PROJECT_SOURCE_DIR};SNAPTHREAD_BIN_DIR=${PROJECT_BINARY_DIR}/bin"
+               ENVIRONMENT "SNAPTHREAD_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+               # A second variable in ENVIRONMENT is lost (gtest_discover_tests splits the
+               # list), so it goes through ENVIRONMENT_MODIFICATION.
+               ENVIRONMENT_MODIFICATION "SNAPTHREAD_BIN_DIR=set:${PROJECT_BINARY_DIR}/bin"
     DISCOVERY_TIMEOUT 60)
 endfunction()
