@@ -65,7 +65,7 @@ void Settle(ForceSafety* s, LocalModel m, const double pos[3], int64_t* now_us,
 
 // ---- PrepareModel -----------------------------------------------------------------------
 
-TEST(PrepareModelTest, NonFiniteModelsAreRejected) {
+TEST(DevicePrepareModelTest, NonFiniteModelsAreRejected) {
   const SafetyLimits limits = TestLimits();
   int rejected = 0, total = 0;
   for (double bad : {kNaN, kInf, -kInf}) {
@@ -94,7 +94,7 @@ TEST(PrepareModelTest, NonFiniteModelsAreRejected) {
   EXPECT_EQ(PrepareModel(s, 0, limits, &out, nullptr), ModelVerdict::kRejected);
 }
 
-TEST(PrepareModelTest, InvalidStatusBecomesZeroForce) {
+TEST(DevicePrepareModelTest, InvalidStatusBecomesZeroForce) {
   force_model_t m = Model(2.0, 300.0);
   m.status = force_model_t::STATUS_INVALID;
   LocalModel out;
@@ -106,7 +106,7 @@ TEST(PrepareModelTest, InvalidStatusBecomesZeroForce) {
   }
 }
 
-TEST(PrepareModelTest, StableSpringPassesUnchanged) {
+TEST(DevicePrepareModelTest, StableSpringPassesUnchanged) {
   force_model_t m = Model(0.5, 300.0);
   m.K[0][1] = m.K[1][0] = 20.0;
   LocalModel out;
@@ -127,7 +127,7 @@ Eigen::Vector3d Stiffnesses(const LocalModel& m) {
   return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(-K).eigenvalues();
 }
 
-TEST(PrepareModelTest, NegativeAndHugeStiffnessAreClamped) {
+TEST(DevicePrepareModelTest, NegativeAndHugeStiffnessAreClamped) {
   // S has eigenvalues {-50, 200, 5000} in a rotated basis; K = -S plus an antisymmetric
   // part that symmetrisation must remove.
   const Eigen::Matrix3d R =
@@ -154,7 +154,7 @@ TEST(PrepareModelTest, NegativeAndHugeStiffnessAreClamped) {
   EXPECT_NEAR(Stiffnesses(neg).cwiseAbs().maxCoeff(), 0.0, 1e-9);
 }
 
-TEST(LimitsTest, SmallerOfDeviceAndScene) {
+TEST(DeviceLimitsTest, SmallerOfDeviceAndScene) {
   DeviceCapabilities caps;
   caps.max_force_n = 8.0;
   caps.max_stiffness_n_per_m = 500.0;
@@ -177,7 +177,7 @@ TEST(LimitsTest, SmallerOfDeviceAndScene) {
 
 // ---- ForceSafety ----------------------------------------------------------------------
 
-TEST(ForceSafetyTest, EvaluatesTheLocalModel) {
+TEST(DeviceForceSafetyTest, EvaluatesTheLocalModel) {
   ForceSafety s(TestLimits(), false);
   force_model_t msg = Model(0.2, 100.0);
   msg.u0[0] = 0.01;
@@ -197,7 +197,7 @@ TEST(ForceSafetyTest, EvaluatesTheLocalModel) {
   EXPECT_FALSE(out.fading);
 }
 
-TEST(ForceSafetyTest, ForceMagnitudeIsClamped) {
+TEST(DeviceForceSafetyTest, ForceMagnitudeIsClamped) {
   ForceSafety s(TestLimits(), false);
   force_model_t msg = Model(0.0, 0.0);
   msg.f0[0] = 30.0;
@@ -217,7 +217,7 @@ TEST(ForceSafetyTest, ForceMagnitudeIsClamped) {
   EXPECT_GT(s.counters().force_clamps.load(), 0u);
 }
 
-TEST(ForceSafetyTest, SlewLimitBoundsEveryTickAndStillReachesTheTarget) {
+TEST(DeviceForceSafetyTest, SlewLimitBoundsEveryTickAndStillReachesTheTarget) {
   const SafetyLimits limits = TestLimits();
   ForceSafety s(limits, false);
   const double pos[3] = {0, 0, 0};
@@ -243,7 +243,7 @@ TEST(ForceSafetyTest, SlewLimitBoundsEveryTickAndStillReachesTheTarget) {
   EXPECT_EQ(s.counters().slew_limits.load() - before, 2u);
 }
 
-TEST(ForceSafetyTest, StaleModelFadesToZeroAndFreshModelRecovers) {
+TEST(DeviceForceSafetyTest, StaleModelFadesToZeroAndFreshModelRecovers) {
   const SafetyLimits limits = TestLimits();
   ForceSafety s(limits, false);
   const double pos[3] = {0, 0, 0};
@@ -309,7 +309,7 @@ TEST(ForceSafetyTest, StaleModelFadesToZeroAndFreshModelRecovers) {
   EXPECT_GE(recovered_after, 0.9e3 * limits.fade_time_s);  // faded in, not stepped
 }
 
-TEST(ForceSafetyTest, BadPosesGetZeroForceAtOnce) {
+TEST(DeviceForceSafetyTest, BadPosesGetZeroForceAtOnce) {
   ForceSafety s(TestLimits(), false);
   const double good[3] = {0.01, 0, 0};
   int64_t now = 0;
@@ -345,7 +345,7 @@ TEST(ForceSafetyTest, BadPosesGetZeroForceAtOnce) {
   EXPECT_NEAR(out.force_n[0], 1.0, 1e-12);
 }
 
-TEST(ForceSafetyTest, FuzzOutputAlwaysFiniteAndBounded) {
+TEST(DeviceForceSafetyTest, FuzzOutputAlwaysFiniteAndBounded) {
   const SafetyLimits limits = TestLimits();
   ForceSafety s(limits, true);
   std::mt19937_64 rng(12345);
@@ -413,7 +413,7 @@ TEST(ForceSafetyTest, FuzzOutputAlwaysFiniteAndBounded) {
 
 // ---- Scripted path and simulated devices ---------------------------------------------------
 
-TEST(ScriptedPathTest, BackAndForthAtConstantSpeed) {
+TEST(DeviceScriptedPathTest, BackAndForthAtConstantSpeed) {
   ScriptedPath p({{0.0, 0.0, 0.0}, {0.03, 0.0, 0.0}, {0.03, 0.01, 0.0}}, 0.02);
   EXPECT_NEAR(p.length_m(), 0.04, 1e-15);
   double x[3], v[3];
@@ -433,7 +433,7 @@ TEST(ScriptedPathTest, BackAndForthAtConstantSpeed) {
   EXPECT_THROW(ScriptedPath({{0, 0, 0}}, 0.0), std::invalid_argument);
 }
 
-TEST(ScriptedPathTest, SceneWaypointsAreMappedToMetres) {
+TEST(DeviceScriptedPathTest, SceneWaypointsAreMappedToMetres) {
   const Scene scene = ParseScene(
       "model: zeeman\n"
       "grasp: {start: [0, 2.5], path: [[-2, 3.0], [2, 1.5]]}\n"
@@ -455,7 +455,7 @@ TEST(ScriptedPathTest, SceneWaypointsAreMappedToMetres) {
 int64_t g_fake_now_us = 0;
 int64_t FakeClock() { return g_fake_now_us; }
 
-TEST(SimDeviceTest, SimPathFollowsThePathAndIgnoresForce) {
+TEST(DeviceSimDeviceTest, SimPathFollowsThePathAndIgnoresForce) {
   g_fake_now_us = 5000000;
   SimPathDevice d(ScriptedPath({{0, 0, 0}, {0.04, 0, 0}}, 0.02), &FakeClock);
   ASSERT_TRUE(d.Open(nullptr));
@@ -516,7 +516,7 @@ LoopResult RunClosedLoop(double model_stiffness_n_per_m, bool prepare_model) {
   return r;
 }
 
-TEST(VirtualHandTest, StiffSpringIsStableAndNegativeStiffnessIsTamed) {
+TEST(DeviceVirtualHandTest, StiffSpringIsStableAndNegativeStiffnessIsTamed) {
   // A stable spring at the clamp limit: the hand moves smoothly (path speed 2 cm/s) and
   // stays within a spring-balance distance of its target (k_hand/(k_hand+k) of 1 cm).
   const LoopResult stable = RunClosedLoop(800.0, true);
@@ -531,7 +531,7 @@ TEST(VirtualHandTest, StiffSpringIsStableAndNegativeStiffnessIsTamed) {
   EXPECT_LT(tamed.max_speed_m_per_s, 0.1);
 }
 
-TEST(VirtualHandTest, FollowsThePathWithoutForce) {
+TEST(DeviceVirtualHandTest, FollowsThePathWithoutForce) {
   g_fake_now_us = 0;
   VirtualHandDevice hand(ScriptedPath({{0.0, 0.0, 0.0}, {0.02, 0.0, 0.0}}, 0.01), {}, &FakeClock);
   ASSERT_TRUE(hand.Open(nullptr));

@@ -70,7 +70,7 @@ class AllocationGuard {
   long count() const { return g_allocations.load(); }
 };
 
-TEST(MallocGuardTest, GuardCountsAllocations) {
+TEST(DeviceMallocGuardTest, GuardCountsAllocations) {
   // The guard must be able to fail: an allocation inside it is seen.
   long n = 0;
   {
@@ -146,13 +146,13 @@ uint64_t RunTicks(HapticDevice* device, int ticks) {
   return safety.counters().poses_rejected.load();
 }
 
-TEST(ServoTickAllocationTest, VirtualHandTickNeverAllocates) {
+TEST(DeviceServoTickAllocationTest, VirtualHandTickNeverAllocates) {
   VirtualHandDevice hand(ScriptedPath({{-0.02, 0.0, 0.0}, {0.02, 0.01, 0.0}}, 0.05), {},
                          &TestClock);
   EXPECT_EQ(RunTicks(&hand, 10000), 0u);
 }
 
-TEST(ServoTickAllocationTest, SimPathTickNeverAllocatesIncludingOutOfWorkspace) {
+TEST(DeviceServoTickAllocationTest, SimPathTickNeverAllocatesIncludingOutOfWorkspace) {
   // The path leaves the 5 cm workspace: poses are rejected (zero force, not published).
   SimPathDevice sim(ScriptedPath({{-0.04, 0.0, 0.0}, {0.08, 0.0, 0.0}}, 0.05), &TestClock);
   EXPECT_GT(RunTicks(&sim, 10000), 1000u);

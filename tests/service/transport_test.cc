@@ -147,7 +147,7 @@ std::vector<uint8_t> Encode(const T& m) {
 
 // ---- Channels / URL / clock ----------------------------------------------------------
 
-TEST(ChannelsTest, NamesArePrefixedBySession) {
+TEST(TransportChannelsTest, NamesArePrefixedBySession) {
   Channels c("LAB_2");
   EXPECT_EQ(c.device_state, "LAB_2_DEVICE_STATE");
   EXPECT_EQ(c.force_model, "LAB_2_FORCE_MODEL");
@@ -158,7 +158,7 @@ TEST(ChannelsTest, NamesArePrefixedBySession) {
   EXPECT_EQ(Channels().device_state, "SNAPTHREAD_DEVICE_STATE");
 }
 
-TEST(ChannelsTest, RejectsInvalidSessionNames) {
+TEST(TransportChannelsTest, RejectsInvalidSessionNames) {
   for (const char* bad : {"", "A B", "A-B", "A.B", "ÄB", "A/B", "A*"}) {
     EXPECT_THROW(Channels{bad}, std::invalid_argument) << bad;
     EXPECT_FALSE(IsValidSessionName(bad)) << bad;
@@ -171,7 +171,7 @@ TEST(ChannelsTest, RejectsInvalidSessionNames) {
   }
 }
 
-TEST(LcmUrlTest, FlagThenEnvironmentThenDefault) {
+TEST(TransportLcmUrlTest, FlagThenEnvironmentThenDefault) {
   const char* saved = std::getenv("LCM_DEFAULT_URL");
   std::string saved_value = saved ? saved : "";
   unsetenv("LCM_DEFAULT_URL");
@@ -186,7 +186,7 @@ TEST(LcmUrlTest, FlagThenEnvironmentThenDefault) {
   }
 }
 
-TEST(ClockTest, MonotonicAdvancesAndRealtimeIsRecent) {
+TEST(TransportClockTest, MonotonicAdvancesAndRealtimeIsRecent) {
   const int64_t a = MonotonicMicros();
   std::this_thread::sleep_for(std::chrono::milliseconds(2));
   const int64_t b = MonotonicMicros();
@@ -228,20 +228,20 @@ void RoundTrip(const T& sent) {
   EXPECT_EQ(Encode(catcher.got.front()), Encode(sent));
 }
 
-TEST(RoundTripTest, DeviceState) { RoundTrip(SampleDeviceState()); }
-TEST(RoundTripTest, ForceModel) {
+TEST(TransportRoundTripTest, DeviceState) { RoundTrip(SampleDeviceState()); }
+TEST(TransportRoundTripTest, ForceModel) {
   RoundTrip(SampleForceModel());
 }
-TEST(RoundTripTest, ThreadShape) {
+TEST(TransportRoundTripTest, ThreadShape) {
   RoundTrip(SampleShape(0));
   RoundTrip(SampleShape(1));
   RoundTrip(SampleShape(200));
 }
-TEST(RoundTripTest, SolverStatus) { RoundTrip(SampleSolverStatus()); }
-TEST(RoundTripTest, DeviceStatus) { RoundTrip(SampleDeviceStatus()); }
-TEST(RoundTripTest, Command) { RoundTrip(SampleCommand()); }
+TEST(TransportRoundTripTest, SolverStatus) { RoundTrip(SampleSolverStatus()); }
+TEST(TransportRoundTripTest, DeviceStatus) { RoundTrip(SampleDeviceStatus()); }
+TEST(TransportRoundTripTest, Command) { RoundTrip(SampleCommand()); }
 
-TEST(RoundTripTest, ForceModelFieldsSurvive) {
+TEST(TransportRoundTripTest, ForceModelFieldsSurvive) {
   // One explicit field-by-field check so that an encoding comparison bug cannot hide one.
   const force_model_t sent = SampleForceModel();
   const auto bytes = Encode(sent);
@@ -261,7 +261,7 @@ TEST(RoundTripTest, ForceModelFieldsSurvive) {
 
 // ---- Validate -------------------------------------------------------------------------
 
-TEST(ValidateTest, AcceptsSamples) {
+TEST(TransportValidateTest, AcceptsSamples) {
   std::string why;
   EXPECT_TRUE(Validate(SampleDeviceState(), &why)) << why;
   EXPECT_TRUE(Validate(SampleForceModel(), &why)) << why;
@@ -271,7 +271,7 @@ TEST(ValidateTest, AcceptsSamples) {
   EXPECT_TRUE(Validate(SampleCommand(), &why)) << why;
 }
 
-TEST(ValidateTest, RejectsNonFiniteDeviceState) {
+TEST(TransportValidateTest, RejectsNonFiniteDeviceState) {
   for (double bad : {kNaN, kInf, -kInf}) {
     for (int i = 0; i < 3; ++i) {
       auto m = SampleDeviceState();
@@ -288,7 +288,7 @@ TEST(ValidateTest, RejectsNonFiniteDeviceState) {
   }
 }
 
-TEST(ValidateTest, QuaternionNormRange) {
+TEST(TransportValidateTest, QuaternionNormRange) {
   auto m = SampleDeviceState();
   m.orientation[0] = 0.0;  // zero quaternion
   EXPECT_FALSE(Validate(m, nullptr));
@@ -300,7 +300,7 @@ TEST(ValidateTest, QuaternionNormRange) {
   EXPECT_TRUE(Validate(m, nullptr));
 }
 
-TEST(ValidateTest, RejectsNonFiniteForceModel) {
+TEST(TransportValidateTest, RejectsNonFiniteForceModel) {
   for (double bad : {kNaN, kInf, -kInf}) {
     for (int i = 0; i < 3; ++i) {
       auto a = SampleForceModel(); a.u0[i] = bad; EXPECT_FALSE(Validate(a, nullptr));
@@ -325,7 +325,7 @@ TEST(ValidateTest, RejectsNonFiniteForceModel) {
   EXPECT_FALSE(Validate(t, nullptr));
 }
 
-TEST(ValidateTest, ShapeCountsMustAgree) {
+TEST(TransportValidateTest, ShapeCountsMustAgree) {
   auto m = SampleShape(4);
   m.num_nodes = 5;
   std::string why;
@@ -348,7 +348,7 @@ TEST(ValidateTest, ShapeCountsMustAgree) {
   EXPECT_FALSE(Validate(inf, nullptr));
 }
 
-TEST(ValidateTest, StatusesAndCommands) {
+TEST(TransportValidateTest, StatusesAndCommands) {
   auto s = SampleSolverStatus();
   s.residual = kNaN;
   EXPECT_FALSE(Validate(s, nullptr));
@@ -387,7 +387,7 @@ void ExpectTruncationsRejected(const T& sample) {
   }
 }
 
-TEST(DecodeTest, TruncatedOversizedAndWrongTypeRejected) {
+TEST(TransportDecodeTest, TruncatedOversizedAndWrongTypeRejected) {
   ExpectTruncationsRejected(SampleDeviceState());
   ExpectTruncationsRejected(SampleForceModel());
   ExpectTruncationsRejected(SampleShape(7));
@@ -396,7 +396,7 @@ TEST(DecodeTest, TruncatedOversizedAndWrongTypeRejected) {
   ExpectTruncationsRejected(SampleCommand());
 }
 
-TEST(DecodeTest, HugeShapeCountIsRefusedBeforeAllocation) {
+TEST(TransportDecodeTest, HugeShapeCountIsRefusedBeforeAllocation) {
   auto m = SampleShape(2);
   auto bytes = Encode(m);
   // num_nodes sits after hash, utime, seq and the two strings (4-byte length + bytes + NUL).
@@ -412,7 +412,7 @@ TEST(DecodeTest, HugeShapeCountIsRefusedBeforeAllocation) {
   }
 }
 
-TEST(DecodeTest, CorruptStringLengthDoesNotThrow) {
+TEST(TransportDecodeTest, CorruptStringLengthDoesNotThrow) {
   auto m = SampleDeviceState();
   auto bytes = Encode(m);
   // device_id's length field follows hash, utime and seq.
@@ -461,7 +461,7 @@ void Fuzz(const T& sample, uint32_t seed, int* accepted) {
   }
 }
 
-TEST(DecodeTest, FuzzEveryType) {
+TEST(TransportDecodeTest, FuzzEveryType) {
   int accepted = 0;
   Fuzz(SampleDeviceState(), 1, &accepted);
   Fuzz(SampleForceModel(), 2, &accepted);
@@ -473,7 +473,7 @@ TEST(DecodeTest, FuzzEveryType) {
   EXPECT_GT(accepted, 0);
 }
 
-TEST(DecodeTest, GarbageOverMemqIsCountedNotFatal) {
+TEST(TransportDecodeTest, GarbageOverMemqIsCountedNotFatal) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
   Catcher<force_model_t> catcher;
@@ -521,7 +521,7 @@ bool Consistent(const Stamped& s) {
   return true;
 }
 
-TEST(LatestValueTest, EmptyThenLatestWins) {
+TEST(TransportLatestValueTest, EmptyThenLatestWins) {
   LatestValue<Stamped> lv;
   Stamped out{};
   bool fresh = true;
@@ -542,7 +542,7 @@ TEST(LatestValueTest, EmptyThenLatestWins) {
   EXPECT_EQ(lv.writes(), 3u);
 }
 
-TEST(LatestValueTest, TwoThreadStressNeverTornNeverBackwards) {
+TEST(TransportLatestValueTest, TwoThreadStressNeverTornNeverBackwards) {
   LatestValue<Stamped> lv;
   constexpr uint64_t kWrites = 400000;
   std::atomic<bool> done{false};
@@ -575,7 +575,7 @@ TEST(LatestValueTest, TwoThreadStressNeverTornNeverBackwards) {
   EXPECT_GT(reads, 0u);
 }
 
-TEST(SpscRingTest, FifoAndFull) {
+TEST(TransportSpscRingTest, FifoAndFull) {
   SpscRing<Stamped, 4> ring;
   Stamped out{};
   EXPECT_FALSE(ring.TryPop(&out));
@@ -590,7 +590,7 @@ TEST(SpscRingTest, FifoAndFull) {
   EXPECT_FALSE(ring.TryPop(&out));
 }
 
-TEST(SpscRingTest, TwoThreadStressDeliversEverythingInOrder) {
+TEST(TransportSpscRingTest, TwoThreadStressDeliversEverythingInOrder) {
   auto ring = std::make_unique<SpscRing<Stamped, 64>>();  // small: forces full/empty races
   constexpr uint64_t kItems = 500000;
   std::thread producer([&] {
@@ -614,7 +614,7 @@ TEST(SpscRingTest, TwoThreadStressDeliversEverythingInOrder) {
 
 // ---- SampleWindow ---------------------------------------------------------------------
 
-TEST(SampleWindowTest, PercentilesOfKnownSamples) {
+TEST(TransportSampleWindowTest, PercentilesOfKnownSamples) {
   SampleWindow w(1000);
   EXPECT_EQ(w.Compute().count, 0u);
   // 1..1000 shuffled: p50 = 500, p99 = 990, max = 1000 (nearest rank).
@@ -630,7 +630,7 @@ TEST(SampleWindowTest, PercentilesOfKnownSamples) {
   EXPECT_DOUBLE_EQ(s.mean, 500.5);
 }
 
-TEST(SampleWindowTest, KeepsOnlyTheNewestSamples) {
+TEST(TransportSampleWindowTest, KeepsOnlyTheNewestSamples) {
   SampleWindow w(10);
   for (int i = 0; i < 100; ++i) w.Push(1000.0);
   for (int i = 0; i < 10; ++i) w.Push(i);
