@@ -49,29 +49,36 @@ void HessianAssembly::Finalize() {
   }
 
   // For each (local i, local j) of each term: the position in valuePtr(), found once by
-  // a binary search in column v[j]'s sorted row indices.
-  value_begin_.assign(terms, 0);
-  value_index_.clear();
+  // a binary search in column v[j]'s sorted row indices, then merged into runs.
+  run_begin_.assign(terms + 1, 0);
+  runs_.clear();
   const int* outer = pattern_.outerIndexPtr();
   const int* inner = pattern_.innerIndexPtr();
   for (int t = 0; t < terms; ++t) {
-    value_begin_[t] = static_cast<int>(value_index_.size());
+    run_begin_[t] = static_cast<int>(runs_.size());
     const int* v = TermVars(t);
     const int k = TermSize(t);
     for (int j = 0; j < k; ++j) {
+      if (v[j] < 0 || v[j] >= n) continue;
       for (int i = 0; i < k; ++i) {
-        int index = -1;
-        if (v[i] >= 0 && v[i] < n && v[j] >= 0 && v[j] < n) {
-          const int* first = inner + outer[v[j]];
-          const int* last = inner + outer[v[j] + 1];
-          const int* it = std::lower_bound(first, last, v[i]);
-          assert(it != last && *it == v[i]);
-          index = static_cast<int>(it - inner);
+        if (v[i] < 0 || v[i] >= n) continue;
+        const int* first = inner + outer[v[j]];
+        const int* last = inner + outer[v[j] + 1];
+        const int* it = std::lower_bound(first, last, v[i]);
+        assert(it != last && *it == v[i]);
+        const int index = static_cast<int>(it - inner);
+        if (!runs_.empty() && static_cast<int>(runs_.size()) > run_begin_[t]) {
+          Run& run = runs_.back();
+          if (run.local_col == j && run.local_row + run.len == i && run.value + run.len == index) {
+            ++run.len;
+            continue;
+          }
         }
-        value_index_.push_back(index);  // column-major: i + j * k
+        runs_.push_back({i, j, 1, index});
       }
     }
   }
+  run_begin_[terms] = static_cast<int>(runs_.size());
 }
 
 void HessianAssembly::AddGradient(int term, const double* local_g, double* g) const {
@@ -91,13 +98,12 @@ void HessianAssembly::AddControlGradient(int term, const double* local_g, double
 }
 
 void HessianAssembly::AddHessian(int term, const double* local_h, int ld, double* values) const {
-  const int k = TermSize(term);
-  const int* index = value_index_.data() + value_begin_[term];
-  for (int j = 0; j < k; ++j) {
-    for (int i = 0; i < k; ++i) {
-      const int m = index[i + j * k];
-      if (m >= 0) values[m] += local_h[i + j * ld];
-    }
+  const Run* run = runs_.data() + run_begin_[term];
+  const Run* end = runs_.data() + run_begin_[term + 1];
+  for (; run != end; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    for (int r = 0; r < run->len; ++r) dst[r] += src[r];
   }
 }
 

@@ -66,8 +66,18 @@ class HessianAssembly {
   int num_controls_ = 0;
   std::vector<int> term_begin_{0};    // term t's variables are vars_[begin[t], begin[t+1])
   std::vector<int> vars_;
-  std::vector<int> value_begin_;      // term t's k*k table starts at value_index_[value_begin_[t]]
-  std::vector<int> value_index_;      // index into valuePtr(), -1 unless both are states
+  // E_xx scatter table. For each term, runs of local entries (rows i0 .. i0+len-1 of
+  // local column j) that land on consecutive valuePtr() positions value .. value+len-1:
+  // a node's coordinates are consecutive in both, so a 3D bending term needs 27 runs of 3
+  // rather than 81 separate look-ups.
+  struct Run {
+    int local_row;
+    int local_col;
+    int len;
+    int value;
+  };
+  std::vector<int> run_begin_;        // term t's runs are runs_[run_begin_[t], run_begin_[t+1])
+  std::vector<Run> runs_;
   std::vector<char> touches_controls_;
   SparseMatrix pattern_;
   int bandwidth_ = 0;
@@ -92,14 +102,16 @@ inline double StretchTerm(const NodeVec<D>& pa, const NodeVec<D>& pb, double c, 
   const double l = v.norm();
   const double dl = l - rest;
   if (g != nullptr || h != nullptr) {
-    const NodeVec<D> w = v / l;
+    // Reciprocals once: divisions cost several times a multiplication here.
+    const double inv_l = 1.0 / l;
+    const NodeVec<D> w = v * inv_l;
     if (g != nullptr) {
       const NodeVec<D> gv = (2.0 * c * dl) * w;
       g->template head<D>() = -gv;
       g->template tail<D>() = gv;
     }
     if (h != nullptr) {
-      const double ratio = rest / l;
+      const double ratio = rest * inv_l;
       Eigen::Matrix<double, D, D> hv = (2.0 * c * ratio) * (w * w.transpose());
       hv.diagonal().array() += 2.0 * c * (1.0 - ratio);
       h->template topLeftCorner<D, D>() = hv;
@@ -126,14 +138,15 @@ inline double BendTerm(const NodeVec<D>& pa, const NodeVec<D>& pb, const NodeVec
   using M = Eigen::Matrix<double, D, D>;
   const NodeVec<D> v1 = pb - pa;
   const NodeVec<D> v2 = pc - pb;
-  const double l1 = v1.norm();
-  const double l2 = v2.norm();
-  const NodeVec<D> w1 = v1 / l1;
-  const NodeVec<D> w2 = v2 / l2;
+  // Reciprocals once: divisions cost several times a multiplication here.
+  const double inv1 = 1.0 / v1.norm();
+  const double inv2 = 1.0 / v2.norm();
+  const NodeVec<D> w1 = v1 * inv1;
+  const NodeVec<D> w2 = v2 * inv2;
   const double cth = w1.dot(w2);
   if (g != nullptr || h != nullptr) {
-    const NodeVec<D> a = (w2 - cth * w1) / l1;
-    const NodeVec<D> b = (w1 - cth * w2) / l2;
+    const NodeVec<D> a = (w2 - cth * w1) * inv1;
+    const NodeVec<D> b = (w1 - cth * w2) * inv2;
     if (g != nullptr) {
       g->template segment<D>(0) = c * a;
       g->template segment<D>(D) = -c * a + c * b;
@@ -144,11 +157,13 @@ inline double BendTerm(const NodeVec<D>& pa, const NodeVec<D>& pb, const NodeVec
       const M w2w2 = w2 * w2.transpose();
       const M wa = w1 * a.transpose();
       const M wb = w2 * b.transpose();
-      M h11 = (c / l1) * (wa + wa.transpose()) - (c * cth / (l1 * l1)) * w1w1;
-      h11.diagonal().array() += c * cth / (l1 * l1);
-      M h22 = (c / l2) * (wb + wb.transpose()) - (c * cth / (l2 * l2)) * w2w2;
-      h22.diagonal().array() += c * cth / (l2 * l2);
-      const double s12 = -c / (l1 * l2);
+      const double c11 = c * cth * inv1 * inv1;
+      const double c22 = c * cth * inv2 * inv2;
+      M h11 = (c * inv1) * (wa + wa.transpose()) - c11 * w1w1;
+      h11.diagonal().array() += c11;
+      M h22 = (c * inv2) * (wb + wb.transpose()) - c22 * w2w2;
+      h22.diagonal().array() += c22;
+      const double s12 = -c * inv1 * inv2;
       M h12 = s12 * (cth * (w1 * w2.transpose()) - w1w1 - w2w2);
       h12.diagonal().array() += s12;
       // Jacobian of (v1, v2) w.r.t. (p_a, p_b, p_c): v1 = [-I, I, 0], v2 = [0, -I, I].

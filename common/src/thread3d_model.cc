@@ -175,9 +175,7 @@ class Thread3dModel final : public Model {
     bool grip = false;
     int grip_local = -1;
     std::array<int, 9> coord_pos{};  // coordinate 3a+k of another local node, or -1
-    int s_pos = -1;
-    std::array<int, 3> p_pos{};      // X, Y, Z
-    std::array<int, 3> d_pos{};      // dx, dy, dz
+    std::array<int, 7> grip_pos{};   // s, X, Y, Z, dx, dy, dz
   };
 
   // Generalised index of coordinate k of node i (-1 if fixed). Not for the grip node.
@@ -231,9 +229,8 @@ class Thread3dModel final : public Model {
           if (var >= 0) term.coord_pos[3 * a + k] = position(var);
         }
       }
-      term.s_pos = position(nx_ - 1);
-      for (int k = 0; k < 3; ++k) term.p_pos[k] = position(nx_ + k);
-      for (int k = 0; k < 3; ++k) term.d_pos[k] = position(nx_ + 3 + k);
+      term.grip_pos[0] = position(nx_ - 1);
+      for (int k = 0; k < 6; ++k) term.grip_pos[1 + k] = position(nx_ + k);
     }
     assembly_.AddTerm(vars, count);
     terms_.push_back(term);
@@ -270,45 +267,67 @@ class Thread3dModel final : public Model {
       f(lg.data(), lh.data(), 9);
       return;
     }
-    // Chain rule to the term's variables through p_{N-1} = P - s d̂, d̂ = d/ρ, ρ = |d|:
-    //   ∂p/∂s = -d̂,  ∂p/∂P = I,  ∂p/∂d = -s Q/ρ with Q = I - d̂ d̂^T,
-    //   Σ_k g_k ∂²p_k/∂s∂d_j  = -(Q g)_j / ρ,
-    //   Σ_k g_k ∂²p_k/∂d_i∂d_j = s [g_i d̂_j + d̂_i g_j + (g·d̂)(δ_ij - 3 d̂_i d̂_j)] / ρ².
+    // Chain rule to the term's variables through p_{N-1} = P - s d̂, d̂ = d/ρ, ρ = |d|.
+    // Its Jacobian w.r.t. g = (s, X, Y, Z, dx, dy, dz) is A = [-d̂ | I | -s Q/ρ] with
+    // Q = I - d̂ d̂^T; the other nodes' coordinates map one-to-one. So (G = grip rows)
+    //   E_g = A^T e_G,  E_rg = (H_rG A),  E_gg = A^T H_GG A + curvature, where
+    //   Σ_k e_k ∂²p_k/∂s∂d_j   = -(Q e)_j / ρ,
+    //   Σ_k e_k ∂²p_k/∂d_i∂d_j = s [e_i d̂_j + d̂_i e_j + (e·d̂)(δ_ij - 3 d̂_i d̂_j)] / ρ².
+    // Variables shared with node N (X, Y, Z) simply accumulate.
     const V3 d = u.segment<3>(3);
     const double rho = d.norm();
     const V3 dh = d / rho;
     const double s = x[nx_ - 1];
     Eigen::Matrix3d q = -dh * dh.transpose();
     q.diagonal().array() += 1.0;
-    Eigen::Matrix<double, 9, kMaxVars> jac = Eigen::Matrix<double, 9, kMaxVars>::Zero();
+    Eigen::Matrix<double, 3, 7> jac_grip;
+    jac_grip.col(0) = -dh;
+    jac_grip.middleCols<3>(1).setIdentity();
+    jac_grip.rightCols<3>() = (-s / rho) * q;
     const int nodes = term.bend ? 3 : 2;
-    for (int b = 0; b < nodes; ++b) {
-      for (int k = 0; k < 3; ++k) {
-        const int r = 3 * b + k;
-        if (b != term.grip_local) {
-          if (term.coord_pos[r] >= 0) jac(r, term.coord_pos[r]) = 1.0;
-          continue;
-        }
-        jac(r, term.s_pos) = -dh[k];
-        jac(r, term.p_pos[k]) += 1.0;
-        for (int j = 0; j < 3; ++j) jac(r, term.d_pos[j]) += -s * q(k, j) / rho;
+    const int g0 = 3 * term.grip_local;
+    const int k = assembly_.TermSize(t);
+    const V3 eg = lg.segment<3>(g0);
+    LocalVec gg;
+    gg.head(k).setZero();
+    for (int r = 0; r < 3 * nodes; ++r) {
+      if (r < g0 || r >= g0 + 3) {
+        if (term.coord_pos[r] >= 0) gg[term.coord_pos[r]] += lg[r];
       }
     }
-    LocalVec gg = jac.transpose() * lg;
+    const Eigen::Matrix<double, 7, 1> ag = jac_grip.transpose() * eg;
+    for (int m = 0; m < 7; ++m) gg[term.grip_pos[m]] += ag[m];
     LocalMat hh;
     if (want_h) {
-      hh.noalias() = jac.transpose() * lh * jac;
-      const V3 gp = lg.segment<3>(3 * term.grip_local);
-      const V3 qg = q * gp / rho;
-      const double gd = gp.dot(dh);
-      const double c = s / (rho * rho);
-      for (int j = 0; j < 3; ++j) {
-        hh(term.s_pos, term.d_pos[j]) -= qg[j];
-        hh(term.d_pos[j], term.s_pos) -= qg[j];
-        for (int i = 0; i < 3; ++i) {
-          hh(term.d_pos[i], term.d_pos[j]) +=
-              c * (gp[i] * dh[j] + dh[i] * gp[j] + gd * ((i == j ? 1.0 : 0.0) - 3.0 * dh[i] * dh[j]));
+      hh.topLeftCorner(k, k).setZero();
+      const Eigen::Matrix<double, 9, 7> b = lh.middleCols<3>(g0) * jac_grip;
+      for (int c = 0; c < 3 * nodes; ++c) {
+        if (c >= g0 && c < g0 + 3) continue;
+        const int pc = term.coord_pos[c];
+        if (pc < 0) continue;
+        for (int r = 0; r < 3 * nodes; ++r) {
+          if (r >= g0 && r < g0 + 3) continue;
+          if (term.coord_pos[r] >= 0) hh(term.coord_pos[r], pc) += lh(r, c);
         }
+        for (int m = 0; m < 7; ++m) {
+          hh(pc, term.grip_pos[m]) += b(c, m);
+          hh(term.grip_pos[m], pc) += b(c, m);
+        }
+      }
+      Eigen::Matrix<double, 7, 7> gg_block = jac_grip.transpose() * b.middleRows<3>(g0);
+      const V3 qe = q * eg / rho;
+      const double ed = eg.dot(dh);
+      const double cs = s / (rho * rho);
+      for (int j = 0; j < 3; ++j) {
+        gg_block(0, 4 + j) -= qe[j];
+        gg_block(4 + j, 0) -= qe[j];
+        for (int i = 0; i < 3; ++i) {
+          gg_block(4 + i, 4 + j) +=
+              cs * (eg[i] * dh[j] + dh[i] * eg[j] + ed * ((i == j ? 1.0 : 0.0) - 3.0 * dh[i] * dh[j]));
+        }
+      }
+      for (int m2 = 0; m2 < 7; ++m2) {
+        for (int m = 0; m < 7; ++m) hh(term.grip_pos[m], term.grip_pos[m2]) += gg_block(m, m2);
       }
     }
     f(gg.data(), hh.data(), kMaxVars);
