@@ -3,7 +3,12 @@
 //  * planar models (zeeman, cusp, curve2d): u = (X, Y) from the pose's x and y; the
 //    device's z is held near the model plane by a stiff virtual plane (force_model.h).
 //  * thread3d: u = (X, Y, Z); with a constrained grip direction also (dx, dy, dz), the
-//    orientation quaternion applied to (1, 0, 0) (lcmtypes/device_state_t.lcm).
+//    orientation quaternion applied to the device's grip axis (lcmtypes/device_state_t.lcm:
+//    R * (1, 0, 0)), expressed in the scene: the device's rest orientation holds the grip
+//    the way the scene starts (grasp.direction), d = R(q) d_start. This is R(q) (1, 0, 0)
+//    exactly when the scene starts along +x, and it lets devices that sense no orientation
+//    (they report the identity: sim-path, virtual-hand, 3-DOF devices) hold the scene's
+//    grip instead of turning it to +x, as model_origin does for positions.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,13 +19,20 @@
 
 namespace snapthread::server {
 
-// R(q) (1, 0, 0) for q = (w, x, y, z); q is normalised first (a zero quaternion gives
-// (1, 0, 0): the identity grip).
-Eigen::Vector3d GripDirection(const Eigen::Vector4d& quaternion_wxyz);
+// R(q) rest for q = (w, x, y, z); q is normalised first (a zero quaternion counts as the
+// identity), rest too (a zero rest counts as (1, 0, 0)).
+Eigen::Vector3d GripDirection(const Eigen::Vector4d& quaternion_wxyz,
+                              const Eigen::Vector3d& rest = Eigen::Vector3d::UnitX());
 
-// Controls u (size model.NumControls()) for a device pose.
+// The grip direction a device at rest (identity orientation) holds in this scene: the
+// scene's start direction (grasp_start[3:6]) for models with a grip, else (1, 0, 0).
+Eigen::Vector3d RestGripDirection(const Scene& scene, const Model& model);
+
+// Controls u (size model.NumControls()) for a device pose; rest_direction as given by
+// RestGripDirection (used only by models with a grip direction).
 Vec PoseToControls(const DeviceMapping& mapping, const Model& model,
-                   const Eigen::Vector3d& position_m, const Eigen::Vector4d& quaternion_wxyz);
+                   const Eigen::Vector3d& position_m, const Eigen::Vector4d& quaternion_wxyz,
+                   const Eigen::Vector3d& rest_direction = Eigen::Vector3d::UnitX());
 
 // The device position (metres) that maps to the positional controls of u (inverse of
 // PoseToControls; z = the model plane for planar models). Used by scripted paths, tests

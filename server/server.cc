@@ -57,6 +57,8 @@ SteadyClock::duration Period(double rate_hz) {
 struct Server::Session {
   Scene scene;
   std::unique_ptr<EquilibriumTracker> tracker;
+  // The grip direction of a device at rest (pose_mapping.h).
+  Eigen::Vector3d rest_direction = Eigen::Vector3d::UnitX();
 };
 
 Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
@@ -107,6 +109,7 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
                      std::string(session->tracker->model().Name()) + " has " +
                      std::to_string(session->tracker->model().NumControls()) + " controls");
   }
+  session->rest_direction = RestGripDirection(scene, session->tracker->model());
   session->tracker->Reset(scene.grasp_start);
   return session;
 }
@@ -239,7 +242,7 @@ void Server::SolveAndPublish(const PoseSample& pose) {
                                  pose.state.position[2]);
   const Eigen::Vector4d quaternion(pose.state.orientation[0], pose.state.orientation[1],
                                    pose.state.orientation[2], pose.state.orientation[3]);
-  const Vec u = PoseToControls(mapping, model, position, quaternion);
+  const Vec u = PoseToControls(mapping, model, position, quaternion, session_->rest_direction);
 
   if (hooks_.before_update) hooks_.before_update();
   const TrackResult* result = nullptr;
@@ -274,8 +277,7 @@ void Server::SolveAndPublish(const PoseSample& pose) {
                                            nullptr, in.device_seq, in.device_utime,
                                            in.server_receive_utime, 0.0, in.seq, in.utime});
   }
-  if (lcm_->publish(channels_.force_model, &msg) != 0) publish_failures_.fetch_add(1);
-
+  // Statistics before the message leaves: whoever receives the model sees them counted.
   last_status_ = msg.status;
   for (int i = 0; i < 3; ++i) last_force_n_[i] = msg.f0[i];
   updates_.fetch_add(1);
@@ -283,14 +285,19 @@ void Server::SolveAndPublish(const PoseSample& pose) {
   if (msg.status == force_model_t::STATUS_SNAPPED) {
     snaps_.fetch_add(1);
     ++snaps_since_reset_;
-    spdlog::debug("server: snap at u = ({})", Format(u));
+    if (spdlog::should_log(spdlog::level::debug)) {
+      spdlog::debug("server: snap at u = ({})", Format(u));
+    }
   }
   status_window_.Push(solve_us);
-  const int64_t now_us = SteadyMicros();
-  std::lock_guard<std::mutex> lock(info_mutex_);
-  run_window_.Push(solve_us);
-  if (first_update_us_ == 0) first_update_us_ = now_us;
-  last_update_us_ = now_us;
+  {
+    const int64_t now_us = SteadyMicros();
+    std::lock_guard<std::mutex> lock(info_mutex_);
+    run_window_.Push(solve_us);
+    if (first_update_us_ == 0) first_update_us_ = now_us;
+    last_update_us_ = now_us;
+  }
+  if (lcm_->publish(channels_.force_model, &msg) != 0) publish_failures_.fetch_add(1);
 }
 
 void Server::ApplyCommand(const command_t& command) {
@@ -343,6 +350,9 @@ void Server::ApplyCommand(const command_t& command) {
       ok = false;
       message = "unknown command " + std::to_string(command.command);
   }
+  // The message first, then the counters: a caller that waits on a counter reads the
+  // message of that command.
+  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), &message);
   if (ok) {
     // A new start: the shape's snap count is "since the session (re)started".
     if (command.command != command_t::SET_METHOD) {
@@ -350,13 +360,12 @@ void Server::ApplyCommand(const command_t& command) {
       last_status_ = force_model_t::STATUS_REGULAR;
       for (double& f : last_force_n_) f = 0.0;
     }
-    commands_applied_.fetch_add(1);
     spdlog::info("server: {}", message);
+    commands_applied_.fetch_add(1);
   } else {
-    commands_refused_.fetch_add(1);
     spdlog::warn("server: {}", message);
+    commands_refused_.fetch_add(1);
   }
-  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), &message);
 }
 
 void Server::PublishShape() {

@@ -66,6 +66,29 @@ TEST(PoseMappingTest, PlanarAndSpatialControls) {
   const Eigen::Vector3d d = GripDirection(Eigen::Vector4d(0, 0, 0, 1.7));
   EXPECT_NEAR(d[0], -1.0, 1e-15);
   EXPECT_NEAR(d.norm(), 1.0, 1e-15);
+
+  // A scene that starts with the grip along -x: the device at rest holds it so, and
+  // turning the device 90 degrees about z turns the grip with it, to -y.
+  const Eigen::Vector3d rest(-2.0, 0.0, 0.0);
+  const Vec at_rest = PoseToControls(map, *thread, pos, Eigen::Vector4d(1, 0, 0, 0), rest);
+  EXPECT_NEAR(at_rest[3], -1.0, 1e-15);
+  EXPECT_NEAR(at_rest[4], 0.0, 1e-15);
+  const Vec turned = PoseToControls(map, *thread, pos, Eigen::Vector4d(h, 0, 0, h), rest);
+  EXPECT_NEAR(turned[3], 0.0, 1e-15);
+  EXPECT_NEAR(turned[4], -1.0, 1e-15);
+  EXPECT_NEAR(turned[5], 0.0, 1e-15);
+  // About x the -x grip does not move.
+  const Vec rolled = PoseToControls(map, *thread, pos, Eigen::Vector4d(h, h, 0, 0), rest);
+  EXPECT_NEAR(rolled[3], -1.0, 1e-15);
+
+  Scene scene;
+  scene.params = p;
+  scene.grasp_start = (Vec(6) << 1, 2, 3, 0, 0, 5).finished();
+  const Eigen::Vector3d r = RestGripDirection(scene, *thread);
+  EXPECT_NEAR(r[2], 1.0, 1e-15);
+  EXPECT_NEAR(r.norm(), 1.0, 1e-15);
+  scene.grasp_start = (Vec(2) << 1, 2).finished();
+  EXPECT_EQ(RestGripDirection(scene, *curve), Eigen::Vector3d::UnitX());
 }
 
 TEST(ServerMessagesTest, PlanarForceModelUnitsAndPlane) {

@@ -324,16 +324,23 @@ TEST_F(ServerTest, ThreadGripDirectionFromOrientation) {
   direct.Reset(scene.grasp_start);
   const Model& model = direct.model();
   ASSERT_EQ(model.NumControls(), 6);
-  // 180 degrees about z: the grip points along -x like the scene's start.
-  const Eigen::Vector4d q(0, 0, 0, 1);
-  const auto poses = PathPoses(scene, model, 20, 0.0);
+  const Eigen::Vector3d rest = RestGripDirection(scene, model);
+  EXPECT_NEAR((rest - scene.grasp_start.segment<3>(3).normalized()).norm(), 0.0, 1e-15);
+  // A device at rest (identity) holds the scene's grip; the last poses turn it by 20
+  // degrees about z.
+  const double half = 0.5 * 20.0 * M_PI / 180.0;
+  const Eigen::Vector4d turned(std::cos(half), 0, 0, std::sin(half));
+  const auto poses = PathPoses(scene, model, 30, 0.0);
+  int direct_snaps = 0;
   for (size_t i = 0; i < poses.size(); ++i) {
+    const Eigen::Vector4d q = i < 20 ? Eigen::Vector4d(1, 0, 0, 0) : turned;
     Publish(MakePose(static_cast<int64_t>(i), poses[i], q));
     force_model_t m;
     ASSERT_TRUE(probe_->WaitModel(static_cast<int64_t>(i), &m));
-    const Vec u = PoseToControls(scene.device, model, poses[i], q);
-    EXPECT_NEAR(u[3], -1.0, 1e-12);
+    const Vec u = PoseToControls(scene.device, model, poses[i], q, rest);
+    if (i < 20) EXPECT_NEAR((u.segment<3>(3) - rest).norm(), 0.0, 1e-15);
     const TrackResult& r = direct.Update(u);
+    if (r.snapped) ++direct_snaps;
     ASSERT_NE(m.status, force_model_t::STATUS_INVALID);
     EXPECT_EQ(m.has_torque, 1);
     const double n = scene.device.newtons_per_model_force;
@@ -348,6 +355,7 @@ TEST_F(ServerTest, ThreadGripDirectionFromOrientation) {
         u.segment<3>(3).normalized().cross(Eigen::Vector3d(r.force.segment<3>(3))) * (n / s);
     for (int a = 0; a < 3; ++a) EXPECT_NEAR(m.torque0[a], tau[a], 1e-9 * (1.0 + tau.norm()));
   }
+  EXPECT_EQ(server_->Stats().snaps, direct_snaps);
   EXPECT_EQ(probe_->invalid(), 0);
 }
 
