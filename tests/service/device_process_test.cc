@@ -390,23 +390,91 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   EXPECT_GT(recovered, 500);
 }
 
-TEST(DeviceProcessTest, SigtermStopsCleanlyAndWritesSummary) {
+// Listens to a session's device poses and statuses.
+class Listener {
+ public:
+  explicit Listener(const std::string& session) : channels_(session), lcm_(kUrl) {
+    if (!lcm_.good()) return;
+    lcm_.subscribe(channels_.device_state, &Listener::OnPose, this);
+    lcm_.subscribe(channels_.device_status, &Listener::OnStatus, this);
+    thread_ = std::thread([this] {
+      while (!stop_.load()) lcm_.handleTimeout(10);
+    });
+  }
+  ~Listener() { Stop(); }
+  void Stop() {
+    stop_.store(true);
+    if (thread_.joinable()) thread_.join();
+  }
+  bool good() { return lcm_.good(); }
+  int poses = 0, seq_gaps = 0, statuses = 0, bad = 0;
+  int64_t first_seq = -1, last_seq = -1;
+  device_status_t last_status{};
+
+ private:
+  void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    device_state_t m;
+    if (!transport::DecodeAndValidate(rbuf, &m, nullptr)) {
+      ++bad;
+      return;
+    }
+    if (first_seq < 0) first_seq = m.seq;
+    if (last_seq >= 0 && m.seq != last_seq + 1) ++seq_gaps;
+    last_seq = m.seq;
+    ++poses;
+  }
+  void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    device_status_t m;
+    if (!transport::DecodeAndValidate(rbuf, &m, nullptr)) {
+      ++bad;
+      return;
+    }
+    last_status = m;
+    ++statuses;
+  }
+  transport::Channels channels_;
+  lcm::LCM lcm_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+};
+
+TEST(DeviceProcessTest, SigtermStopsCleanlyAndPublishesPosesAndStatus) {
   const std::string bin = DeviceBinary();
   ASSERT_FALSE(bin.empty());
   const ScopedDir scoped;
   const std::string& dir = scoped.path;
+  const std::string session = UniqueSession("TERM");
+  Listener listener(session);
+  ASSERT_TRUE(listener.good());
   Process device({bin, "--backend", "virtual-hand", "--scene", WriteScene(dir), "--session",
-                  UniqueSession("TERM"), "--lcm-url", kUrl, "--duration", "0", "--no-rt",
-                  "--summary", dir + "/summary.json"},
+                  session, "--lcm-url", kUrl, "--duration", "0", "--no-rt",
+                  "--publish-divisor", "4", "--summary", dir + "/summary.json"},
                  dir + "/device");
   ASSERT_TRUE(device.started());
-  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
   device.Signal(SIGTERM);
   ASSERT_EQ(device.Wait(10.0), 0) << device.err();
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  listener.Stop();
   const std::string summary = ReadFile(dir + "/summary.json");
-  EXPECT_GT(JsonNumber(summary, "ticks"), 100) << summary;
+  const double ticks = JsonNumber(summary, "ticks");
+  EXPECT_GT(ticks, 1000) << summary;
   EXPECT_EQ(JsonNumber(summary, "models_received"), 0.0) << summary;  // no server
   EXPECT_EQ(JsonNumber(summary, "nonfinite_outputs"), 0.0);
+  // Every 4th pose is published, numbered consecutively from 0.
+  EXPECT_EQ(listener.bad, 0);
+  EXPECT_GT(listener.poses, 0.8 * ticks / 4) << listener.poses << " poses, " << ticks << " ticks";
+  EXPECT_LE(listener.poses, ticks / 4 + 1);
+  EXPECT_EQ(listener.first_seq, 0);
+  EXPECT_LE(listener.seq_gaps, 3);  // udpm may drop a datagram now and then
+  // DEVICE_STATUS at ~2 Hz.
+  EXPECT_GE(listener.statuses, 3);
+  EXPECT_LE(listener.statuses, 7);
+  EXPECT_GT(listener.last_status.ticks, 500);
+  EXPECT_GT(listener.last_status.tick_rate_hz, 300.0);
+  EXPECT_LE(listener.last_status.tick_rate_hz, 1100.0);
+  EXPECT_EQ(listener.last_status.models_received, 0);
+  EXPECT_EQ(listener.last_status.device_id, "virtual-hand");
 }
 
 TEST(DeviceProcessTest, BadArgumentsExitTwoNamingTheArgument) {
