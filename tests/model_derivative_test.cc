@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <ostream>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -420,6 +421,22 @@ TEST_P(ModelDerivativeTest, NodesProbeAndInitialStateAreConsistent) {
     EXPECT_EQ(nodes.col(2), Eigen::Vector3d(0.0, -3.0, 0.0));   // anchor
     EXPECT_EQ(m.Probe(pt.x, pt.u), pt.x[0]);
   }
+}
+
+TEST(ModelFactoryTest, ConstructorsValidateParams) {
+  ModelParams p;
+  p.n = 1;
+  EXPECT_THROW(MakeCurve2dModel(p), std::invalid_argument);
+  EXPECT_THROW(MakeThread3dModel(p), std::invalid_argument);
+  p.n = 2;
+  p.grip_direction = true;  // a grip needs N >= 3 (node N-1 must not be the clamped node 1)
+  EXPECT_THROW(MakeThread3dModel(p), std::invalid_argument);
+  p.n = 3;
+  EXPECT_EQ(MakeThread3dModel(p)->NumStates(), 2);  // x_1 and s
+  p.grip_direction = false;
+  p.stretching = -1.0;
+  EXPECT_THROW(MakeCurve2dModel(p), std::invalid_argument);
+  EXPECT_EQ(MakeZeemanModel()->Name(), "zeeman");
 }
 
 INSTANTIATE_TEST_SUITE_P(AllModels, ModelDerivativeTest, ::testing::ValuesIn(AllCases()),
