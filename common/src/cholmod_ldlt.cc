@@ -90,14 +90,6 @@ cholmod_sparse CholmodLdlt::ViewOfS() {
   return s;
 }
 
-long CholmodLdlt::FactorNonzeros() const {
-  if (factor_ == nullptr || factor_->nz == nullptr) return 0;
-  const int* nz = static_cast<const int*>(factor_->nz);
-  long total = 0;
-  for (int j = 0; j < n_; ++j) total += nz[j];
-  return total;
-}
-
 LinearSolverStatus CholmodLdlt::Analyze(const SparseMatrix& a) {
   factorized_ = false;
   FreeFactor();

@@ -39,9 +39,6 @@ class CholmodLdlt final : public SymmetricLinearSolver {
   int NegativePivots() const override { return negative_pivots_; }
   double MinAbsPivot() const override { return min_abs_pivot_; }
 
-  // Nonzeros of L (including the diagonal D) of the analysed pattern; 0 before.
-  long FactorNonzeros() const;
-
  private:
   void FreeFactor();
   // Appends CHOLMOD's status (cc_.status) as text to message_.

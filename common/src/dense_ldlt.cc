@@ -19,7 +19,7 @@ LinearSolverStatus DenseLdlt::Analyze(const SparseMatrix& a) {
   n_ = static_cast<int>(a.rows());
   pattern_.Assign(a);
   dense_.setZero(n_, n_);
-  ldlt_ = Eigen::LDLT<Mat, Eigen::Lower>(n_);  // preallocates factor, transpositions, work
+  ldlt_.emplace(n_);  // preallocates the factor, transpositions and work vector
   message_.clear();
   return LinearSolverStatus::kSuccess;
 }
@@ -43,16 +43,16 @@ LinearSolverStatus DenseLdlt::Factorize(const SparseMatrix& a) {
       if (rows[p] >= j) dense_(rows[p], j) = values[p];
     }
   }
-  ldlt_.compute(dense_);
+  ldlt_->compute(dense_);
   const double scale = internal::MaxAbsEntry(a);
-  const internal::PivotSummary pivots = internal::SummarizePivots(ldlt_.vectorD(), n_, scale);
+  const internal::PivotSummary pivots = internal::SummarizePivots(ldlt_->vectorD(), n_, scale);
   negative_pivots_ = pivots.negative;
   min_abs_pivot_ = pivots.min_abs;
-  if (pivots.first_bad >= 0 || ldlt_.info() != Eigen::Success) {
+  if (pivots.first_bad >= 0 || ldlt_->info() != Eigen::Success) {
     // Eigen's LDLT stops pivoting once the remaining diagonal is below its own tolerance;
     // either way a (relative) zero pivot means singular to working precision.
     const int i = pivots.first_bad >= 0 ? pivots.first_bad : 0;
-    message_ = internal::PivotFailureMessage("dense", i, ldlt_.vectorD()(i), scale);
+    message_ = internal::PivotFailureMessage("dense", i, ldlt_->vectorD()(i), scale);
     return LinearSolverStatus::kNumericalIssue;
   }
   factorized_ = true;
@@ -65,7 +65,7 @@ LinearSolverStatus DenseLdlt::Solve(const Vec& b, Vec* x) const {
     return LinearSolverStatus::kInvalidInput;
   }
   x->resize(n_);
-  *x = ldlt_.solve(b);
+  *x = ldlt_->solve(b);
   return LinearSolverStatus::kSuccess;
 }
 

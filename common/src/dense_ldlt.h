@@ -9,6 +9,7 @@
 // zero pivot and is reported as kNumericalIssue, like a singular one.
 #pragma once
 
+#include <optional>
 #include <string_view>
 
 #include <Eigen/Cholesky>
@@ -35,7 +36,9 @@ class DenseLdlt final : public SymmetricLinearSolver {
   internal::PatternCopy pattern_;
   int n_ = 0;
   Mat dense_;  // lower triangle of A (the upper one is never read)
-  Eigen::LDLT<Mat, Eigen::Lower> ldlt_;
+  // Emplaced with the size in Analyze() (LDLT's preallocating constructor; constructed in
+  // place because copying it would read its not-yet-initialised info member).
+  std::optional<Eigen::LDLT<Mat, Eigen::Lower>> ldlt_;
   bool factorized_ = false;
   int negative_pivots_ = 0;
   double min_abs_pivot_ = 0.0;
