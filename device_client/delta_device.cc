@@ -18,7 +18,7 @@ bool DeltaDevice::Open(std::string* error) {
     return false;
   }
   const char* name = dhdGetSystemName(id_);
-  caps_.model_name = std::string("delta:") + (name ? name : "unknown");
+  caps_.model_name = name ? name : "unknown";
   // The SDK does not report these; conservative values for a delta.3 / omega.3 at 1 kHz.
   caps_.max_force_n = 12.0;
   caps_.max_stiffness_n_per_m = 2000.0;

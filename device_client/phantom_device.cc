@@ -1,7 +1,9 @@
 // UNTESTED (no OpenHaptics SDK or device here): see phantom_device.h.
 #include "phantom_device.h"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace snapthread::device {
 
@@ -23,7 +25,8 @@ bool PhantomDevice::Open(std::string* error) {
   hdGetDoublev(HD_NOMINAL_MAX_STIFFNESS, &max_stiffness);
   hdGetDoublev(HD_NOMINAL_MAX_DAMPING, &max_damping);
   hdGetDoublev(HD_USABLE_WORKSPACE_DIMENSIONS, workspace);
-  caps_.model_name = std::string("phantom:") + hdGetString(HD_DEVICE_MODEL_TYPE);
+  const char* model = hdGetString(HD_DEVICE_MODEL_TYPE);
+  caps_.model_name = model ? model : "unknown";
   caps_.max_force_n = max_force;
   caps_.max_stiffness_n_per_m = 1000.0 * max_stiffness;           // N/mm -> N/m
   caps_.max_linear_damping_n_per_m_per_s = 1000.0 * max_damping;  // N s/mm -> N s/m
