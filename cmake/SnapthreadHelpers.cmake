@@ -8,6 +8,11 @@ function(snapthread_add_test name)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
   endif()
+  # An empty LABELS value would shift the PROPERTIES key/value pairs below (and lose
+  # ENVIRONMENT), so every test gets a label.
+  if(NOT ARG_LABELS)
+    set(ARG_LABELS unit)
+  endif()
   include(GoogleTest)
   gtest_discover_tests(${name}
     PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}"
