@@ -354,12 +354,20 @@ TEST_F(ProcessTest, ServerKilledForceFadesThenRecoversWithANewServer) {
   const auto rows = ReadTrace(dir_ + "/trace.csv");
   ASSERT_GT(rows.size(), 3000u);
 
-  // The outage: the first stale tick after the device had settled on server A's models.
-  size_t first_stale = rows.size();
-  for (size_t i = 0; i < rows.size(); ++i) {
+  // The outage: the longest stretch of stale ticks (a loaded machine may stall the
+  // server for ~100 ms now and then; the kill is the stretch of ~1.5 s).
+  size_t first_stale = rows.size(), longest = 0;
+  for (size_t i = 0; i < rows.size();) {
     if (rows[i].t_s > 1.0 && rows[i].model_age_ms > kTimeoutMs) {
-      first_stale = i;
-      break;
+      size_t j = i;
+      while (j < rows.size() && rows[j].model_age_ms > kTimeoutMs) ++j;
+      if (j - i > longest) {
+        longest = j - i;
+        first_stale = i;
+      }
+      i = j;
+    } else {
+      ++i;
     }
   }
   ASSERT_LT(first_stale, rows.size()) << "the device never noticed the killed server";

@@ -583,6 +583,8 @@ TEST_F(ServerTest, BadPacketsAreCountedAndDropped) {
 
   ASSERT_TRUE(WaitFor([&] { return server_->Stats().rejected_messages == bad; }))
       << "rejected " << server_->Stats().rejected_messages << " of " << bad;
+  // The solver status reports them (~10 Hz).
+  EXPECT_TRUE(probe_->WaitStatus(0, [&](const solver_status_t& s) { return s.rejected_messages == bad; }));
   // The server is alive and answers a good pose; nothing bad reached the solver.
   Publish(good);
   force_model_t m;
