@@ -288,7 +288,10 @@ int RunDeviceClient(const DeviceClientOptions& o) {
 
   std::atomic<bool> stop_threads{false};
   std::thread lcm_thread([&] {
-    while (!stop_threads.load()) lcm.handleTimeout(20);
+    while (!stop_threads.load()) {
+      // < 0: the provider failed; do not spin (the watchdog fades the force meanwhile).
+      if (lcm.handleTimeout(20) < 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
   });
 
   ServoLoopOptions loop_options;
@@ -331,6 +334,7 @@ int RunDeviceClient(const DeviceClientOptions& o) {
     if (transport::Validate(st, &why)) lcm.publish(channels.device_status, &st);
   };
 
+  std::atomic<uint64_t> invalid_poses_unpublished{0};
   std::thread io_thread([&] {
     device_state_t msg{};
     msg.device_id = device_id;
@@ -345,7 +349,13 @@ int RunDeviceClient(const DeviceClientOptions& o) {
         for (int k = 0; k < 3; ++k) msg.position[k] = p.position_m[k];
         for (int k = 0; k < 4; ++k) msg.orientation[k] = p.orientation[k];
         msg.buttons = p.buttons;
-        lcm.publish(channels.device_state, &msg);
+        // The servo already refused bad positions; this also catches a backend's bad
+        // orientation, so the server never receives a pose it would have to reject.
+        if (transport::Validate(msg, nullptr)) {
+          lcm.publish(channels.device_state, &msg);
+        } else {
+          invalid_poses_unpublished.fetch_add(1);
+        }
       }
       TraceRow r;
       while (trace_ring->TryPop(&r)) {
@@ -435,14 +445,15 @@ int RunDeviceClient(const DeviceClientOptions& o) {
         "  \"slew_limits\": %llu,\n  \"fade_ticks\": %llu,\n  \"snaps_felt\": %llu,\n"
         "  \"max_force_n\": %.6f,\n  \"nonfinite_outputs\": %llu,\n  \"overruns\": %llu,\n"
         "  \"read_failures\": %llu,\n  \"pose_ring_drops\": %llu,\n  \"trace_ring_drops\": %llu,\n"
-        "  \"realtime\": %s\n}\n",
+        "  \"invalid_poses_unpublished\": %llu,\n  \"realtime\": %s\n}\n",
         o.backend.c_str(), o.session.c_str(), run_s, u(ticks), tick_rate, lat.p50, lat.p99,
         stats.lateness_max_us, rt.p50, rt.p99, u(receiver.received()), u(receiver.rejected()),
         u(receiver.invalid_models()), u(sc.poses_rejected.load()), u(sc.force_clamps.load()),
         u(receiver.stiffness_clamps()), u(sc.slew_limits.load()), u(sc.fade_ticks.load()),
         u(receiver.snaps_felt()), safety.max_force_n(), u(sc.nonfinite_outputs.load()),
         u(loop.overruns()), u(tick.counters().read_failures.load()), u(poses->dropped()),
-        u(trace_ring->dropped()), loop.realtime_active() ? "true" : "false");
+        u(trace_ring->dropped()), u(invalid_poses_unpublished.load()),
+        loop.realtime_active() ? "true" : "false");
     std::fclose(f);
   }
   return kExitOk;
