@@ -217,6 +217,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   double r = EvalGradient(xr, u, &g_, &s);
   s.termination = Termination::kBudgetSpent;
   bool newton_stalled = false;
+  int reduction_stalls = 0;
   while (true) {
     if (!std::isfinite(r)) {
       xr = last_good_;
@@ -261,6 +262,20 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
           s.termination = Termination::kConverged;
         break;
       }
+      // Approaching a fold (lambda_0 below half its reference) a Newton step must also
+      // lower the energy; one that raises it is aimed at the saddle that is about to
+      // meet the followed minimum, so this iteration uses the reduction instead.
+      const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : lambda0;
+      bool take_newton = true;
+      if (lambda0 < 0.5 * ref) {
+        xs_ = xr - dx_;
+        take_newton = model_.Energy(xs_, u) <= model_.Energy(xr, u);
+      }
+      if (!take_newton) {
+        degenerate = true;
+      }
+    }
+    if (!degenerate) {
       xr -= dx_;
       // Where E_xx is regular Newton converges quadratically; a step that does not
       // even halve |E_x| says the quadratic model has failed (a fold is close): the
@@ -269,7 +284,8 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       r = EvalGradient(xr, u, &g_, &s);
       newton_stalled = !(r < 0.5 * r_before);
       continue;
-    } else {
+    }
+    {
       // A factorisation that failed on an exactly singular E_xx still allows the
       // reduction: it needs only the restricted factor and the last eigenvector.
       const bool many_negative = st == LinearSolverStatus::kSuccess && factor_->NegativePivots() > 1;
@@ -296,8 +312,27 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
           break;
         }
       }
+      // On the quartic the reduction converges like Newton. Where the followed minimum
+      // has just vanished its ghost still attracts the quartic model, and the steps
+      // crawl through the bottleneck: two steps in a row that do not halve |E_x| mean
+      // the minimum is gone — finish the snap now rather than over the next updates.
+      // A reduction step that raises |E_x| (the energy fell, the force grew) says the
+      // same at once.
+      const double r_before = r;
+      r = EvalGradient(xr, u, &g_, &s);
+      reduction_stalls = (r < 0.5 * r_before) ? 0 : reduction_stalls + 1;
+      if (reduction_stalls >= 2 || r > r_before) {
+        if (!FinishSnap(u, &xr, &s)) {
+          s.termination = Termination::kLinearSolverFailed;
+          s.message = "snap minimiser did not converge";
+        }
+        r = EvalGradient(xr, u, &g_, &s);
+        if (s.termination != Termination::kLinearSolverFailed && r < options_.cutoff)
+          s.termination = Termination::kConverged;
+        break;
+      }
+      continue;
     }
-    r = EvalGradient(xr, u, &g_, &s);
   }
   if (!xr.allFinite()) {
     xr = last_good_;

@@ -1,0 +1,163 @@
+// snapthread-stability: where methods fail. Runs the standard sweeps for each method
+// and iteration budget, compares each with a tight reference trace, prints the table
+// (chatter, snap placement, force error, cost), writes CSVs and a gnuplot chart of
+// force traces (newton against higher-order, like the seed's Figs 2.5/2.7/2.10).
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "stability.h"
+
+namespace fs = std::filesystem;
+using namespace snapthread;
+
+namespace {
+
+std::vector<int> ParseInts(const std::string& s, const char* what) {
+  std::vector<int> v;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');) {
+    if (item == "inf" || item == "0") {
+      v.push_back(0);
+      continue;
+    }
+    try {
+      size_t used = 0;
+      const int k = std::stoi(item, &used);
+      if (used != item.size() || k < 0) throw std::invalid_argument(item);
+      v.push_back(k);
+    } catch (const std::exception&) {
+      throw std::invalid_argument(std::string(what) + ": '" + item + "' is not an iteration budget (integer >= 1 or inf)");
+    }
+  }
+  return v;
+}
+
+// Charted force traces of one sweep at one budget: reference and every method.
+void WriteTraces(const fs::path& file, const StandardSweep& sw, const std::vector<SweepRow>& ref,
+                 const std::map<Method, std::vector<SweepRow>>& traces) {
+  std::ofstream out(file);
+  const int c = sw.force_component;
+  out << "step,control_distance,reference";
+  for (const auto& [m, t] : traces) out << ',' << ToString(m);
+  out << '\n';
+  for (size_t i = 0; i < ref.size(); ++i) {
+    out << i << ',' << i * sw.step << ',' << ref[i].force[c];
+    for (const auto& [m, t] : traces) out << ',' << (i < t.size() ? t[i].force[c] : 0.0);
+    out << '\n';
+  }
+}
+
+bool Plot(const fs::path& dir, const std::vector<std::string>& sweeps, int budget) {
+  const fs::path script = dir / "stability.gp";
+  std::ofstream gp(script);
+  const int n = static_cast<int>(sweeps.size());
+  gp << "set terminal pngcairo size 1400," << 330 * n << " font 'DejaVu Sans,10'\n"
+     << "set output '" << (dir / "stability.png").string() << "'\n"
+     << "set datafile separator ','\nset key outside right\nset grid\n"
+     << "set multiplot layout " << n << ",1 title 'Force on the grasp along standard sweeps, budget "
+     << (budget == 0 ? std::string("unlimited") : std::to_string(budget)) << " iterations per update'\n";
+  for (const auto& s : sweeps) {
+    const std::string f = (dir / ("traces_" + s + ".csv")).string();
+    gp << "set title '" << s << "'\nset xlabel 'update'\nset ylabel 'force component'\n"
+       << "plot '" << f << "' using 1:4 with lines lw 1 lc rgb '#1f77b4' title 'newton', "
+       << "'' using 1:5 with lines lw 1 lc rgb '#ff7f0e' title 'newton-ls', "
+       << "'' using 1:6 with lines lw 2 lc rgb '#2ca02c' title 'higher-order', "
+       << "'' using 1:3 with lines lw 1 dt 2 lc rgb '#d62728' title 'reference'\n";
+  }
+  gp << "unset multiplot\n";
+  gp.close();
+  const std::string cmd = "gnuplot '" + script.string() + "'";
+  return std::system(cmd.c_str()) == 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"snapthread-stability: chatter, snap placement and force error of each method on the standard sweeps"};
+  std::string scenes_dir = SNAPTHREAD_SCENES_DIR, out_dir = "out/stability", budgets_text = "1,2,3,5,10,inf",
+              only;
+  int substeps = 10, plot_budget = 2;
+  bool no_plot = false;
+  app.add_option("--scenes", scenes_dir, "folder with the scene files");
+  app.add_option("--out", out_dir, "output folder (CSV, traces, chart)");
+  app.add_option("--budgets", budgets_text, "iteration budgets per update, comma-separated (inf = unlimited)");
+  app.add_option("--sweeps", only, "only these sweeps (comma-separated names)");
+  app.add_option("--substeps", substeps, "reference: fine steps per row")->check(CLI::Range(1, 1000));
+  app.add_option("--plot-budget", plot_budget, "budget whose traces are charted (0 = unlimited)");
+  app.add_flag("--no-plot", no_plot, "skip the gnuplot chart");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  try {
+    const std::vector<int> budgets = ParseInts(budgets_text, "--budgets");
+    std::vector<StandardSweep> sweeps = StandardSweeps(scenes_dir);
+    if (!only.empty()) {
+      std::vector<StandardSweep> keep;
+      std::stringstream ss(only);
+      for (std::string name; std::getline(ss, name, ',');) {
+        bool found = false;
+        for (const auto& s : sweeps)
+          if (s.name == name) {
+            keep.push_back(s);
+            found = true;
+          }
+        if (!found) throw std::invalid_argument("--sweeps: no sweep named '" + name + "'");
+      }
+      sweeps = keep;
+    }
+    fs::create_directories(out_dir);
+    std::vector<StabilityRow> table;
+    std::vector<std::string> charted;
+    for (const auto& sw : sweeps) {
+      std::cerr << "stability: " << sw.name << " (" << sw.controls.size() << " updates): " << sw.description << '\n';
+      const Scene scene = LoadScene(sw.scene_file);
+      const auto ref = ReferenceTrace(scene, sw.controls, substeps);
+      std::map<Method, std::vector<SweepRow>> chart;
+      for (Method m : {Method::kNewton, Method::kNewtonLineSearch, Method::kHigherOrder}) {
+        for (int k : budgets) {
+          Scene sc = scene;
+          sc.solver.method = m;
+          sc.solver.max_iterations = k;
+          auto tracker = MakeTracker(sc);
+          auto trace = RunSweep(tracker.get(), sw.controls);
+          StabilityRow row = Compare(trace, ref);
+          row.sweep = sw.name;
+          row.method = m;
+          row.budget = k;
+          table.push_back(row);
+          if (k == plot_budget) chart[m] = std::move(trace);
+        }
+      }
+      if (chart.size() == 3) {
+        WriteTraces(fs::path(out_dir) / ("traces_" + sw.name + ".csv"), sw, ref, chart);
+        charted.push_back(sw.name);
+      }
+    }
+    PrintStabilityTable(table, std::cout);
+    std::ofstream csv(fs::path(out_dir) / "stability.csv");
+    WriteStabilityCsv(table, csv);
+    if (!no_plot && !charted.empty()) {
+      if (!Plot(out_dir, charted, plot_budget)) {
+        std::cerr << "stability: gnuplot failed (is gnuplot installed? deploy/setup.sh installs gnuplot-nox)\n";
+        return 1;
+      }
+      std::cerr << "stability: chart " << (fs::path(out_dir) / "stability.png").string() << '\n';
+    }
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "snapthread-stability: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "snapthread-stability: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
