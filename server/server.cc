@@ -72,6 +72,7 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
   // touching the network.
   Scene scene = LoadScene(params_.scene_path);
   session_ = MakeSession(scene);
+  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), nullptr);
 
   if (lcm != nullptr) {
     lcm_ = lcm;
@@ -125,7 +126,6 @@ void Server::SetInfo(const std::string& scene, const std::string& method,
 void Server::Start() {
   if (started_) return;
   started_ = true;
-  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), nullptr);
   state_sub_ = lcm_->subscribe(channels_.device_state, &Server::HandleDeviceState, this);
   command_sub_ = lcm_->subscribe(channels_.command, &Server::HandleCommand, this);
   running_ = true;
