@@ -6,10 +6,12 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <new>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -278,6 +280,23 @@ TEST_P(LinearSolverTest, RefactorizesWithNewValuesOnTheSamePattern) {
     ASSERT_EQ(solver->Solve(rhs, &x), LinearSolverStatus::kSuccess);
     const Vec reference = Eigen::FullPivLU<Mat>(dense).solve(rhs);
     EXPECT_LT(RelativeError(x, reference), 1e-12) << "round " << round;
+  }
+}
+
+// Analyze() again with another pattern (other size and band) replaces the old one.
+TEST_P(LinearSolverTest, ReanalyzesForANewPattern) {
+  std::mt19937 rng(13);
+  auto solver = Make();
+  Vec x;
+  for (const auto& [n, b] : std::vector<std::pair<int, int>>{{50, 2}, {7, 1}, {120, 8}, {50, 2}}) {
+    SCOPED_TRACE("n = " + std::to_string(n) + ", b = " + std::to_string(b));
+    const Mat dense = RandomSpdBand(n, b, &rng);
+    const SparseMatrix a = BandToSparse(dense, b);
+    ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess) << solver->message();
+    ASSERT_EQ(solver->Factorize(a), LinearSolverStatus::kSuccess) << solver->message();
+    const Vec rhs = RandomVector(n, &rng);
+    ASSERT_EQ(solver->Solve(rhs, &x), LinearSolverStatus::kSuccess);
+    EXPECT_LT(RelativeError(x, Eigen::FullPivLU<Mat>(dense).solve(rhs)), 1e-12);
   }
 }
 
