@@ -343,13 +343,19 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   EXPECT_EQ(header, "t_s,seq,x_m,y_m,z_m,fx_n,fy_n,fz_n,model_age_ms,model_status,clamped,fading");
   ASSERT_GT(rows.size(), 1000u);
 
-  // Spring law over the bulk of the fresh-model samples (the 100 ms fade-ins after the
-  // start and the restart are the expected exceptions).
+  // Spring law on every settled sample: a fresh model, and no stale tick (fading or no
+  // model) within the last fade time, so the fade gain is back at 1. (A starved fake
+  // server on a loaded machine makes short fades in the middle of the run too.)
   const double timeout_ms = 50.0, fade_ms = 100.0;
-  int fresh = 0, lawful = 0;
+  int settled = 0, lawful = 0;
+  double last_unsettled_t = 0.0;
   for (const auto& r : rows) {
-    if (r.model_age_ms < 0.0 || r.model_age_ms > 20.0 || r.fading) continue;
-    ++fresh;
+    if (r.model_age_ms < 0.0 || r.fading) {
+      last_unsettled_t = r.t_s;
+      continue;
+    }
+    if (r.model_age_ms > 20.0 || r.t_s - last_unsettled_t < 1e-3 * fade_ms + 0.005) continue;
+    ++settled;
     double err2 = 0.0;
     for (int k = 0; k < 3; ++k) {
       const double e = r.f[k] - (-kSpringNPerM * r.x[k]);
@@ -357,8 +363,8 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
     }
     if (std::sqrt(err2) < 1e-3) ++lawful;
   }
-  EXPECT_GT(fresh, 500);
-  EXPECT_GT(lawful, 0.85 * fresh) << lawful << " of " << fresh;
+  EXPECT_GT(settled, 500);
+  EXPECT_GE(lawful, 0.99 * settled) << lawful << " of " << settled;
 
   // Fade: once the model is older than timeout + fade (+ a tick), the force is exactly 0;
   // between timeout and that, the device says it is fading.
