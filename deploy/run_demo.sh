@@ -58,7 +58,10 @@ trap cleanup EXIT
 trap 'echo "run_demo: interrupted" >&2; exit 1' INT TERM
 
 echo "run_demo: scene $(basename "$scene"), session $session on $url, ${duration} s; logs in $out"
+# The server's own --duration is only a safety net (stopped with SIGTERM after the
+# device finishes): it never outlives the demo by more than a minute.
 "$bin/snapthread-server" --scene "$scene" --session "$session" --lcm-url "$url" \
+  --duration "$(awk -v d="$duration" 'BEGIN { print d + 60 }')" \
   --summary "$out/server.json" > "$out/server.log" 2>&1 &
 server_pid=$!
 # Wait until the server has loaded the scene and subscribed (it logs its session line).

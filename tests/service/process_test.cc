@@ -218,7 +218,10 @@ class ProcessTest : public ::testing::Test {
     auto child = std::make_unique<Child>(
         std::vector<std::string>{bin_ + "/snapthread-server", "--scene", scene_path_, "--session",
                                  session_, "--lcm-url", kUrl, "--summary",
-                                 dir_ + "/server_" + tag + ".json", "--log-level", "info"},
+                                 dir_ + "/server_" + tag + ".json", "--log-level", "info",
+                                 // A safety net should the test die without its cleanup;
+                                 // the tests stop it with SIGTERM long before.
+                                 "--duration", "300"},
         dir_ + "/server_" + tag + ".log");
     EXPECT_TRUE(child->started());
     // Up when it has logged its session line (scene loaded, LCM started, subscribed).
@@ -487,6 +490,45 @@ TEST_F(ProcessTest, ServerCommandLine) {
   }
   EXPECT_GT(s.at("shapes_published"), 5);  // 60 Hz for 0.5 s, even with no device
   EXPECT_NE(log.find("final: updates=0"), std::string::npos) << log;
+
+  // --duration 0 runs until SIGINT, then stops cleanly.
+  {
+    Child c({server, "--scene", scene_path_, "--session", session_, "--lcm-url", kUrl},
+            dir_ + "/sigint.log");
+    ASSERT_TRUE(c.WaitForLog("server: session", 30s)) << c.Log();
+    c.Signal(SIGINT);
+    ASSERT_TRUE(c.Wait(30s, &code));
+    EXPECT_EQ(code, 0) << c.Log();
+    EXPECT_NE(c.Log().find("final: updates=0"), std::string::npos) << c.Log();
+  }
+}
+
+// deploy/run_demo.sh end to end (server + virtual-hand device, summary), short.
+TEST_F(ProcessTest, RunDemoScript) {
+  Child demo({"/bin/bash", source_ + "/deploy/run_demo.sh", "--bin-dir", bin_, "--duration", "3",
+              "--out", dir_ + "/demo"},
+             dir_ + "/demo.log");
+  int code = -1;
+  ASSERT_TRUE(demo.Wait(120s, &code)) << demo.Log();
+  const std::string log = demo.Log();
+  EXPECT_EQ(code, 0) << log;
+  for (const char* text : {"tick rate", "round trip", "snaps felt", "max force", "clamps",
+                           "updates", "solve", "final log line: updates="}) {
+    EXPECT_NE(log.find(text), std::string::npos) << text << " missing in\n" << log;
+  }
+  const auto dev = ReadJsonNumbers(dir_ + "/demo/device.json");
+  const auto srv = ReadJsonNumbers(dir_ + "/demo/server.json");
+  ASSERT_EQ(dev.count("models_received"), 1u) << log;
+  EXPECT_GT(dev.at("models_received"), 1000);
+  EXPECT_EQ(dev.at("nonfinite_outputs"), 0);
+  EXPECT_GT(srv.at("updates"), 1000);
+
+  // Bad arguments: exit 2 naming the argument.
+  Child bad({"/bin/bash", source_ + "/deploy/run_demo.sh", "--bin-dir", bin_, "--duration", "x"},
+            dir_ + "/demo_bad.log");
+  ASSERT_TRUE(bad.Wait(60s, &code));
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(bad.Log().find("--duration"), std::string::npos) << bad.Log();
 }
 
 }  // namespace
