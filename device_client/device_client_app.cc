@@ -190,6 +190,17 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
 
 int RunDeviceClient(const DeviceClientOptions& o) {
   spdlog::set_level(spdlog::level::from_str(o.log_level));
+  if (!transport::IsValidSessionName(o.session)) {
+    std::fprintf(stderr, "snapthread-device: --session '%s': expected [A-Za-z0-9_]+\n",
+                 o.session.c_str());
+    return kExitBadArguments;
+  }
+  if (!(o.rate_hz >= 100.0 && o.rate_hz <= 10000.0) || o.publish_divisor < 1 ||
+      o.trace_divisor < 1 || !(o.model_timeout_ms > 0.0) || !(o.fade_ms > 0.0) ||
+      !(o.speed_m_per_s > 0.0) || !(o.duration_s >= 0.0)) {
+    std::fprintf(stderr, "snapthread-device: options out of range (see --help)\n");
+    return kExitBadArguments;
+  }
   const transport::Channels channels(o.session);
 
   // ---- configuration: scene, path, backend, limits (bad input -> exit 2) --------------
