@@ -43,6 +43,7 @@ namespace {
 
 constexpr const char* kUrl = "udpm://239.255.76.67:7667?ttl=0";
 constexpr double kSpringNPerM = 40.0;
+constexpr double kNegativeStiffnessNPerM = 25.0;
 
 std::string UniqueSession(const std::string& tag) {
   static std::atomic<int> counter{0};
@@ -193,12 +194,16 @@ class FakeServer {
     m.seq = ++seq_;
     m.device_seq = pose.seq;
     m.device_utime = pose.utime;
-    m.status = force_model_t::STATUS_REGULAR;
+    // Every 100th model reports a snap (the device counts snaps felt).
+    m.status = m.seq % 100 == 0 ? force_model_t::STATUS_SNAPPED : force_model_t::STATUS_REGULAR;
     for (int i = 0; i < 3; ++i) {
       m.u0[i] = pose.position[i];
       m.f0[i] = -kSpringNPerM * pose.position[i];
       m.K[i][i] = -kSpringNPerM;
     }
+    // A negative stiffness along z (dF_z/dz > 0), which the device must clamp to zero in
+    // every model. The sim-path stays at z = 0, so the spring law is unaffected.
+    m.K[2][2] = +kNegativeStiffnessNPerM;
     lcm_.publish(channels_.force_model, &m);
   }
 
@@ -337,6 +342,11 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   EXPECT_LE(rejected, injected) << summary;
   EXPECT_EQ(JsonNumber(summary, "nonfinite_outputs"), 0.0) << summary;
   EXPECT_GT(JsonNumber(summary, "fade_ticks"), 200) << summary;
+  // Every accepted model had its negative z stiffness clamped; about 1 in 100 snapped.
+  const double received = JsonNumber(summary, "models_received");
+  EXPECT_EQ(JsonNumber(summary, "stiffness_clamps"), received) << summary;
+  EXPECT_GE(JsonNumber(summary, "snaps_felt"), std::floor(0.5 * received / 100)) << summary;
+  EXPECT_LE(JsonNumber(summary, "snaps_felt"), std::ceil(received / 100) + 2) << summary;
 
   std::string header;
   const auto rows = ReadTrace(dir + "/trace.csv", &header);

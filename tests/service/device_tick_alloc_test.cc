@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "safety.h"
+#include "snapthread/transport/percentiles.h"
 #include "servo_loop.h"
 #include "sim_path_device.h"
 #include "virtual_hand_device.h"
@@ -156,6 +157,21 @@ TEST(DeviceServoTickAllocationTest, SimPathTickNeverAllocatesIncludingOutOfWorks
   // The path leaves the 5 cm workspace: poses are rejected (zero force, not published).
   SimPathDevice sim(ScriptedPath({{-0.04, 0.0, 0.0}, {0.08, 0.0, 0.0}}, 0.05), &TestClock);
   EXPECT_GT(RunTicks(&sim, 10000), 1000u);
+}
+
+TEST(DeviceMallocGuardTest, SampleWindowPushAndComputeNeverAllocate) {
+  transport::SampleWindow window(1000);
+  window.Compute();  // warm-up
+  long allocations = 0;
+  {
+    AllocationGuard guard;
+    for (int i = 0; i < 10000; ++i) window.Push(static_cast<double>(i % 977));
+    const auto s = window.Compute();
+    allocations = guard.count();
+    EXPECT_EQ(s.count, 1000u);
+    EXPECT_EQ(s.max, 976.0);
+  }
+  EXPECT_EQ(allocations, 0);
 }
 
 }  // namespace
