@@ -1,7 +1,9 @@
 // snapthread-linear-bench: Factorize + Solve time of each LDL^T backend on banded SPD
 // matrices with the bandwidth of a 3-D thread chain (thread3d couples nodes up to two
 // apart, 3 coordinates per node: half-bandwidth 2*3 + 2 = 8), for growing n. The
-// numbers set the "auto" rule in common/src/linear_solver.cc.
+// numbers set the "auto" rule in common/src/linear_solver.cc. With --thread3d the
+// matrices are real thread3d Hessians instead (n is then the number of segments; the
+// thread is compressed to 80% so the Hessian is indefinite, as near a buckle).
 //
 // Each cell is the median over samples; a sample times a batch of repetitions long
 // enough (>= --min-sample-us) for the clock, divided by the batch size. The machine is
@@ -16,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "snapthread/linear_solver.h"
+#include "snapthread/models.h"
 
 namespace snapthread {
 namespace {
@@ -49,6 +52,24 @@ SparseMatrix RandomSpdBand(int n, int b, bool ring, std::mt19937* rng) {
   a.setFromTriplets(t.begin(), t.end());
   a.makeCompressed();
   return a;
+}
+
+// thread3d Hessian at a compressed, slightly perturbed state; *bandwidth as the model
+// reports it.
+SparseMatrix Thread3dHessian(int segments, std::mt19937* rng, int* bandwidth) {
+  ModelParams p;
+  p.model = "thread3d";
+  p.n = segments;
+  const auto model = MakeModel(p);
+  Vec u = Vec::Zero(model->NumControls());
+  u[0] = 0.8 * segments * p.segment_length;
+  Vec x = model->InitialState(u);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (int i = 0; i < x.size(); ++i) x[i] += noise(*rng);
+  SparseMatrix h = model->HessianPattern();
+  model->Hessian(x, u, &h);
+  *bandwidth = model->HessianBandwidth();
+  return h;
 }
 
 struct Cell {
@@ -128,30 +149,46 @@ int main(int argc, char** argv) {
   double budget_s = 0.5;
   bool csv = false;
   bool ring = false;
+  bool thread3d = false;
   app.add_option("--bandwidth", bandwidth, "half-bandwidth b (thread3d: 8)")->check(CLI::NonNegativeNumber);
   app.add_option("--sizes", sizes, "matrix sizes n");
   app.add_option("--dense-max", dense_max, "largest n for the O(n^3) dense backend");
   app.add_option("--min-sample-us", min_sample_us, "shortest timed batch, microseconds");
   app.add_option("--budget-s", budget_s, "time budget per cell, seconds (>= 5 samples)");
   app.add_flag("--ring", ring, "close the chain: couple the first and last unknowns");
+  app.add_flag("--thread3d", thread3d, "real thread3d Hessians; --sizes are segment counts");
   app.add_flag("--csv", csv, "print CSV instead of a table");
   CLI11_PARSE(app, argc, argv);
 
   const std::vector<std::string> backends = {"cholmod", "dense", "banded", "auto"};
+  if (thread3d && ring) {
+    std::fprintf(stderr, "--ring and --thread3d exclude each other\n");
+    return 2;
+  }
   if (csv) {
     std::printf("n,bandwidth,backend,chosen,median_us,analyze_us,samples\n");
   } else {
-    std::printf("Factorize+Solve, median us (half-bandwidth %d, full band%s, SPD)\n", bandwidth,
-                ring ? " + corner (ring)" : "");
+    if (thread3d) {
+      std::printf("Factorize+Solve, median us (thread3d Hessians, 80%% compressed: indefinite)\n");
+    } else {
+      std::printf("Factorize+Solve, median us (half-bandwidth %d, full band%s, SPD)\n",
+                  bandwidth, ring ? " + corner (ring)" : "");
+    }
     std::printf("%8s", "n");
     for (const auto& b : backends) std::printf(" %14s", b.c_str());
     std::printf("  auto picks\n");
   }
   std::mt19937 rng(12345);
-  for (int n : sizes) {
-    const SparseMatrix a = RandomSpdBand(n, std::min(bandwidth, n - 1), ring, &rng);
-    // The bandwidth "auto" is told, as a model would report it.
-    const int b = ring ? n - 1 : std::min(bandwidth, n - 1);
+  for (int size : sizes) {
+    int b = 0;  // the bandwidth "auto" is told, as a model would report it
+    SparseMatrix a;
+    if (thread3d) {
+      a = Thread3dHessian(size, &rng, &b);
+    } else {
+      a = RandomSpdBand(size, std::min(bandwidth, size - 1), ring, &rng);
+      b = ring ? size - 1 : std::min(bandwidth, size - 1);
+    }
+    const int n = static_cast<int>(a.rows());
     Vec rhs = Vec::Ones(n);
     std::string chosen;
     {

@@ -33,6 +33,9 @@ std::vector<std::string> LinearSolverNames() { return {"auto", "cholmod", "dense
 //   dense pattern (b = n - 1): n = 30: 6.8 / 3.4 / 4.1;  n = 100: 143 / 50 / 79
 //   chain closed into a ring (b = 8 plus the corner (0, n-1): sparse, bandwidth n - 1):
 //        n = 30: 3.3 / 3.0 / 3.6;  n = 100: 12 / 37 / 53;  n = 1000: 119 / 28200 / 86900
+//   real thread3d Hessians (snapthread-linear-bench --thread3d; 80% compressed, so
+//   indefinite; the model reports b = 8):
+//        n = 25: 2.1 / 2.3 / 1.7;  n = 295: 25 / 728 / 24;  n = 2995: 263 / - / 247
 //
 // So: a band with 2b <= n is fastest in "banded" at every size (CHOLMOD finds the same
 // fill with AMD but pays for its bookkeeping, ~1.4x); a small matrix that is not
