@@ -2,6 +2,7 @@
 // and iteration budget, compares each with a tight reference trace, prints the table
 // (chatter, snap placement, force error, cost), writes CSVs and a gnuplot chart of
 // force traces (newton against higher-order, like the seed's Figs 2.5/2.7/2.10).
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -53,27 +54,79 @@ void WriteTraces(const fs::path& file, const StandardSweep& sw, const std::vecto
   }
 }
 
-bool Plot(const fs::path& dir, const std::vector<std::string>& sweeps, int budget) {
+// One row per charted sweep: the whole trace, and a zoom on the first reference snap.
+bool Plot(const fs::path& dir, const std::vector<std::pair<std::string, int>>& sweeps, int budget) {
   const fs::path script = dir / "stability.gp";
   std::ofstream gp(script);
   const int n = static_cast<int>(sweeps.size());
-  gp << "set terminal pngcairo size 1400," << 330 * n << " font 'DejaVu Sans,10'\n"
+  gp << "set terminal pngcairo size 1500," << 300 * n + 60 << " font 'DejaVu Sans,10'\n"
      << "set output '" << (dir / "stability.png").string() << "'\n"
-     << "set datafile separator ','\nset key outside right\nset grid\n"
-     << "set multiplot layout " << n << ",1 title 'Force on the grasp along standard sweeps, budget "
-     << (budget == 0 ? std::string("unlimited") : std::to_string(budget)) << " iterations per update'\n";
-  for (const auto& s : sweeps) {
-    const std::string f = (dir / ("traces_" + s + ".csv")).string();
-    gp << "set title '" << s << "'\nset xlabel 'update'\nset ylabel 'force component'\n"
-       << "plot '" << f << "' using 1:4 with lines lw 1 lc rgb '#1f77b4' title 'newton', "
-       << "'' using 1:5 with lines lw 1 lc rgb '#ff7f0e' title 'newton-ls', "
-       << "'' using 1:6 with lines lw 2 lc rgb '#2ca02c' title 'higher-order', "
-       << "'' using 1:3 with lines lw 1 dt 2 lc rgb '#d62728' title 'reference'\n";
+     << "set termoption noenhanced\nset datafile separator ','\nset key top left\nset grid\n"
+     << "set multiplot layout " << n << ",2 title 'Force on the grasp along standard sweeps, "
+     << (budget == 0 ? std::string("unlimited") : std::to_string(budget))
+     << " iterations per update (reference: newton-ls, cutoff 1e-10, 10x finer steps)'\n";
+  for (const auto& [name, snap] : sweeps) {
+    const std::string f = (dir / ("traces_" + name + ".csv")).string();
+    const std::string curves = "'" + f + "' using 1:4 with lines lw 1 lc rgb '#1f77b4' title 'newton', " +
+                               "'' using 1:5 with lines lw 1 lc rgb '#ff7f0e' title 'newton-ls', " +
+                               "'' using 1:6 with lines lw 2 lc rgb '#2ca02c' title 'higher-order', " +
+                               "'' using 1:3 with lines lw 1 dt 2 lc rgb '#d62728' title 'reference'\n";
+    gp << "set title '" << name << "'\nset xlabel 'update'\nset ylabel 'force component'\nset autoscale x\n"
+       << "plot " << curves;
+    gp << "set title '" << name << ": zoom on the first snap'\n";
+    if (snap > 0) gp << "set xrange [" << std::max(0, snap - 40) << ":" << snap + 60 << "]\n";
+    gp << "plot " << curves << "set autoscale x\n";
   }
   gp << "unset multiplot\n";
   gp.close();
   const std::string cmd = "gnuplot '" + script.string() + "'";
   return std::system(cmd.c_str()) == 0;
+}
+
+// Seed Fig 2.9: equilibria along a sweep through a snap at the haptic cutoff 1e-6 (a),
+// their difference from 1e-10 solutions (b), and the 1e-8 - 1e-10 difference (c).
+bool Figure29(const std::string& scenes_dir, const fs::path& dir, bool plot) {
+  Scene scene = LoadScene(scenes_dir + "/curve2d_snap.yaml");
+  SweepSpec spec;
+  spec.from = Vec(2);
+  spec.to = Vec(2);
+  spec.from << 9.0, 2.6;
+  spec.to << 9.0, 4.0;
+  spec.steps = 700;
+  std::map<double, std::vector<SweepRow>> runs;
+  for (double cutoff : {1e-6, 1e-8, 1e-10}) {
+    Scene sc = scene;
+    sc.solver.cutoff = cutoff;
+    sc.solver.max_iterations = 0;
+    auto tracker = MakeTracker(sc);
+    runs[cutoff] = RunSweep(tracker.get(), SweepControls(sc, spec));
+  }
+  std::ofstream out(dir / "fig29.csv");
+  out << "step,u_y,probe_1e-6,dprobe_1e-6_1e-10,dprobe_1e-8_1e-10,dforce_1e-6_1e-10,dforce_1e-8_1e-10\n";
+  const auto& a = runs[1e-6];
+  const auto& b = runs[1e-8];
+  const auto& c = runs[1e-10];
+  for (size_t i = 0; i < a.size(); ++i)
+    out << i << ',' << a[i].u[1] << ',' << a[i].probe << ',' << std::abs(a[i].probe - c[i].probe) << ','
+        << std::abs(b[i].probe - c[i].probe) << ',' << (a[i].force - c[i].force).norm() << ','
+        << (b[i].force - c[i].force).norm() << '\n';
+  out.close();
+  if (!plot) return true;
+  std::ofstream gp(dir / "fig29.gp");
+  const std::string f = (dir / "fig29.csv").string();
+  gp << "set terminal pngcairo size 1000,900 font 'DejaVu Sans,10'\n"
+     << "set output '" << (dir / "fig29.png").string() << "'\n"
+     << "set datafile separator ','\nset grid\nset key top left\nset xlabel 'grasp Y (X = 9)'\n"
+     << "set multiplot layout 3,1 title 'curve2d\\_snap through its snap at Y = 3.41 (after seed Fig 2.9)'\n"
+     << "set ylabel 'y of node 5'\nplot '" << f << "' every ::1 using 2:3 with lines lw 2 title '(a) cutoff 1e-6'\n"
+     << "set logscale y\nset format y '10^{%L}'\nset ylabel '|difference|'\n"
+     << "plot '" << f << "' every ::1 using 2:($4+1e-17) with lines title '(b) node y: 1e-6 vs 1e-10', "
+     << "'' every ::1 using 2:($6+1e-17) with lines title 'force: 1e-6 vs 1e-10'\n"
+     << "plot '" << f << "' every ::1 using 2:($5+1e-17) with lines title '(c) node y: 1e-8 vs 1e-10', "
+     << "'' every ::1 using 2:($7+1e-17) with lines title 'force: 1e-8 vs 1e-10'\n"
+     << "unset multiplot\n";
+  gp.close();
+  return std::system(("gnuplot '" + (dir / "fig29.gp").string() + "'").c_str()) == 0;
 }
 
 }  // namespace
@@ -116,7 +169,8 @@ int main(int argc, char** argv) {
     }
     fs::create_directories(out_dir);
     std::vector<StabilityRow> table;
-    std::vector<std::string> charted;
+    std::vector<std::pair<std::string, int>> charted;
+    const std::vector<std::string> chart_names = {"zeeman_folds", "cusp_folds", "curve2d_snap", "thread3d_loop"};
     for (const auto& sw : sweeps) {
       std::cerr << "stability: " << sw.name << " (" << sw.controls.size() << " updates): " << sw.description << '\n';
       const Scene scene = LoadScene(sw.scene_file);
@@ -139,10 +193,18 @@ int main(int argc, char** argv) {
       }
       if (chart.size() == 3) {
         WriteTraces(fs::path(out_dir) / ("traces_" + sw.name + ".csv"), sw, ref, chart);
-        charted.push_back(sw.name);
+        int first_snap = 0;
+        for (const auto& r : ref)
+          if (r.snapped && first_snap == 0) first_snap = r.step;
+        if (std::find(chart_names.begin(), chart_names.end(), sw.name) != chart_names.end() || !only.empty())
+          charted.push_back({sw.name, first_snap});
       }
     }
     PrintStabilityTable(table, std::cout);
+    if (only.empty() && !Figure29(scenes_dir, out_dir, !no_plot)) {
+      std::cerr << "stability: gnuplot failed for fig29\n";
+      return 1;
+    }
     std::ofstream csv(fs::path(out_dir) / "stability.csv");
     WriteStabilityCsv(table, csv);
     if (!no_plot && !charted.empty()) {
