@@ -17,8 +17,9 @@ const char* ToString(LinearSolverStatus s) {
 
 std::vector<std::string> LinearSolverNames() { return {"auto", "cholmod", "dense", "banded"}; }
 
-// "auto", measured with snapthread-linear-bench (Release, 2 shared cores, load ~7;
-// median us of Factorize+Solve on random SPD full-band matrices):
+// "auto", measured with snapthread-linear-bench (Release, 2 cores shared with other
+// builds, load ~7, so single runs vary by up to ~30%; median us of Factorize+Solve on
+// random SPD full-band matrices, columns cholmod / dense / banded):
 //
 //   half-bandwidth b = 8 (thread3d: 3 coordinates per node, nodes coupled 2 apart)
 //        n    cholmod    dense   banded
@@ -38,7 +39,7 @@ std::vector<std::string> LinearSolverNames() { return {"auto", "cholmod", "dense
 //        n = 25: 2.1 / 2.3 / 1.7;  n = 295: 25 / 728 / 24;  n = 2995: 263 / - / 247
 //
 // So: a band with 2b <= n is fastest in "banded" at every size (CHOLMOD finds the same
-// fill with AMD but pays for its bookkeeping, ~1.4x); a small matrix that is not
+// fill with AMD but pays for its bookkeeping, 1.05-2x); a small matrix that is not
 // banded is fastest dense (n <= 30, where it also pivots); anything else, or a pattern
 // whose bandwidth is unknown (bandwidth < 0) or not known to be small, goes to CHOLMOD,
 // whose cost follows the fill, not the bandwidth (the ring above).
