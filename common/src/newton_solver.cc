@@ -155,8 +155,8 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s) {
   const LinearSolverStatus st = FactorAt(x, u, s);
   if (st == LinearSolverStatus::kSuccess) {
     s->negative_pivots = factor_->NegativePivots();
-    // Two warm-started steps track the eigenpair; a cold start needs more.
-    s->lambda_min = eig_.Update(*factor_, h_, eig_.initialized() ? 2 : 40);
+    // Two warm-started steps track the eigenpair; a cold start or a new branch needs more.
+    s->lambda_min = eig_.Update(*factor_, h_, eig_.initialized() && !s->snapped ? 2 : 40);
   } else {
     s->negative_pivots = -1;
     s->lambda_min = 0.0;  // singular to working precision
