@@ -44,7 +44,10 @@ trap cleanup EXIT
 
 echo "run_session: session $session on $url, ${duration} s, outputs in $out"
 # Logger first, so the log holds every sequence number from 1.
-lcm-logger -q -c "${session}_.*" --lcm-url="$url" -f "$log" > "$out/logger.txt" 2>&1 &
+# As root, SCHED_FIFO (like the systemd unit): a logger stalled ~30 ms drops messages.
+logger_prio=()
+[ "$(id -u)" -eq 0 ] && command -v chrt >/dev/null && logger_prio=(chrt -f 10)
+"${logger_prio[@]}" lcm-logger -q -c "${session}_.*" --lcm-url="$url" -f "$log" > "$out/logger.txt" 2>&1 &
 logger_pid=$!
 pids+=("$logger_pid")
 sleep 0.3

@@ -24,7 +24,6 @@ namespace snapthread::viewer {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr double kFramePeriodS = 1.0 / 60.0;  // render cap: the machine is shared
 constexpr double kGraspPickPixels = 30.0;     // press this close to the grasp to drag it
 
 std::string g_glfw_error;  // written only by the GLFW error callback on the main thread
@@ -249,6 +248,7 @@ int RunViewer(const ViewerOptions& options) {
     receiver.Start();
     const auto start = Clock::now();
     const bool screenshot = !options.screenshot_path.empty();
+    const double frame_period_s = 1.0 / options.max_fps;
     while (!glfwWindowShouldClose(window)) {
       const auto frame_start = Clock::now();
       glfwPollEvents();
@@ -308,8 +308,8 @@ int RunViewer(const ViewerOptions& options) {
       }
       if (options.duration_s > 0 && elapsed > options.duration_s) break;
       const double spent = Seconds(frame_start);
-      if (spent < kFramePeriodS) {
-        std::this_thread::sleep_for(std::chrono::duration<double>(kFramePeriodS - spent));
+      if (spent < frame_period_s) {
+        std::this_thread::sleep_for(std::chrono::duration<double>(frame_period_s - spent));
       }
     }
     if (!screenshot) {

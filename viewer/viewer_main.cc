@@ -36,6 +36,8 @@ int main(int argc, char** argv) {
                "print live rates of every <SESSION>_* channel once per second (no window)");
   app.add_option("--duration-s", o.duration_s, "exit after this many seconds (0 = never)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--max-fps", o.max_fps, "render at most this many frames per second")
+      ->capture_default_str()->check(CLI::Range(1.0, 1000.0));
   app.add_flag("--grasp-mode", o.grasp_mode,
                "drag the grasp with the mouse: publishes device_state_t on <SESSION>_DEVICE_STATE");
   app.add_option("--scene", o.scene_path, "scene YAML (its device mapping; needed by --grasp-mode)")

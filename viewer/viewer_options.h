@@ -15,6 +15,7 @@ struct ViewerOptions {
   double timeout_s = 10.0;      // screenshot / print-rates: give up after this long (0 = never)
   bool print_rates = false;     // print live channel rates once per second, no window
   double duration_s = 0.0;      // exit after this long (0 = run until closed)
+  double max_fps = 60.0;        // render at most this often (the machine may be shared)
   bool grasp_mode = false;      // mouse drag of the grasp publishes device_state_t
   std::string scene_path;       // needed by grasp mode (device mapping)
 };

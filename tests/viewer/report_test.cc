@@ -200,6 +200,10 @@ TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
   EXPECT_NE(Line(summary, "channel RPT_SOLVER_STATUS ").find("messages 20 "), std::string::npos);
   EXPECT_NE(Line(summary, "channel OTHER_CHANNEL ").find("messages 1 "), std::string::npos);
   EXPECT_NE(summary.find("max_force_n: 2.0000"), std::string::npos) << summary;
+  // Models answer poses 1..200 except the 4 dropped; the late repeat answers an older pose.
+  EXPECT_NE(summary.find("latest_wins: models answer 196 poses of seq 1..200, skipped_poses 4, "
+                         "device_seq_regressions 1"),
+            std::string::npos) << summary;
   EXPECT_NE(summary.find("snaps: 1 "), std::string::npos) << summary;
   EXPECT_NE(summary.find("shapes count 1"), std::string::npos) << summary;
   EXPECT_NE(summary.find("clamps: force 4 "), std::string::npos) << summary;

@@ -98,6 +98,13 @@ void SessionReview::Add(const lcm::LogEvent& e) {
     force_.push_back({t, {m.f0[0], m.f0[1], m.f0[2]}, n, m.status, m.seq});
     if (m.status == force_model_t::STATUS_SNAPPED) snap_times_s_.push_back(t);
     solve_.push_back({t, m.iterations, m.residual, m.solve_us, m.status});
+    if (first_answered_pose_ < 0) first_answered_pose_ = m.device_seq;
+    if (m.device_seq > last_answered_pose_) {
+      answered_poses_++;
+      last_answered_pose_ = m.device_seq;
+    } else {
+      device_seq_regressions_++;
+    }
     // Round trip as the logger saw it: pose k logged -> model answering k logged.
     const auto it = pose_log_time_us_.find(m.device_seq);
     if (it != pose_log_time_us_.end()) {
@@ -262,6 +269,13 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
   s << "\n";
   for (size_t i = 0; i < snap_times_s_.size() && i < 20; ++i) {
     s << "  snap at t_s " << Fmt("%.3f", snap_times_s_[i]) << "\n";
+  }
+
+  if (first_answered_pose_ >= 0) {
+    const int64_t span = last_answered_pose_ - first_answered_pose_ + 1;
+    s << "latest_wins: models answer " << answered_poses_ << " poses of seq "
+      << first_answered_pose_ << ".." << last_answered_pose_ << ", skipped_poses "
+      << span - answered_poses_ << ", device_seq_regressions " << device_seq_regressions_ << "\n";
   }
 
   s << "\nsolver:\n";

@@ -80,6 +80,12 @@ class SessionReview {
   std::vector<RoundTripRow> round_trip_;
   std::map<int64_t, int64_t> pose_log_time_us_;  // device seq -> log time (recent poses)
   int64_t shape_snaps_first_ = -1, shape_snaps_last_ = -1;
+  // Latest wins (DESIGN.md): the server answers the newest pose and skips older queued
+  // ones, so force_model_t.device_seq may jump but must never go back.
+  int64_t first_answered_pose_ = -1;
+  int64_t last_answered_pose_ = -1;
+  int64_t answered_poses_ = 0;        // force models answering a newer pose than the last
+  int64_t device_seq_regressions_ = 0;  // a model answering an older pose than a previous one
 };
 
 }  // namespace snapthread::report
