@@ -2,6 +2,9 @@
 #include <cmath>
 
 #include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include "snapthread/device_state_t.hpp"
 
 #include "grasp_publisher.h"
 #include "orbit_camera.h"
@@ -61,6 +64,42 @@ TEST(GraspMappingTest, ModelToDeviceInvertsTheSceneMapping) {
   const Eigen::Vector3d dev = ModelToDeviceMetres(m, model);
   EXPECT_NEAR(dev.x(), 2.0 / 50.0, 1e-15);
   EXPECT_LT((DeviceMetresToModel(m, dev) - model).norm(), 1e-12);
+}
+
+// Receives device_state_t on one channel (memq: same process, synchronous handle()).
+struct PoseSink {
+  std::vector<device_state_t> poses;
+  void On(const lcm::ReceiveBuffer*, const std::string&, const device_state_t* msg) {
+    poses.push_back(*msg);
+  }
+};
+
+TEST(GraspMappingTest, PublisherSendsDeviceMetresOnTheSessionChannel) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  PoseSink sink;
+  lcm.subscribe("GRASPTEST_DEVICE_STATE", &PoseSink::On, &sink);
+  DeviceMapping m;
+  m.model_units_per_metre = 100.0;
+  m.model_origin = {0.5, 0.0, 0.0};
+  GraspPublisher publisher(&lcm, "GRASPTEST", m);
+  ASSERT_TRUE(publisher.Publish({2.5, -1.0, 0.0}, true));
+  ASSERT_TRUE(publisher.Publish({3.0, -1.5, 0.0}, false));
+  // A non-finite drag target is refused, never sent.
+  EXPECT_FALSE(publisher.Publish({std::nan(""), 0.0, 0.0}, true));
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  ASSERT_EQ(sink.poses.size(), 2u);
+  const device_state_t& a = sink.poses[0];
+  EXPECT_NEAR(a.position[0], 0.02, 1e-15);  // (2.5 - 0.5) / 100 m
+  EXPECT_NEAR(a.position[1], -0.01, 1e-15);
+  EXPECT_NEAR(a.position[2], 0.0, 1e-15);
+  EXPECT_EQ(a.buttons, 1);
+  EXPECT_EQ(a.orientation[0], 1.0);
+  EXPECT_EQ(a.device_id, "viewer-mouse");
+  EXPECT_EQ(sink.poses[1].seq, a.seq + 1);
+  EXPECT_EQ(sink.poses[1].buttons, 0);
+  EXPECT_GE(sink.poses[1].utime, a.utime);
 }
 
 TEST(ShapeCheckTest, RefusesEmptyAndGarbageBuffers) {
