@@ -334,11 +334,13 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       continue;
     }
   }
+  bool gradient_current = s.termination != Termination::kNonFinite;
   if (!xr.allFinite()) {
     xr = last_good_;
     s.termination = Termination::kNonFinite;
+    gradient_current = false;
   }
-  Finish(xr, u, &s);
+  Finish(xr, u, &s, gradient_current);
   LeaveSaddle(u, &xr, &s);
   Classify(&s);
   return s;

@@ -147,8 +147,8 @@ bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s) 
   return false;
 }
 
-void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s) {
-  s->residual = EvalGradient(x, u, &g_, s);
+void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradient_current) {
+  s->residual = gradient_current ? g_.norm() : EvalGradient(x, u, &g_, s);
   s->energy = model_.Energy(x, u);
   // The factorisation at the returned state serves implicit differentiation (K) and
   // the eigenvalue estimate.
@@ -257,11 +257,13 @@ SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
     }
     r = EvalGradient(x_ref, u, &g_, &s);
   }
+  bool gradient_current = s.termination != Termination::kNonFinite;
   if (!x_ref.allFinite()) {
     x_ref = last_good;
     s.termination = Termination::kNonFinite;
+    gradient_current = false;
   }
-  Finish(x_ref, u, &s);
+  Finish(x_ref, u, &s, gradient_current);
   // Plain Newton (2.18) is kept as the seed's baseline: it may sit on a maximum or a
   // saddle (Fig 2.5). The globalised variant may not.
   if (line_search) LeaveSaddle(u, &x_ref, &s);

@@ -35,7 +35,8 @@ class SolverBase : public EquilibriumSolver {
   LinearSolverStatus FactorShifted(double shift, SolverSummary* s);
   // Final bookkeeping at the returned state: factorisation for implicit
   // differentiation, lowest eigenpair, inertia, residual, energy, timing.
-  void Finish(const Vec& x, const Vec& u, SolverSummary* s);
+  // gradient_current: g_ already holds E_x(x) (saves one evaluation per update).
+  void Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradient_current = false);
   // Newton-ls step: inertia-corrected Newton direction + Armijo backtracking from x
   // with gradient g. Returns false if no decrease could be found.
   bool GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s);
