@@ -8,7 +8,7 @@ namespace snapthread::report {
 namespace {
 
 constexpr char kPreamble[] =
-    "set terminal pngcairo size 1100,700 font ',10'\n"
+    "set terminal pngcairo size 1100,700 font ',10' noenhanced\n"
     "set datafile separator ','\n"
     "set grid\n"
     "set key top right\n"
@@ -49,9 +49,9 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
     std::string body = "set title 'Force on the grasp (" + ch + "_FORCE_MODEL f0); snaps marked'\n"
                        "set xlabel 'time [s]'\nset ylabel 'force [N]'\n"
                        "plot " + Csv(dir, "force.csv") + " skip 1 using 1:5 with lines lw 2 title '|F|', "
-                       "'' skip 1 using 1:2 with lines title 'F_x', "
-                       "'' skip 1 using 1:3 with lines title 'F_y', "
-                       "'' skip 1 using 1:4 with lines title 'F_z'";
+                       "'' skip 1 using 1:2 with lines title 'Fx', "
+                       "'' skip 1 using 1:3 with lines title 'Fy', "
+                       "'' skip 1 using 1:4 with lines title 'Fz'";
     // An empty snaps.csv would make gnuplot fail, so the series is added only when present.
     std::ifstream snaps(dir + "/snaps.csv");
     std::string header, first;
