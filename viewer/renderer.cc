@@ -230,8 +230,11 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
     }
     const double extent = std::max((hi - lo).norm(), 1e-3);
     const double radius = 0.012 * extent;
-    scene_.AppendTube(CatmullRomCurve(nodes, kSplineSamplesPerSegment), radius, kTubeSides,
-                      StatusColor(shape.status));
+    // Threads (curve2d, thread3d) are smooth curves through their nodes; the Zeeman and cusp
+    // "shapes" are linkages (rods between joints), drawn straight.
+    const bool smooth = shape.model == "curve2d" || shape.model == "thread3d";
+    scene_.AppendTube(CatmullRomCurve(nodes, smooth ? kSplineSamplesPerSegment : 1), radius,
+                      kTubeSides, StatusColor(shape.status));
     scene_.AppendSphere(nodes.front(), 2.2 * radius, {0.6f, 0.6f, 0.62f});  // clamp
     const Eigen::Vector3d grasp(shape.grasp[0], shape.grasp[1], shape.grasp[2]);
     scene_.AppendSphere(grasp, 2.0 * radius,
