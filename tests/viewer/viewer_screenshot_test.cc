@@ -267,6 +267,52 @@ TEST(ViewerScreenshotTest, MalformedShapePacketsAreDroppedAndCounted) {
   ExpectArcDrawn(img);  // the valid shapes still render correctly
 }
 
+// Review path of docs/lab-setup.md: a logged session played back with lcm-logplayer into a
+// viewer shows the logged thread.
+TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
+  const std::string session = UniqueSession("VIEWREPLAY");
+  const std::string dir = TempDir("viewer-replay");
+  const std::string log_path = dir + "/session.lcmlog";
+  {
+    lcm::LogFile log(log_path, "w");
+    ASSERT_TRUE(log.good());
+    const std::string channel = transport::Channels(session).shape;
+    for (int k = 0; k < 400; ++k) {  // 8 s of shapes at 50 Hz
+      thread_shape_t s = ArcShape(k);
+      std::vector<uint8_t> buf(s.getEncodedSize());
+      s.encode(buf.data(), 0, int(buf.size()));
+      lcm::LogEvent e;
+      e.timestamp = 1700000000000000 + k * 20000;
+      e.channel = channel;
+      e.datalen = int32_t(buf.size());
+      e.data = buf.data();
+      ASSERT_EQ(log.writeEvent(&e), 0);
+    }
+  }
+  // The viewer first (it must be listening), then the player.
+  std::random_device rd;
+  const std::vector<std::string> viewer_argv = {
+      "xvfb-run", "-a", "-n", std::to_string(100 + rd() % 800), "-s", "-screen 0 1280x720x24",
+      BinDir() + "/snapthread-viewer", "--session", session, "--lcm-url", kLoopbackUrl,
+      "--screenshot", dir + "/shot.png", "--after-shapes", "10", "--timeout-s", "30",
+      "--width", std::to_string(kWidth), "--height", std::to_string(kHeight)};
+  const int viewer = StartProcess(viewer_argv, dir + "/out.txt", dir + "/err.txt");
+  ASSERT_GT(viewer, 0);
+  std::this_thread::sleep_for(std::chrono::seconds(2));  // Xvfb + GL start-up
+  const int player = StartProcess({"lcm-logplayer", std::string("--lcm-url=") + kLoopbackUrl, log_path},
+                                  dir + "/player_out.txt", dir + "/player_err.txt");
+  ASSERT_GT(player, 0) << "cannot start lcm-logplayer (liblcm-bin)";
+  const ProcessResult v = WaitProcess(viewer, 60.0, dir + "/out.txt", dir + "/err.txt");
+  // The player would go on to the end of the log; the viewer has what it needs.
+  WaitProcess(player, 0.2, dir + "/player_out.txt", dir + "/player_err.txt");
+  ASSERT_TRUE(v.exited) << v.err;
+  ASSERT_EQ(v.exit_code, 0) << v.out << v.err;
+  Image img;
+  std::string error;
+  ASSERT_TRUE(ReadPng(dir + "/shot.png", &img, &error)) << error;
+  ExpectArcDrawn(img);
+}
+
 TEST(ViewerScreenshotTest, TimesOutWithAClearMessageWhenNothingArrives) {
   const std::string session = UniqueSession("VIEWNONE");
   const std::string dir = TempDir("viewer-none");
