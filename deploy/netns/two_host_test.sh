@@ -26,7 +26,7 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 command -v ip >/dev/null || { echo "SKIPPED: ip (iproute2) not installed"; exit $skip; }
 
-tag=$(( $$ % 100000 ))
+tag=$$
 subnet="10.213.$(( $$ % 250 + 1 ))"
 ns_br="st_br_$tag"
 ns_srv="st_srv_$tag"
@@ -58,6 +58,16 @@ stop_logger() {
   wait "$1" 2>/dev/null
 }
 fail() { echo "FAIL: $*"; echo "--- outputs in $work"; for f in "$work"/*.txt; do echo "== $f"; tail -n 15 "$f"; done; exit 1; }
+
+# Namespaces left by an earlier run of this script that was killed before its trap ran
+# (their names end in the pid of that run, which is gone).
+for ns in $(ip netns list 2>/dev/null | awk '{print $1}' | grep -E '^st_(br|srv|dev|obs)_[0-9]+$'); do
+  owner=${ns##*_}
+  if ! kill -0 "$owner" 2>/dev/null; then
+    for p in $(ip netns pids "$ns" 2>/dev/null); do kill -9 "$p" 2>/dev/null || true; done
+    ip netns del "$ns" 2>/dev/null && echo "removed stale namespace $ns"
+  fi
+done
 
 if ! ip netns add "$ns_br" 2>"$work/netns_err.txt"; then
   echo "SKIPPED: ip netns add not permitted here: $(cat "$work/netns_err.txt")"
