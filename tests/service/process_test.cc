@@ -234,15 +234,19 @@ class ProcessTest : public ::testing::Test {
     std::ostringstream dur, spd;
     dur << duration_s;
     spd << speed;
-    auto child = std::make_unique<Child>(
-        std::vector<std::string>{bin_ + "/snapthread-device", "--backend", "sim-path", "--scene",
-                                 scene_path_, "--path-csv", path_csv, "--speed-m-per-s", spd.str(),
-                                 "--session", session_, "--lcm-url", kUrl, "--duration", dur.str(),
-                                 "--rate-hz", "1000", "--publish-divisor", "1",
-                                 "--model-timeout-ms", std::to_string(kTimeoutMs), "--fade-ms",
-                                 std::to_string(kFadeMs), "--no-rt", "--trace",
-                                 dir_ + "/trace.csv", "--summary", dir_ + "/device.json"},
-        dir_ + "/device.log");
+    std::vector<std::string> argv{bin_ + "/snapthread-device", "--backend", "sim-path", "--scene",
+                                  scene_path_, "--speed-m-per-s", spd.str(),
+                                  "--session", session_, "--lcm-url", kUrl, "--duration", dur.str(),
+                                  "--rate-hz", "1000", "--publish-divisor", "1",
+                                  "--model-timeout-ms", std::to_string(kTimeoutMs), "--fade-ms",
+                                  std::to_string(kFadeMs), "--no-rt", "--trace",
+                                  dir_ + "/trace.csv", "--summary", dir_ + "/device.json"};
+    // Empty: the scene's own grasp path.
+    if (!path_csv.empty()) {
+      argv.push_back("--path-csv");
+      argv.push_back(path_csv);
+    }
+    auto child = std::make_unique<Child>(argv, dir_ + "/device.log");
     EXPECT_TRUE(child->started());
     return child;
   }
@@ -431,6 +435,30 @@ TEST_F(ProcessTest, ServerKilledForceFadesThenRecoversWithANewServer) {
               "%d fresh ticks with force after recovery\n",
               outage_s, 1e3 * (rows[first_zero].t_s - t_last_model), kTimeoutMs, kFadeMs,
               fresh_with_force);
+}
+
+// thread3d with a constrained grip over real processes, driven along the scene's own path
+// by sim-path: every model valid, finite forces, no chatter. (The grip mapping
+// d = R(q) d_start itself is checked in server_messages_test.cc.)
+TEST_F(ProcessTest, GripSceneFollowsWithoutChatter) {
+  scene_path_ = source_ + "/scenes/thread3d_loop.yaml";
+  scene_ = LoadScene(scene_path_);
+  auto server = StartServer("a");
+  auto device = StartDevice(5.0, "", 0.02);
+  int code = -1;
+  ASSERT_TRUE(device->Wait(120s, &code)) << "device did not finish";
+  EXPECT_EQ(code, 0) << device->Log();
+  server->Signal(SIGTERM);
+  ASSERT_TRUE(server->Wait(60s, &code));
+  EXPECT_EQ(code, 0) << server->Log();
+  auto dev = ReadJsonNumbers(dir_ + "/device.json");
+  auto srv = ReadJsonNumbers(dir_ + "/server_a.json");
+  ASSERT_GT(dev.count("ticks"), 0u) << device->Log();
+  EXPECT_GT(dev["models_received"], 0.5 * dev["ticks"]);
+  EXPECT_EQ(dev["nonfinite_outputs"], 0);
+  EXPECT_EQ(srv["invalid_models"], 0);
+  EXPECT_LE(srv["snaps"], 10) << "the thread chatters";
+  EXPECT_GT(dev["max_force_n"], 0.05);
 }
 
 // The server's command line: exit codes and messages that name the argument.
