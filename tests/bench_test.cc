@@ -1,0 +1,297 @@
+// snapthread-bench's logic on tiny inputs (issue 6): the power-law fit, the Pareto
+// front, chain resizing, the hand-speed paths, JSON reading, and the advisor's choice.
+// No timed assertions: rates are only checked to be consistent with the choice made.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "bench.h"
+#include "snapthread/models.h"
+#include "test_util.h"
+
+namespace snapthread {
+namespace {
+
+TEST(BenchStats, SummarizeGivesMedianAndSpread) {
+  const Spread odd = Summarize({5.0, 1.0, 3.0});
+  EXPECT_EQ(odd.count, 3);
+  EXPECT_DOUBLE_EQ(odd.median, 3.0);
+  EXPECT_DOUBLE_EQ(odd.min, 1.0);
+  EXPECT_DOUBLE_EQ(odd.max, 5.0);
+  EXPECT_DOUBLE_EQ(Summarize({4.0, 1.0, 2.0, 10.0}).median, 3.0);
+  EXPECT_EQ(Summarize({}).count, 0);
+}
+
+TEST(BenchStats, PowerLawFitRecoversAKnownLaw) {
+  for (double slope : {-1.9, -1.0, 0.5}) {
+    std::vector<double> x, y;
+    for (double n : {5.0, 10.0, 20.0, 50.0, 100.0, 1000.0}) {
+      x.push_back(n);
+      y.push_back(3e5 * std::pow(n, slope));
+    }
+    const PowerLawFit f = FitPowerLaw(x, y);
+    EXPECT_EQ(f.points, 6);
+    EXPECT_NEAR(f.slope, slope, 1e-12);
+    EXPECT_NEAR(f.intercept, std::log10(3e5), 1e-10);
+    EXPECT_NEAR(f.r2, 1.0, 1e-12);
+    EXPECT_NEAR(f.At(40.0), 3e5 * std::pow(40.0, slope), 1e-8 * 3e5 * std::pow(40.0, slope));
+  }
+}
+
+TEST(BenchStats, PowerLawFitIgnoresUnusablePointsAndNeedsTwo) {
+  // A zero rate (a skipped point) must not poison the fit.
+  const PowerLawFit f = FitPowerLaw({10, 100, 0, 1000, 50}, {1e4, 1e3, 5.0, 1e2, 0.0});
+  EXPECT_EQ(f.points, 3);
+  EXPECT_NEAR(f.slope, -1.0, 1e-12);
+  EXPECT_LT(FitPowerLaw({10}, {1}).points, 2);
+  EXPECT_LT(FitPowerLaw({10, 10}, {1, 2}).points, 2);  // no spread in x: no slope
+  // Noisy data: the slope is the least-squares one, between the extremes.
+  const PowerLawFit g = FitPowerLaw({1, 10, 100}, {1, 0.2, 0.01});
+  EXPECT_LT(g.slope, -0.7);
+  EXPECT_GT(g.slope, -1.3);
+  EXPECT_LT(g.r2, 1.0);
+}
+
+TEST(BenchPareto, FrontKeepsOnlyNonDominatedPointsSortedByRate) {
+  // rate, error
+  const std::vector<ParetoPoint> p = {
+      {100, 1e-3},   // 0 front (most accurate)
+      {1000, 1e-2},  // 1 front
+      {500, 1e-2},   // 2 dominated by 1 (slower, same error)
+      {2000, 1e-1},  // 3 front (fastest)
+      {800, 5e-3},   // 4 front
+      {90, 2e-3},    // 5 dominated by 0
+      {800, 5e-3},   // 6 exact duplicate of 4: only the first is kept
+      {1500, 2e-1},  // 7 dominated by 3
+  };
+  EXPECT_EQ(ParetoFront(p), (std::vector<int>{0, 4, 1, 3}));
+  EXPECT_TRUE(ParetoFront({}).empty());
+  EXPECT_EQ(ParetoFront({{1, 1}}), std::vector<int>{0});
+}
+
+TEST(BenchPareto, MarkParetoFrontsIsPerSweep) {
+  std::vector<AccuracyRow> rows(4);
+  rows[0].sweep = rows[1].sweep = "a";
+  rows[2].sweep = rows[3].sweep = "b";
+  rows[0].rate_hz.median = 10;
+  rows[0].stability.force_error_rms = 1.0;
+  rows[1].rate_hz.median = 20;
+  rows[1].stability.force_error_rms = 0.5;  // dominates row 0
+  // In sweep b, a slow point with a large error would be dominated by sweep a's rows,
+  // but fronts are per sweep.
+  rows[2].rate_hz.median = 1;
+  rows[2].stability.force_error_rms = 5.0;
+  rows[3].rate_hz.median = 0.5;
+  rows[3].stability.force_error_rms = 1.0;
+  MarkParetoFronts(&rows);
+  EXPECT_FALSE(rows[0].pareto);
+  EXPECT_TRUE(rows[1].pareto);
+  EXPECT_TRUE(rows[2].pareto);
+  EXPECT_TRUE(rows[3].pareto);
+}
+
+TEST(BenchChains, ResizeKeepsLengthAndContinuumStiffness) {
+  const Scene s = testing::SceneFile("curve2d_snap.yaml");
+  const double total = s.params.n * s.params.segment_length;
+  const double force_scale = MakeModel(s.params)->ForceScale();
+  for (int n : {5, 20, 37}) {
+    const Scene r = ResizeChain(s, n);
+    EXPECT_EQ(r.params.n, n);
+    EXPECT_NEAR(r.params.n * r.params.segment_length, total, 1e-12);
+    EXPECT_NEAR(r.params.bending * r.params.segment_length, s.params.bending * s.params.segment_length, 1e-12);
+    EXPECT_NEAR(r.params.stretching * r.params.segment_length, s.params.stretching * s.params.segment_length, 1e-9);
+    // Forces stay comparable across n.
+    EXPECT_NEAR(MakeModel(r.params)->ForceScale(), force_scale, 1e-12 * force_scale);
+  }
+  const Scene z = testing::SceneFile("zeeman.yaml");
+  EXPECT_EQ(ResizeChain(z, 40).params.n, z.params.n);
+  EXPECT_FALSE(IsChain(z));
+  EXPECT_TRUE(IsChain(s));
+}
+
+TEST(BenchPaths, HandSpeedPathMatchesTheStandardSweeps) {
+  const Scene curve = testing::SceneFile("curve2d_snap.yaml");
+  const auto p = HandSpeedPath(curve);
+  ASSERT_EQ(p.size(), 8001u);  // two legs of 8 units at 0.002 per update
+  for (size_t i = 1; i < p.size(); ++i) EXPECT_LE((p[i] - p[i - 1]).norm(), 0.002 + 1e-12);
+  const Scene loop = testing::SceneFile("thread3d_loop.yaml");
+  const auto q = HandSpeedPath(loop);
+  EXPECT_EQ(q.size(), (loop.path.size() - 1) * 60 + 1);  // 30 degree legs at 0.5 degrees
+}
+
+TEST(BenchPaths, HandSpeedControlMovesSlowlyAndStaysNearTheStart) {
+  const Scene base = testing::SceneFile("thread3d_loop.yaml");
+  const Scene s = HandSpeedScene(base, 40, Method::kHigherOrder, "banded", 1e-6);
+  EXPECT_FALSE(s.params.grip_direction);
+  ASSERT_EQ(s.grasp_start.size(), 3);
+  const double total = 40 * base.params.segment_length;
+  EXPECT_NEAR(s.grasp_start[0], 0.9 * total, 1e-12);
+  Vec u, prev;
+  HandSpeedControl(s, 0, &prev);
+  EXPECT_NEAR((prev - s.grasp_start).norm(), 0.0, 1e-12);
+  double lo = prev[1], hi = prev[1];
+  for (long i = 1; i < 20000; ++i) {
+    HandSpeedControl(s, i, &u);
+    EXPECT_LE((u - prev).norm(), 0.002 * base.params.segment_length + 1e-9);
+    lo = std::min(lo, u[1]);
+    hi = std::max(hi, u[1]);
+    prev = u;
+  }
+  EXPECT_NEAR(hi - s.grasp_start[1], 0.05 * total, 0.003);
+  EXPECT_NEAR(s.grasp_start[1] - lo, 0.05 * total, 0.003);
+}
+
+TEST(BenchScaling, HandSpeedUpdatesConvergeWithoutSnapping) {
+  const Scene base = testing::SceneFile("thread3d_loop.yaml");
+  ScalingOptions o;
+  o.repetitions = 2;
+  o.min_sample_s = 0.0;
+  o.min_updates = 100;
+  for (Method m : {Method::kNewton, Method::kHigherOrder}) {
+    const ScalingRow r = TimeHandSpeed(HandSpeedScene(base, 8, m, "auto", 1e-6), o);
+    EXPECT_EQ(r.n, 8);
+    EXPECT_EQ(r.updates, 100);
+    EXPECT_EQ(r.rate_hz.count, 2);
+    EXPECT_GT(r.rate_hz.min, 0.0);
+    EXPECT_EQ(r.snaps, 0);
+    EXPECT_LT(r.max_residual, 1e-6);
+    EXPECT_GE(r.iterations_per_update, 1.0);
+  }
+}
+
+TEST(BenchService, JsonNumberReadsFlatFields) {
+  const std::string j = "{\n  \"backend\": \"virtual-hand\",\n  \"round_trip_us_p50\": 412.5,\n"
+                        "  \"round_trip_us_p99\": 1.2e3,\n  \"realtime\": false\n}\n";
+  double v = 0;
+  ASSERT_TRUE(JsonNumber(j, "round_trip_us_p50", &v));
+  EXPECT_DOUBLE_EQ(v, 412.5);
+  ASSERT_TRUE(JsonNumber(j, "round_trip_us_p99", &v));
+  EXPECT_DOUBLE_EQ(v, 1200.0);
+  EXPECT_FALSE(JsonNumber(j, "lateness_us_p50", &v));
+  EXPECT_FALSE(JsonNumber(j, "backend", &v));
+}
+
+TEST(BenchService, MissingBinariesAreReportedNotThrown) {
+  ServiceOptions o;
+  o.bin_dir = "/nonexistent";
+  o.scenes_dir = testing::SourceDir() + "/scenes";
+  o.work_dir = ::testing::TempDir();
+  const ServiceRun r = RunServiceOnce(o, "curve2d_snap", 0);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("missing"), std::string::npos) << r.error;
+}
+
+AdviceCandidate Cand(int n, Method m, double rate, double err) {
+  AdviceCandidate c;
+  c.n = n;
+  c.method = m;
+  c.rate_hz = rate;
+  c.force_error = err;
+  return c;
+}
+
+TEST(BenchAdvisor, SelectCheapestPicksTheFastestMeetingBothTargets) {
+  const std::vector<AdviceCandidate> c = {
+      Cand(10, Method::kNewton, 9e4, 0.2),         // fastest, too inaccurate
+      Cand(10, Method::kNewtonLineSearch, 5e4, 0.01),
+      Cand(10, Method::kHigherOrder, 7e4, 0.04),   // the answer
+      Cand(10, Method::kHigherOrder, 7e4, 0.06),   // as fast, misses the error target
+      Cand(10, Method::kNewtonLineSearch, 900, 0.001),  // too slow
+  };
+  EXPECT_EQ(SelectCheapest(c, 0.05, 1000), 2);
+  EXPECT_EQ(SelectCheapest(c, 0.5, 1000), 0);
+  EXPECT_EQ(SelectCheapest(c, 0.005, 1000), -1);  // only the slow one is that accurate
+  EXPECT_EQ(SelectCheapest(c, 0.005, 800), 4);
+  EXPECT_EQ(SelectCheapest(c, 0.05, 1e6), -1);
+  // A tie in rate goes to the more accurate one.
+  EXPECT_EQ(SelectCheapest({Cand(5, Method::kNewton, 1e3, 0.03), Cand(5, Method::kNewton, 1e3, 0.02)}, 0.05, 10), 1);
+}
+
+// A small strip: 6 segments (resized by the advisor), compressed and lifted a little (no snap), 120 updates.
+Scene SmallStrip() {
+  return ParseScene(R"(
+name: small_strip
+model: curve2d
+params: {n: 6, segment_length: 1.0, bending: 1.0, stretching: 100.0}
+grasp:
+  start: [5.4, 0.2]
+  path: [[5.4, 0.2], [5.4, 0.44]]
+solver: {method: higher-order, cutoff: 1.0e-6, max_iterations: 10}
+)",
+                    "<small_strip>");
+}
+
+AdvisorOptions SmallOptions() {
+  AdvisorOptions o;
+  // Below n = 8 this strip's coarse models buckle into visibly different shapes (model
+  // errors 0.09 / 0.32 / 0.33 for n = 3 / 4 / 6): the ladder starts where the error falls.
+  o.n_ladder = {8, 12, 16, 24};
+  o.reference_n = 48;
+  o.methods = {Method::kNewton, Method::kHigherOrder};
+  o.cutoffs = {1e-4, 1e-8};
+  o.budgets = {1, 0};
+  o.repetitions = 1;
+  o.substeps = 2;
+  return o;
+}
+
+TEST(BenchAdvisor, PicksTheSmallestModelAndCheapestConfigurationOrReportsNone) {
+  const Scene scene = SmallStrip();
+  EXPECT_THROW(Advise(scene, SmallOptions(), nullptr), std::invalid_argument);  // no targets
+
+  // Impossible accuracy: the whole ladder is climbed, nothing is timed, none is found.
+  AdvisorOptions o = SmallOptions();
+  o.target_force_error = 1e-14;
+  o.target_rate_hz = 1.0;
+  const Advice none = Advise(scene, o, nullptr);
+  EXPECT_FALSE(none.found);
+  EXPECT_FALSE(none.message.empty());
+  ASSERT_EQ(none.model_errors.size(), 4u);
+  EXPECT_TRUE(none.candidates.empty());
+  EXPECT_EQ(none.reference_n, 48);
+  // Finer chains approach the reference.
+  EXPECT_LT(none.model_errors[3].force_error, 0.5 * none.model_errors[0].force_error);
+  const double e12 = none.model_errors[1].force_error, e16 = none.model_errors[2].force_error;
+  ASSERT_LT(e16, e12);
+
+  // A target between the n=12 and n=16 model errors (with room for the solver's own
+  // error): n = 16 is the smallest model that can meet it.
+  o.target_force_error = e16 + 0.5 * (e12 - e16);
+  o.target_rate_hz = 1.0;  // any configuration is fast enough
+  const Advice a = Advise(scene, o, nullptr);
+  ASSERT_TRUE(a.found) << a.message;
+  EXPECT_EQ(a.choice.n, 16);
+  EXPECT_LE(a.choice.force_error, o.target_force_error);
+  EXPECT_GE(a.choice.rate_hz, o.target_rate_hz);
+  ASSERT_EQ(a.model_errors.size(), 3u);  // 8, 12, 16
+  EXPECT_GT(a.model_errors[0].force_error, o.target_force_error);
+  EXPECT_GT(a.model_errors[1].force_error, o.target_force_error);
+  // The choice is the fastest configuration in the evidence meeting both targets.
+  ASSERT_EQ(a.candidates.size(), 2u * 2u * 2u);
+  for (const auto& c : a.candidates) {
+    EXPECT_EQ(c.n, 16);
+    if (c.MeetsError(o.target_force_error) && c.MeetsRate(o.target_rate_hz)) EXPECT_LE(c.rate_hz, a.choice.rate_hz);
+  }
+
+  // The same accuracy at an unreachable rate: reported, with the evidence.
+  o.target_rate_hz = 1e12;
+  const Advice slow = Advise(scene, o, nullptr);
+  EXPECT_FALSE(slow.found);
+  EXPECT_EQ(slow.candidates.size(), 8u);
+  EXPECT_NE(slow.message.find("updates/s"), std::string::npos) << slow.message;
+}
+
+TEST(BenchAdvisor, UsesTheTargetsTheSceneStates) {
+  Scene scene = SmallStrip();
+  scene.target_force_error = 10.0;  // anything goes
+  scene.target_rate_hz = 1.0;
+  AdvisorOptions o = SmallOptions();
+  const Advice a = Advise(scene, o, nullptr);
+  ASSERT_TRUE(a.found) << a.message;
+  EXPECT_EQ(a.choice.n, 8);  // the coarsest model meets so loose a target
+  EXPECT_DOUBLE_EQ(a.target_force_error, 10.0);
+  EXPECT_DOUBLE_EQ(a.target_rate_hz, 1.0);
+}
+
+}  // namespace
+}  // namespace snapthread

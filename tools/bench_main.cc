@@ -1,0 +1,277 @@
+// snapthread-bench: speed against accuracy, scaling with n, service latency and the
+// "model no more than a scene needs" advisor. See tools/bench.h and docs/benchmarks.md.
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "bench.h"
+
+namespace fs = std::filesystem;
+using namespace snapthread;
+
+namespace {
+
+std::vector<std::string> Split(const std::string& s) {
+  std::vector<std::string> v;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) v.push_back(item);
+  return v;
+}
+
+std::vector<int> ParseBudgets(const std::string& s) {
+  std::vector<int> v;
+  for (const auto& item : Split(s)) {
+    if (item == "inf") {
+      v.push_back(0);
+      continue;
+    }
+    size_t used = 0;
+    int k = -1;
+    try {
+      k = std::stoi(item, &used);
+    } catch (const std::exception&) {
+    }
+    if (k < 0 || used != item.size())
+      throw std::invalid_argument("--budgets: '" + item + "' is not an iteration budget (integer >= 1, or inf)");
+    v.push_back(k);
+  }
+  return v;
+}
+
+std::vector<int> ParseCounts(const std::string& s, const char* what) {
+  std::vector<int> v;
+  for (const auto& item : Split(s)) {
+    size_t used = 0;
+    int k = 0;
+    try {
+      k = std::stoi(item, &used);
+    } catch (const std::exception&) {
+    }
+    if (k < 2 || used != item.size())
+      throw std::invalid_argument(std::string(what) + ": '" + item + "' is not a segment count (integer >= 2)");
+    v.push_back(k);
+  }
+  return v;
+}
+
+std::vector<double> ParseCutoffs(const std::string& s) {
+  std::vector<double> v;
+  for (const auto& item : Split(s)) {
+    size_t used = 0;
+    double c = 0;
+    try {
+      c = std::stod(item, &used);
+    } catch (const std::exception&) {
+    }
+    if (!(c > 0) || used != item.size()) throw std::invalid_argument("--cutoffs: '" + item + "' is not a positive number");
+    v.push_back(c);
+  }
+  return v;
+}
+
+std::vector<Method> ParseMethods(const std::string& s) {
+  std::vector<Method> v;
+  for (const auto& item : Split(s)) {
+    Method m;
+    if (!ParseMethod(item, &m)) throw std::invalid_argument("--methods: unknown method '" + item + "'");
+    v.push_back(m);
+  }
+  return v;
+}
+
+std::string ExeDir() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(".") : p.parent_path().string();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"snapthread-bench: speed against accuracy (Pareto), scaling with n, service latency; "
+               "--advise SCENE picks the smallest model and cheapest solver meeting the scene's targets"};
+  std::string scenes_dir = SNAPTHREAD_SCENES_DIR, out_dir = "out/bench", only = "accuracy,scaling,service",
+              bin_dir = ExeDir(), advise, methods_text, cutoffs_text, budgets_text, ns_text, backends_text,
+              sweeps_text, ladder_text, service_scenes;
+  std::vector<std::string> sets;
+  bool quick = false, no_plot = false;
+  int repetitions = 0, reference_n = 0;
+  double service_duration = 0.0, target_force_error = 0.0, target_rate_hz = 0.0;
+  app.add_flag("--quick", quick, "small grids, one repetition, short service run (for development)");
+  app.add_option("--only", only, "benchmarks to run: accuracy,scaling,service (comma-separated)");
+  app.add_option("--out", out_dir, "output folder (CSV, gnuplot scripts, PNG charts, summary.txt)");
+  app.add_option("--scenes", scenes_dir, "folder with the scene files");
+  app.add_option("--bin-dir", bin_dir, "folder with snapthread-server and snapthread-device (service)");
+  app.add_option("--repetitions", repetitions, "repetitions per measurement (default 3, quick 1)")
+      ->check(CLI::Range(1, 100));
+  app.add_option("--methods", methods_text, "methods (default newton,newton-ls,higher-order)");
+  app.add_option("--cutoffs", cutoffs_text, "accuracy/advise: cutoffs (default 1e-4,1e-6,1e-8,1e-10)");
+  app.add_option("--budgets", budgets_text, "accuracy/advise: iteration budgets, inf = unlimited (default 1,2,3,5,10,inf)");
+  app.add_option("--sweeps", sweeps_text, "accuracy: standard sweeps (default zeeman_folds,cusp_folds,curve2d_snap,thread3d_loop)");
+  app.add_option("--ns", ns_text, "scaling: segment counts (default 5,10,20,50,100,200,500,1000,2000)");
+  app.add_option("--backends", backends_text, "scaling: linear solvers (default auto,banded,cholmod,dense)");
+  app.add_option("--service-scenes", service_scenes, "service: scene names (default curve2d_snap,thread3d_loop)");
+  app.add_option("--service-duration", service_duration, "service: seconds per run (default 10, quick 3)")
+      ->check(CLI::Range(1.0, 600.0));
+  app.add_flag("--no-plot", no_plot, "skip the gnuplot charts");
+  app.add_option("--advise", advise, "scene file: advise the smallest n and cheapest method/cutoff/budget instead");
+  app.add_option("--set", sets, "advise: scene override key=value (e.g. targets.rate_hz=20000), repeatable");
+  app.add_option("--target-force-error", target_force_error, "advise: force error target (overrides the scene's)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--target-rate-hz", target_rate_hz, "advise: rate target in updates/s (overrides the scene's)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--ladder", ladder_text, "advise: segment counts to try (default 5,8,10,15,20,30,50,80,100)");
+  app.add_option("--reference-n", reference_n, "advise: segments of the reference model (default max(2 n, ladder max))")
+      ->check(CLI::Range(2, 100000));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+
+  try {
+    const std::string machine = MachineDescription();
+    std::cerr << "snapthread-bench: " << machine << (quick ? " (quick)" : "") << '\n';
+    const auto t_start = std::chrono::steady_clock::now();
+    if (!advise.empty()) {
+      std::vector<SceneOverride> overrides;
+      for (const auto& s : sets) overrides.push_back(ParseOverride(s));
+      const Scene scene = LoadScene(advise, overrides);
+      AdvisorOptions o;
+      if (quick) {
+        o.n_ladder = {5, 8, 10, 15, 20};
+        o.cutoffs = {1e-6, 1e-10};
+        o.budgets = {1, 3, 0};
+        o.repetitions = 1;
+        o.substeps = 2;
+      }
+      if (!ladder_text.empty()) o.n_ladder = ParseCounts(ladder_text, "--ladder");
+      if (!methods_text.empty()) o.methods = ParseMethods(methods_text);
+      if (!cutoffs_text.empty()) o.cutoffs = ParseCutoffs(cutoffs_text);
+      if (!budgets_text.empty()) o.budgets = ParseBudgets(budgets_text);
+      if (repetitions > 0) o.repetitions = repetitions;
+      o.reference_n = reference_n;
+      o.target_force_error = target_force_error;
+      o.target_rate_hz = target_rate_hz;
+      const Advice a = Advise(scene, o, &std::cerr);
+      std::cout << "advise " << advise << " (" << machine << ")\n";
+      PrintAdvice(a, std::cout);
+      return a.found ? 0 : 3;
+    }
+
+    fs::create_directories(out_dir);
+    const std::string out_abs = fs::absolute(out_dir).string();
+    std::ofstream summary(fs::path(out_dir) / "summary.txt");
+    summary << "snapthread-bench " << (quick ? "--quick " : "") << "on " << machine << "\n\n";
+    const auto parts = Split(only);
+    auto want = [&](const char* p) { return std::find(parts.begin(), parts.end(), p) != parts.end(); };
+    for (const auto& p : parts)
+      if (p != "accuracy" && p != "scaling" && p != "service")
+        throw std::invalid_argument("--only: unknown benchmark '" + p + "' (accuracy, scaling, service)");
+    bool plots_ok = true;
+
+    if (want("accuracy")) {
+      AccuracyOptions o;
+      if (quick) {
+        o.cutoffs = {1e-6, 1e-10};
+        o.budgets = {1, 3, 0};
+        o.repetitions = 1;
+        o.substeps = 3;
+      }
+      if (!sweeps_text.empty()) o.sweeps = Split(sweeps_text);
+      if (!methods_text.empty()) o.methods = ParseMethods(methods_text);
+      if (!cutoffs_text.empty()) o.cutoffs = ParseCutoffs(cutoffs_text);
+      if (!budgets_text.empty()) o.budgets = ParseBudgets(budgets_text);
+      if (repetitions > 0) o.repetitions = repetitions;
+      const auto rows = RunAccuracyBench(scenes_dir, o, &std::cerr);
+      std::ofstream csv(fs::path(out_dir) / "accuracy.csv");
+      WriteAccuracyCsv(rows, csv);
+      std::ostringstream table;
+      table << "== speed against accuracy (median of " << o.repetitions
+            << " runs; |dF|/Fs = rms force error / ForceScale; chatter = spurious force reversals; * = Pareto front)\n";
+      PrintAccuracyTable(rows, false, table);
+      std::cout << table.str();
+      summary << table.str() << '\n';
+      if (!no_plot) {
+        const std::string script = (fs::path(out_dir) / "bench_pareto.gp").string();
+        std::ofstream(script) << ParetoGnuplot(rows, out_abs, out_abs + "/bench_pareto.png");
+        plots_ok = RunGnuplot(script) && plots_ok;
+      }
+    }
+
+    if (want("scaling")) {
+      ScalingOptions o;
+      if (quick) {
+        o.ns = {5, 10, 50, 200, 1000};
+        o.repetitions = 1;
+        o.min_sample_s = 0.05;
+      }
+      if (!ns_text.empty()) o.ns = ParseCounts(ns_text, "--ns");
+      if (!methods_text.empty()) o.methods = ParseMethods(methods_text);
+      if (!backends_text.empty()) o.backends = Split(backends_text);
+      if (repetitions > 0) o.repetitions = repetitions;
+      const auto rows = RunScalingBench(scenes_dir, o, &std::cerr);
+      const auto fits = FitScaling(rows);
+      std::ofstream csv(fs::path(out_dir) / "scaling.csv");
+      WriteScalingCsv(rows, csv);
+      std::ostringstream table;
+      table << "== scaling: thread3d hand-speed update rate (median of " << o.repetitions << " repetitions)\n";
+      PrintScalingTable(rows, fits, table);
+      std::cout << table.str();
+      summary << table.str() << '\n';
+      if (!no_plot) {
+        const std::string script = (fs::path(out_dir) / "bench_scaling.gp").string();
+        std::ofstream(script) << ScalingGnuplot(rows, fits, out_abs, out_abs + "/bench_scaling.png");
+        plots_ok = RunGnuplot(script) && plots_ok;
+      }
+    }
+
+    if (want("service")) {
+      ServiceOptions o;
+      o.bin_dir = bin_dir;
+      o.scenes_dir = scenes_dir;
+      o.work_dir = (fs::path(out_dir) / "service").string();
+      if (quick) {
+        o.scenes = {"curve2d_snap"};
+        o.duration_s = 3.0;
+        o.repetitions = 1;
+      }
+      if (!service_scenes.empty()) o.scenes = Split(service_scenes);
+      if (service_duration > 0) o.duration_s = service_duration;
+      if (repetitions > 0) o.repetitions = repetitions;
+      const auto runs = RunServiceBench(o, &std::cerr);
+      std::ofstream csv(fs::path(out_dir) / "service.csv");
+      WriteServiceCsv(runs, csv);
+      std::ostringstream table;
+      table << "== service: server + device (virtual-hand, --no-rt, 1 kHz) on loopback, " << o.duration_s
+            << " s per run\n";
+      PrintServiceTable(runs, table);
+      std::cout << table.str();
+      summary << table.str() << '\n';
+      for (const auto& r : runs)
+        if (!r.ok) std::cerr << "snapthread-bench: service run failed: " << r.error << '\n';
+    }
+    const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    summary << "total " << total << " s\n";
+    std::cerr << "snapthread-bench: done in " << total << " s; results in " << out_dir << '\n';
+    if (!plots_ok) {
+      std::cerr << "snapthread-bench: gnuplot failed (deploy/setup.sh installs gnuplot-nox)\n";
+      return 1;
+    }
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "snapthread-bench: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "snapthread-bench: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
