@@ -1,6 +1,8 @@
 // End-to-end: snapthread-viewer runs as a real process under xvfb-run, receives shapes over
 // udpm loopback, and its screenshot must show the thread where the camera projects it.
 #include <atomic>
+#include <cstdio>
+#include <mutex>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -9,7 +11,10 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "grasp_publisher.h"
 #include "hud_layout.h"
+#include "snapthread/device_state_t.hpp"
+#include "snapthread/scene.h"
 #include "orbit_camera.h"
 #include "snapthread/thread_shape_t.hpp"
 #include "snapthread/transport/channels.h"
@@ -311,6 +316,104 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
   std::string error;
   ASSERT_TRUE(ReadPng(dir + "/shot.png", &img, &error)) << error;
   ExpectArcDrawn(img);
+}
+
+// Collects device_state_t from a session over udpm on its own thread.
+class PoseCollector {
+ public:
+  explicit PoseCollector(const std::string& session) {
+    lcm_.subscribe(transport::Channels(session).device_state, &PoseCollector::On, this);
+    thread_ = std::thread([this] {
+      while (running_) lcm_.handleTimeout(20);
+    });
+  }
+  ~PoseCollector() {
+    running_ = false;
+    thread_.join();
+  }
+  std::vector<device_state_t> Poses() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return poses_;
+  }
+
+ private:
+  void On(const lcm::ReceiveBuffer*, const std::string&, const device_state_t* msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    poses_.push_back(*msg);
+  }
+  lcm::LCM lcm_{kLoopbackUrl};
+  std::atomic<bool> running_{true};
+  std::mutex mutex_;
+  std::vector<device_state_t> poses_;
+  std::thread thread_;
+};
+
+// --grasp-mode end to end: a real mouse drag (xdotool in the Xvfb display) from the grasp
+// to another pixel makes the viewer publish device states at the dragged-to point, in
+// device metres through the scene's mapping.
+TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
+  const std::string session = UniqueSession("VIEWGRASP");
+  const std::string dir = TempDir("viewer-grasp");
+  const std::string scene_path = SourceDir() + "/scenes/curve2d_snap.yaml";
+  const Scene scene = LoadScene(scene_path);
+  // Where the viewer's camera puts the arc's grasp (-1, 0, 0), and the drag target.
+  const std::vector<Point3> nodes = ArcNodes();
+  Eigen::Vector3d lo = nodes[0], hi = nodes[0];
+  for (const auto& p : nodes) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  OrbitCamera camera;
+  camera.Fit(lo, hi, double(kWidth) / kHeight);
+  const Eigen::Vector2d grasp_px = camera.ProjectToPixel(nodes.back(), kWidth, kHeight);
+  const Eigen::Vector2d target_px(std::round(grasp_px.x() + 60), std::round(grasp_px.y() - 45));
+  Eigen::Vector3d origin, direction;
+  camera.PixelRay(target_px.x(), target_px.y(), kWidth, kHeight, &origin, &direction);
+  const Eigen::Vector3d target_model = origin - origin.z() / direction.z() * direction;  // z = 0
+  const Eigen::Vector3d expected_m = viewer::ModelToDeviceMetres(scene.device, target_model);
+
+  ShapePublisher publisher(session, /*with_garbage=*/false);
+  ASSERT_TRUE(publisher.Start());
+  PoseCollector collector(session);
+  const std::string viewer = BinDir() + "/snapthread-viewer";
+  const std::string title = "snapthread-viewer: " + session;
+  char script[2048];
+  std::snprintf(script, sizeof script,
+                "'%s' --grasp-mode --scene '%s' --session %s --lcm-url '%s' --width %d --height %d "
+                "--duration-s 12 & vp=$!; "
+                "for i in $(seq 50); do w=$(xdotool search --name '%s' | head -1); "
+                "[ -n \"$w\" ] && break; sleep 0.2; done; sleep 1.5; "
+                "xdotool mousemove --window $w %d %d; sleep 0.3; xdotool mousedown 1; sleep 0.3; "
+                "xdotool mousemove --window $w %d %d; sleep 0.3; xdotool mousemove --window $w %d %d; "
+                "sleep 1.0; xdotool mouseup 1; sleep 0.5; kill $vp; wait $vp; exit 0",
+                viewer.c_str(), scene_path.c_str(), session.c_str(), kLoopbackUrl, kWidth, kHeight,
+                title.c_str(), int(std::lround(grasp_px.x())), int(std::lround(grasp_px.y())),
+                int(target_px.x() - 20), int(target_px.y()), int(target_px.x()), int(target_px.y()));
+  std::random_device rd;
+  const int pid = StartProcess({"xvfb-run", "-a", "-n", std::to_string(100 + rd() % 800), "-s",
+                                "-screen 0 1280x720x24", "bash", "-c", script},
+                               dir + "/out.txt", dir + "/err.txt");
+  ASSERT_GT(pid, 0);
+  const ProcessResult r = WaitProcess(pid, 40.0, dir + "/out.txt", dir + "/err.txt");
+  publisher.Stop();
+  ASSERT_TRUE(r.exited) << r.err;
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const std::vector<device_state_t> poses = collector.Poses();
+  ASSERT_GE(poses.size(), 10u) << "viewer published " << poses.size() << " poses\n" << r.out << r.err;
+  for (size_t i = 1; i < poses.size(); ++i) EXPECT_EQ(poses[i].seq, poses[i - 1].seq + 1);
+  for (const auto& p : poses) {
+    EXPECT_EQ(p.buttons, 1);  // published only while the button is held
+    EXPECT_EQ(p.device_id, "viewer-mouse");
+  }
+  // The pose while held at the target: the model point under the cursor, in device metres
+  // (one pixel is ~0.007 model units = 0.14 mm here).
+  const device_state_t& last = poses.back();
+  EXPECT_NEAR(last.position[0], expected_m.x(), 5e-4);
+  EXPECT_NEAR(last.position[1], expected_m.y(), 5e-4);
+  EXPECT_NEAR(last.position[2], expected_m.z(), 1e-9);  // planar model: on the plane z = 0
+  // The drag moved it: far from the grasp's own position.
+  const Eigen::Vector3d grasp_m = viewer::ModelToDeviceMetres(scene.device, nodes.back());
+  EXPECT_GT(std::hypot(last.position[0] - grasp_m.x(), last.position[1] - grasp_m.y()), 5e-3);
 }
 
 TEST(ViewerScreenshotTest, TimesOutWithAClearMessageWhenNothingArrives) {
