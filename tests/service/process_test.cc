@@ -198,6 +198,14 @@ class ProcessTest : public ::testing::Test {
     scene_ = LoadScene(scene_path_);
   }
 
+  // Keep the logs and traces of a failed test for the post-mortem, drop the rest.
+  void TearDown() override {
+    if (!HasFailure() && !dir_.empty()) {
+      std::error_code ec;
+      fs::remove_all(dir_, ec);
+    }
+  }
+
   // A path through the strip's snap: from the scene's start (bent up, y = -3) up to
   // y = 3.8 (the bent-up branch ends at y ~ 3.42 and the strip snaps to bent down), and
   // back. Written as device metres for the device's --path-csv.
