@@ -159,6 +159,37 @@ TEST(BenchScaling, HandSpeedUpdatesConvergeWithoutSnapping) {
   }
 }
 
+TEST(BenchTiming, TimedSweepRecordsTheSameTraceAsRunSweep) {
+  Scene s = testing::SceneFile("curve2d_snap.yaml");
+  SweepSpec spec;
+  spec.from = Vec(2);
+  spec.to = Vec(2);
+  spec.from << 9.0, 3.0;
+  spec.to << 9.0, 3.8;  // through the snap at Y = 3.41
+  spec.steps = 100;
+  const auto controls = SweepControls(s, spec);
+  auto tracker = MakeTracker(s);
+  const auto plain = RunSweep(tracker.get(), controls);
+  const TimedSweep t = TimeSweep(s, controls, 3, 0.0);
+  ASSERT_EQ(t.rows.size(), plain.size());
+  EXPECT_EQ(t.rate_hz.count, 3);
+  EXPECT_GT(t.rate_hz.min, 0.0);
+  int snaps = 0;
+  for (size_t i = 0; i < plain.size(); ++i) {
+    EXPECT_EQ(t.rows[i].step, static_cast<int>(i));
+    EXPECT_EQ((t.rows[i].force - plain[i].force).norm(), 0.0) << "row " << i;
+    EXPECT_EQ(t.rows[i].probe, plain[i].probe);
+    EXPECT_EQ(t.rows[i].snapped, plain[i].snapped);
+    EXPECT_EQ(t.rows[i].iterations, plain[i].iterations);
+    snaps += t.rows[i].snapped;
+  }
+  EXPECT_EQ(snaps, 1);
+  // A minimum time per repetition repeats the sweep, it does not change the trace.
+  const TimedSweep longer = TimeSweep(s, controls, 1, 0.02);
+  EXPECT_EQ(longer.rate_hz.count, 1);
+  EXPECT_EQ((longer.rows.back().force - plain.back().force).norm(), 0.0);
+}
+
 TEST(BenchService, JsonNumberReadsFlatFields) {
   const std::string j = "{\n  \"backend\": \"virtual-hand\",\n  \"round_trip_us_p50\": 412.5,\n"
                         "  \"round_trip_us_p99\": 1.2e3,\n  \"realtime\": false\n}\n";
@@ -231,6 +262,7 @@ AdvisorOptions SmallOptions() {
   o.cutoffs = {1e-4, 1e-8};
   o.budgets = {1, 0};
   o.repetitions = 1;
+  o.min_time_s = 0.0;
   o.substeps = 2;
   return o;
 }

@@ -121,12 +121,14 @@ std::vector<int> ParetoFront(const std::vector<ParetoPoint>& p) {
 
 // ---------------------------------------------------------------- timed sweeps
 
-TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int repetitions) {
+TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int repetitions, double min_time_s) {
   TimedSweep out;
   if (controls.size() < 2) throw std::invalid_argument("bench: a timed sweep needs two or more controls");
   std::vector<double> rates;
   const size_t rows = controls.size();
-  for (int rep = 0; rep < std::max(1, repetitions); ++rep) {
+  double rep_seconds = 0.0;
+  long rep_updates = 0;
+  for (int pass = 0, rep = 0; rep < std::max(1, repetitions); ++pass) {
     auto tracker = MakeTracker(scene);
     const int m = tracker->model().NumControls();
     // Preallocated so the timed loop only copies a few numbers per update.
@@ -153,9 +155,18 @@ TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int r
     keep(0, tracker->Reset(controls[0]));
     const auto t0 = Clock::now();
     for (size_t i = 1; i < rows; ++i) keep(i, tracker->Update(controls[i]));
-    const double s = Seconds(t0, Clock::now());
-    rates.push_back((rows - 1) / std::max(s, 1e-9));
-    if (rep == 0) {
+    rep_seconds += Seconds(t0, Clock::now());
+    rep_updates += static_cast<long>(rows - 1);
+    const bool keep_rows = pass == 0;
+    // A repetition runs the sweep again until it has lasted min_time_s (a short sweep
+    // is below the clock's and the scheduler's resolution).
+    if (rep_seconds >= min_time_s) {
+      rates.push_back(rep_updates / std::max(rep_seconds, 1e-9));
+      rep_seconds = 0.0;
+      rep_updates = 0;
+      ++rep;
+    }
+    if (keep_rows) {
       out.rows.resize(rows);
       for (size_t i = 0; i < rows; ++i) {
         SweepRow& r = out.rows[i];
@@ -208,7 +219,7 @@ std::vector<AccuracyRow> RunAccuracyBench(const std::string& scenes_dir, const A
           sc.solver.method = m;
           sc.solver.cutoff = cutoff;
           sc.solver.max_iterations = budget;
-          const TimedSweep t = TimeSweep(sc, sw->controls, o.repetitions);
+          const TimedSweep t = TimeSweep(sc, sw->controls, o.repetitions, o.min_time_s);
           AccuracyRow row;
           row.sweep = name;
           row.method = m;
@@ -745,7 +756,7 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
           c.solver.method = m;
           c.solver.cutoff = cutoff;
           c.solver.max_iterations = budget;
-          const TimedSweep t = TimeSweep(c, path, o.repetitions);
+          const TimedSweep t = TimeSweep(c, path, o.repetitions, o.min_time_s);
           AdviceCandidate cand;
           cand.n = chain ? n : 0;
           cand.method = m;

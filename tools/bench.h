@@ -57,14 +57,15 @@ std::vector<int> ParetoFront(const std::vector<ParetoPoint>& points);
 
 // ---------------------------------------------------------------- timed sweeps
 
-// A sweep run once per repetition from a fresh tracker; the trace of the first run (for
-// the error against a reference) and the rate of every run (updates after the reset
+// A sweep run from a fresh tracker each time (the reset is not timed); a repetition
+// repeats it until it has lasted `min_time_s`. The trace of the first run (for the error
+// against a reference) and the rate of every repetition (updates after the resets
 // divided by their wall time).
 struct TimedSweep {
   std::vector<SweepRow> rows;
   Spread rate_hz;
 };
-TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int repetitions);
+TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int repetitions, double min_time_s = 0.0);
 
 // ---------------------------------------------------------------- accuracy
 
@@ -74,6 +75,7 @@ struct AccuracyOptions {
   std::vector<double> cutoffs = {1e-4, 1e-6, 1e-8, 1e-10};
   std::vector<int> budgets = {1, 2, 3, 5, 10, 0};  // 0 = unlimited
   int repetitions = 3;
+  double min_time_s = 0.05;  // per repetition (short sweeps are repeated)
   int substeps = 10;  // reference: fine steps per row (as the stability suite)
 };
 
@@ -191,6 +193,7 @@ struct AdvisorOptions {
   std::vector<double> cutoffs = {1e-4, 1e-6, 1e-8, 1e-10};
   std::vector<int> budgets = {1, 2, 3, 5, 10, 0};
   int repetitions = 3;
+  double min_time_s = 0.05;  // per repetition (short sweeps are repeated)
   int substeps = 4;       // reference trace: fine steps per row
   // Overrides of the scene's targets (0 = use the scene's).
   double target_force_error = 0.0;

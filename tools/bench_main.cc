@@ -151,6 +151,7 @@ int main(int argc, char** argv) {
         o.cutoffs = {1e-6, 1e-10};
         o.budgets = {1, 3, 0};
         o.repetitions = 1;
+        o.min_time_s = 0.01;
         o.substeps = 2;
       }
       if (!ladder_text.empty()) o.n_ladder = ParseCounts(ladder_text, "--ladder");
@@ -184,6 +185,7 @@ int main(int argc, char** argv) {
         o.cutoffs = {1e-6, 1e-10};
         o.budgets = {1, 3, 0};
         o.repetitions = 1;
+        o.min_time_s = 0.01;
         o.substeps = 3;
       }
       if (!sweeps_text.empty()) o.sweeps = Split(sweeps_text);
