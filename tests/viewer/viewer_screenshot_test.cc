@@ -43,7 +43,7 @@ std::vector<Point3> ArcNodes() {
   return nodes;
 }
 
-thread_shape_t ArcShape(int64_t seq) {
+thread_shape_t ArcShape(int64_t seq, int8_t status = 0) {
   thread_shape_t s{};
   s.utime = seq * 16000;
   s.seq = seq;
@@ -58,7 +58,7 @@ thread_shape_t ArcShape(int64_t seq) {
     s.force[i] = 0.0;           // no force arrow, so only the thread, clamp and grasp are drawn
     s.force_newtons[i] = 0.0;
   }
-  s.status = 0;
+  s.status = status;
   s.snaps = 0;
   return s;
 }
@@ -66,8 +66,8 @@ thread_shape_t ArcShape(int64_t seq) {
 // Publishes the arc every 20 ms (plus malformed packets when asked) until stopped.
 class ShapePublisher {
  public:
-  ShapePublisher(const std::string& session, bool with_garbage)
-      : channel_(transport::Channels(session).shape), garbage_(with_garbage) {}
+  ShapePublisher(const std::string& session, bool with_garbage, int8_t status = 0)
+      : channel_(transport::Channels(session).shape), garbage_(with_garbage), status_(status) {}
   ~ShapePublisher() { Stop(); }
   bool Start() {
     if (!lcm_.good()) return false;
@@ -86,7 +86,7 @@ class ShapePublisher {
     int64_t seq = 0;
     while (running_) {
       if (garbage_) PublishGarbage(seq, &rng);
-      thread_shape_t s = ArcShape(++seq);
+      thread_shape_t s = ArcShape(++seq, status_);
       lcm_.publish(channel_, &s);
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
@@ -133,6 +133,7 @@ class ShapePublisher {
   lcm::LCM lcm_{kLoopbackUrl};
   std::string channel_;
   bool garbage_;
+  int8_t status_;
   std::atomic<bool> running_{true};
   std::atomic<int64_t> garbage_sent_{0};
   std::thread thread_;
@@ -270,6 +271,51 @@ TEST(ViewerScreenshotTest, MalformedShapePacketsAreDroppedAndCounted) {
   std::string error;
   ASSERT_TRUE(ReadPng(run.png, &img, &error)) << error;
   ExpectArcDrawn(img);  // the valid shapes still render correctly
+}
+
+// Mean colour of the drawn path pixels (outside the overlays).
+Eigen::Vector3d PathColour(const Image& img) {
+  const std::vector<Point3> nodes = ArcNodes();
+  Eigen::Vector3d lo = nodes[0], hi = nodes[0];
+  for (const auto& p : nodes) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  OrbitCamera camera;
+  camera.Fit(lo, hi, double(kWidth) / kHeight);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const auto& p : CatmullRomCurve(nodes, 8)) {
+    const Eigen::Vector2d q = camera.ProjectToPixel(p, kWidth, kHeight);
+    if (InOverlay(q.x(), q.y(), 4)) continue;
+    const uint8_t* c = img.At(int(std::lround(q.x())), int(std::lround(q.y())));
+    sum += Eigen::Vector3d(c[0], c[1], c[2]);
+    n++;
+  }
+  return n > 0 ? Eigen::Vector3d(sum / n) : sum;
+}
+
+// The solver state is colour coded: regular threads are drawn pale blue, snapped ones red.
+TEST(ViewerScreenshotTest, SolverStateIsColourCoded) {
+  Eigen::Vector3d colour[2];
+  const int8_t states[2] = {0, 2};  // force_model_t::STATUS_REGULAR, STATUS_SNAPPED
+  for (int i = 0; i < 2; ++i) {
+    const std::string session = UniqueSession("VIEWSTATE");
+    const std::string dir = TempDir("viewer-state" + std::to_string(i));
+    ShapePublisher publisher(session, false, states[i]);
+    ASSERT_TRUE(publisher.Start());
+    const ViewerRun run = RunViewerScreenshot(session, dir, 3, 30.0);
+    publisher.Stop();
+    ASSERT_EQ(run.result.exit_code, 0) << run.result.err;
+    Image img;
+    std::string error;
+    ASSERT_TRUE(ReadPng(run.png, &img, &error)) << error;
+    ExpectArcDrawn(img);
+    colour[i] = PathColour(img);
+  }
+  EXPECT_GT(colour[0].z(), colour[0].x() + 40) << "regular: " << colour[0].transpose();
+  EXPECT_GT(colour[1].x(), colour[1].y() + 80) << "snapped: " << colour[1].transpose();
+  EXPECT_GT(colour[1].x(), colour[1].z() + 80) << "snapped: " << colour[1].transpose();
 }
 
 // Review path of docs/lab-setup.md: a logged session played back with lcm-logplayer into a
