@@ -632,11 +632,12 @@ void PrintServiceTable(const std::vector<ServiceRun>& runs, std::ostream& out) {
     by[r.scene].push_back(&r);
   }
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%-14s %5s %24s %24s %24s %24s %12s\n", "scene", "runs", "round trip p50 us",
-                "round trip p99 us", "lateness p50 us", "lateness p99 us", "tick Hz");
+  std::snprintf(buf, sizeof buf, "%-14s %5s %22s %22s %22s %22s %18s %18s %18s\n", "scene", "runs",
+                "round trip p50 us", "round trip p99 us", "lateness p50 us", "lateness p99 us", "tick Hz",
+                "server updates/s", "server solve p99 us");
   out << buf << "  (median [min..max] over the runs)\n";
   for (const auto& s : order) {
-    std::vector<double> a, b, c, d, e;
+    std::vector<double> a, b, c, d, e, f, g;
     int ok = 0;
     for (const ServiceRun* r : by[s]) {
       if (!r->ok) continue;
@@ -646,6 +647,8 @@ void PrintServiceTable(const std::vector<ServiceRun>& runs, std::ostream& out) {
       c.push_back(r->lateness_us_p50);
       d.push_back(r->lateness_us_p99);
       e.push_back(r->tick_rate_hz);
+      f.push_back(r->server_update_rate_hz);
+      g.push_back(r->server_solve_us_p99);
     }
     auto cell = [](const std::vector<double>& v) {
       const Spread sp = Summarize(v);
@@ -653,8 +656,9 @@ void PrintServiceTable(const std::vector<ServiceRun>& runs, std::ostream& out) {
       std::snprintf(t, sizeof t, "%.0f [%.0f..%.0f]", sp.median, sp.min, sp.max);
       return std::string(t);
     };
-    std::snprintf(buf, sizeof buf, "%-14s %2d/%-2zu %24s %24s %24s %24s %12s\n", s.c_str(), ok, by[s].size(),
-                  cell(a).c_str(), cell(b).c_str(), cell(c).c_str(), cell(d).c_str(), cell(e).c_str());
+    std::snprintf(buf, sizeof buf, "%-14s %2d/%-2zu %22s %22s %22s %22s %18s %18s %18s\n", s.c_str(), ok,
+                  by[s].size(), cell(a).c_str(), cell(b).c_str(), cell(c).c_str(), cell(d).c_str(), cell(e).c_str(),
+                  cell(f).c_str(), cell(g).c_str());
     out << buf;
   }
 }
@@ -695,11 +699,17 @@ std::vector<Vec> HandSpeedPath(const Scene& scene) {
 }
 
 int SelectCheapest(const std::vector<AdviceCandidate>& c, double te, double tr) {
+  double fastest = -1.0;
+  for (const auto& x : c)
+    if (x.Acceptable(te, tr)) fastest = std::max(fastest, x.rate_hz);
+  if (fastest < 0) return -1;
+  // Rates within kRateTieFraction of the fastest are within the measurement noise of a
+  // shared machine: among those the more accurate configuration wins.
   int best = -1;
   for (size_t i = 0; i < c.size(); ++i) {
-    if (!c[i].MeetsError(te) || !c[i].MeetsRate(tr)) continue;
-    if (best < 0 || c[i].rate_hz > c[best].rate_hz ||
-        (c[i].rate_hz == c[best].rate_hz && c[i].force_error < c[best].force_error))
+    if (!c[i].Acceptable(te, tr) || c[i].rate_hz < (1.0 - kRateTieFraction) * fastest) continue;
+    if (best < 0 || c[i].force_error < c[best].force_error ||
+        (c[i].force_error == c[best].force_error && c[i].rate_hz > c[best].rate_hz))
       best = static_cast<int>(i);
   }
   return best;
@@ -722,8 +732,11 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
 
   Scene ref_scene = scene;
   if (chain) {
-    a.reference_n = o.reference_n > 0 ? o.reference_n : std::max(2 * scene.params.n, ladder.back());
+    a.reference_n = o.reference_n > 0 ? o.reference_n : 2 * std::max(scene.params.n, ladder.back());
     ref_scene = ResizeChain(scene, a.reference_n);
+    // A rung as fine as the reference would compare the reference with itself.
+    std::erase_if(ladder, [&](int n) { return n >= a.reference_n; });
+    if (ladder.empty()) throw std::invalid_argument("advise: every n of the ladder is >= the reference n");
   }
   const double scale = ForceScaleOf(ref_scene);
   const auto t_ref = Clock::now();
@@ -822,7 +835,8 @@ void PrintAdvice(const Advice& a, std::ostream& out) {
                 "rate(1/s)", "|dF|/Fs", "chatter", "meets");
   out << buf;
   for (const auto& c : a.candidates) {
-    const bool e = c.MeetsError(a.target_force_error), r = c.MeetsRate(a.target_rate_hz);
+    const bool e = c.MeetsError(a.target_force_error) && c.spurious_reversals == 0,
+               r = c.MeetsRate(a.target_rate_hz);
     const bool chosen = a.found && c.n == a.choice.n && c.method == a.choice.method && c.cutoff == a.choice.cutoff &&
                         c.budget == a.choice.budget;
     std::snprintf(buf, sizeof buf, "  %5d %-12s %7.0e %6s %11.3e %10.3e %8d  %s%s\n", c.n, ToString(c.method),
@@ -910,7 +924,7 @@ std::string ParetoGnuplot(const std::vector<AccuracyRow>& rows, const std::strin
            << " with points pt 7 ps 0.8 lc rgb '" << MethodColor(m) << "' title '" << ToString(m) << "'";
       }
       if (panel == 0)
-        gp << ", '" << dir << "/pareto_" << s << "_front.csv' every ::1 using 1:2 with lines dt 2 lc rgb '#444444' "
+        gp << ", '" << dir << "/pareto_" << s << "_front.csv' every ::1 using 1:2 with linespoints pt 6 ps 1.2 dt 2 lc rgb '#444444' "
            << "title 'Pareto front'";
       gp << "\n";
     }

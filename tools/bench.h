@@ -188,7 +188,7 @@ std::vector<Vec> HandSpeedPath(const Scene& scene);
 
 struct AdvisorOptions {
   std::vector<int> n_ladder = {5, 8, 10, 15, 20, 30, 50, 80, 100};
-  int reference_n = 0;  // 0: max(2 x the scene's n, the ladder's largest)
+  int reference_n = 0;  // 0: 2 x max(the scene's n, the ladder's largest); rungs >= it are dropped
   std::vector<Method> methods = {Method::kNewton, Method::kNewtonLineSearch, Method::kHigherOrder};
   std::vector<double> cutoffs = {1e-4, 1e-6, 1e-8, 1e-10};
   std::vector<int> budgets = {1, 2, 3, 5, 10, 0};
@@ -212,6 +212,11 @@ struct AdviceCandidate {
   int spurious_reversals = 0;
   bool MeetsError(double target) const { return force_error <= target; }
   bool MeetsRate(double target) const { return rate_hz >= target; }
+  // Both targets, and no chatter: a force that reverses spuriously is not acceptable
+  // however small its rms error.
+  bool Acceptable(double target_error, double target_rate) const {
+    return MeetsError(target_error) && MeetsRate(target_rate) && spurious_reversals == 0;
+  }
 };
 
 struct ModelErrorRow {
@@ -229,8 +234,10 @@ struct Advice {
   std::string message;                        // why this choice / why none
 };
 
-// Index of the fastest candidate meeting both targets (ties: the lowest error), -1 if
-// none does.
+// Index of the cheapest acceptable candidate (both targets, no chatter), -1 if none is:
+// the fastest, where rates within kRateTieFraction of the fastest count as equal (noise)
+// and the lowest force error among them wins.
+constexpr double kRateTieFraction = 0.05;
 int SelectCheapest(const std::vector<AdviceCandidate>& candidates, double target_force_error, double target_rate_hz);
 
 // Throws std::invalid_argument when the scene states no targets and none are given.
