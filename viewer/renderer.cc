@@ -160,11 +160,13 @@ void Renderer::AppendLine(float x0, float y0, float x1, float y1, const Rgb& c) 
 void Renderer::AppendText(const std::string& text, float x, float y, float scale,
                           const Rgb& color) {
   // stb_easy_font emits quads of 4 vertices (x, y, z floats + 4 colour bytes = 16 bytes).
-  static char buffer[16 * 4 * 2000];
+  text_quads_.resize(16 * 4 * kMaxTextQuads);
+  char* buffer = text_quads_.data();
   unsigned char rgba[4] = {255, 255, 255, 255};
   std::vector<char> copy(text.begin(), text.end());
   copy.push_back('\0');
-  const int quads = stb_easy_font_print(0.f, 0.f, copy.data(), rgba, buffer, sizeof buffer);
+  const int quads = stb_easy_font_print(0.f, 0.f, copy.data(), rgba, buffer,
+                                        static_cast<int>(text_quads_.size()));
   for (int q = 0; q < quads; ++q) {
     float corner[4][2];
     for (int k = 0; k < 4; ++k) {

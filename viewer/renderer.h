@@ -55,6 +55,8 @@ class Renderer {
   MeshBuilder scene_;
   std::vector<Vertex> overlay_triangles_;
   std::vector<Vertex> overlay_lines_;
+  static constexpr int kMaxTextQuads = 4000;  // per AppendText call (~ 40 lines of text)
+  std::vector<char> text_quads_;              // stb_easy_font output, reused
   double force_scale_n_ = 0.0;  // running max |F| for the arrow length
 };
 
