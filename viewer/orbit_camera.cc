@@ -21,6 +21,12 @@ void OrbitCamera::Orbit(double dyaw_rad, double dpitch_rad) {
   pitch_rad_ = std::clamp(pitch_rad_ + dpitch_rad, -1.5, 1.5);
 }
 
+void OrbitCamera::SetAngles(double yaw_rad, double pitch_rad) {
+  yaw_rad_ = 0.0;
+  pitch_rad_ = 0.0;
+  Orbit(yaw_rad, pitch_rad);
+}
+
 void OrbitCamera::Zoom(double factor) {
   distance_ = std::clamp(distance_ * factor, 1e-4, 1e6);
 }

@@ -16,6 +16,7 @@ class OrbitCamera {
   void Fit(const Eigen::Vector3d& box_min, const Eigen::Vector3d& box_max, double aspect,
            double fill = 0.7);
   void Orbit(double dyaw_rad, double dpitch_rad);
+  void SetAngles(double yaw_rad, double pitch_rad);
   void Zoom(double factor);  // distance *= factor
 
   Eigen::Vector3d Eye() const;

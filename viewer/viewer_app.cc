@@ -261,6 +261,9 @@ int RunViewer(const ViewerOptions& options) {
       SessionSnapshot snap = receiver.Snapshot();
       if (snap.has_shape) {
         if (!input.fitted || input.request_fit) {
+          // Planar models face the camera as drawn in the seed; a 3-D thread starts from an
+          // oblique view so its depth is visible.
+          if (!input.fitted && !IsPlanarModel(snap.shape.model)) input.camera.SetAngles(0.5, 0.35);
           FitToShape(snap.shape, w, h, &input.camera);
           input.fitted = true;
           input.request_fit = false;
