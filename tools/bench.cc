@@ -377,12 +377,16 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
   std::vector<ScalingRow> rows;
   std::vector<int> ns = o.ns;
   std::sort(ns.begin(), ns.end());
-  for (Method m : o.methods)
-    for (const std::string& backend : o.backends) {
-      double last_us = 0.0;
-      int last_n = 0;
-      for (int n : ns) {
-        if (last_n > 0) {
+  // The last measured point per method/backend, for skipping sizes that would be too slow.
+  std::map<std::pair<Method, std::string>, std::pair<int, double>> last;  // n, us per update
+  // n outermost, methods and backends interleaved: a change in the machine's load hits
+  // every method alike instead of biasing one against another.
+  for (int n : ns)
+    for (const std::string& backend : o.backends)
+      for (Method m : o.methods) {
+        const auto key = std::make_pair(m, backend);
+        if (last.count(key)) {
+          const auto [last_n, last_us] = last[key];
           // Dense LDL^T grows as n^3; the sparse ones about linearly (1.5 leaves room).
           const double p = backend == "dense" ? 3.0 : 1.5;
           const double predicted = last_us * std::pow(static_cast<double>(n) / last_n, p);
@@ -396,8 +400,7 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
         const auto t0 = Clock::now();
         ScalingRow r = TimeHandSpeed(HandSpeedScene(base, n, m, backend, o.cutoff), o);
         rows.push_back(r);
-        last_us = 1e6 / std::max(r.rate_hz.median, 1e-9);
-        last_n = n;
+        last[key] = {n, 1e6 / std::max(r.rate_hz.median, 1e-9)};
         if (progress)
           *progress << "bench scaling: " << ToString(m) << "/" << backend << " n=" << n << ": "
                     << Sci(r.rate_hz.median) << " updates/s (" << r.updates << " x " << r.rate_hz.count << ", "
@@ -405,7 +408,14 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
                     << std::setprecision(1) << Seconds(t0, Clock::now()) << " s)\n"
                     << std::defaultfloat << std::flush;
       }
-    }
+  // Grouped per method and backend for the tables and charts.
+  std::stable_sort(rows.begin(), rows.end(), [&](const ScalingRow& a, const ScalingRow& b) {
+    auto mi = [&](Method m) { return std::find(o.methods.begin(), o.methods.end(), m) - o.methods.begin(); };
+    auto bi = [&](const std::string& x) { return std::find(o.backends.begin(), o.backends.end(), x) - o.backends.begin(); };
+    if (mi(a.method) != mi(b.method)) return mi(a.method) < mi(b.method);
+    if (bi(a.backend) != bi(b.backend)) return bi(a.backend) < bi(b.backend);
+    return a.n < b.n;
+  });
   return rows;
 }
 
@@ -464,6 +474,51 @@ void PrintScalingTable(const std::vector<ScalingRow>& rows, const std::vector<Sc
       out << buf;
     } else {
       out << "-\n";
+    }
+  }
+}
+
+void PrintScalingTargets(const std::vector<ScalingRow>& rows, const std::vector<ScalingFit>& fits, std::ostream& out) {
+  auto rate = [&](Method m, const std::string& b, int n) {
+    for (const auto& r : rows)
+      if (r.method == m && r.backend == b && r.n == n) return r.rate_hz.median;
+    return 0.0;
+  };
+  char buf[256];
+  out << "issue-6 targets (higher-order, auto backend, cutoff 1e-6, hand-speed update):\n";
+  for (const auto& [n, target] : std::vector<std::pair<int, double>>{{10, 1e5}, {100, 1e4}, {1000, 1e3}}) {
+    const double r = rate(Method::kHigherOrder, "auto", n);
+    if (r <= 0) {
+      std::snprintf(buf, sizeof buf, "  n = %-5d >= %.0e /s: not measured\n", n, target);
+    } else {
+      std::snprintf(buf, sizeof buf, "  n = %-5d >= %.0e /s: measured %.3e /s -> %s\n", n, target, r,
+                    r >= target ? "met" : "NOT met");
+    }
+    out << buf;
+  }
+  for (const auto& f : fits)
+    if (f.method == Method::kHigherOrder && f.backend == "auto" && f.all.points >= 2) {
+      std::snprintf(buf, sizeof buf, "  log-log slope >= -1.05: measured %.3f over all n (%.3f for n >= 100) -> %s\n",
+                    f.all.slope, f.large.points >= 2 ? f.large.slope : f.all.slope,
+                    f.all.slope >= -1.05 ? "met" : "NOT met");
+      out << buf;
+    }
+  out << "  cost per update higher-order / newton (<= 1.3 targeted), per backend and n:\n";
+  for (const std::string b : {"auto", "banded", "cholmod", "dense"}) {
+    std::string line;
+    double worst = 0.0;
+    for (const auto& r : rows) {
+      if (r.method != Method::kHigherOrder || r.backend != b) continue;
+      const double rn = rate(Method::kNewton, b, r.n);
+      if (rn <= 0 || r.rate_hz.median <= 0) continue;
+      const double ratio = rn / r.rate_hz.median;  // us(higher-order) / us(newton)
+      worst = std::max(worst, ratio);
+      std::snprintf(buf, sizeof buf, " n=%d:%.2f", r.n, ratio);
+      line += buf;
+    }
+    if (!line.empty()) {
+      std::snprintf(buf, sizeof buf, "    %-8s worst %.2f ->%s |", b.c_str(), worst, worst <= 1.3 ? " met" : " NOT met");
+      out << buf << line << '\n';
     }
   }
 }

@@ -143,6 +143,9 @@ struct ScalingFit {
 std::vector<ScalingFit> FitScaling(const std::vector<ScalingRow>& rows);
 void WriteScalingCsv(const std::vector<ScalingRow>& rows, std::ostream& out);
 void PrintScalingTable(const std::vector<ScalingRow>& rows, const std::vector<ScalingFit>& fits, std::ostream& out);
+// The targets (higher-order / auto: n = 10, 100, 1000 rates, slope, cost relative
+// to newton), each reported as met or not from the measured rows.
+void PrintScalingTargets(const std::vector<ScalingRow>& rows, const std::vector<ScalingFit>& fits, std::ostream& out);
 
 // ---------------------------------------------------------------- service
 

@@ -212,7 +212,7 @@ int main(int argc, char** argv) {
     if (want("scaling")) {
       ScalingOptions o;
       if (quick) {
-        o.ns = {5, 10, 50, 200, 1000};
+        o.ns = {5, 10, 100, 1000};
         o.repetitions = 1;
         o.min_sample_s = 0.05;
       }
@@ -227,6 +227,7 @@ int main(int argc, char** argv) {
       std::ostringstream table;
       table << "== scaling: thread3d hand-speed update rate (median of " << o.repetitions << " repetitions)\n";
       PrintScalingTable(rows, fits, table);
+      PrintScalingTargets(rows, fits, table);
       std::cout << table.str();
       summary << table.str() << '\n';
       if (!no_plot) {
