@@ -168,15 +168,15 @@ int main(int argc, char** argv) {
       return a.found ? 0 : 3;
     }
 
-    fs::create_directories(out_dir);
-    const std::string out_abs = fs::absolute(out_dir).string();
-    std::ofstream summary(fs::path(out_dir) / "summary.txt");
-    summary << "snapthread-bench " << (quick ? "--quick " : "") << "on " << machine << "\n\n";
     const auto parts = Split(only);
     auto want = [&](const char* p) { return std::find(parts.begin(), parts.end(), p) != parts.end(); };
     for (const auto& p : parts)
       if (p != "accuracy" && p != "scaling" && p != "service")
         throw std::invalid_argument("--only: unknown benchmark '" + p + "' (accuracy, scaling, service)");
+    fs::create_directories(out_dir);
+    const std::string out_abs = fs::absolute(out_dir).string();
+    std::ofstream summary(fs::path(out_dir) / "summary.txt");
+    summary << "snapthread-bench " << (quick ? "--quick " : "") << "on " << machine << "\n\n";
     bool plots_ok = true;
 
     if (want("accuracy")) {
