@@ -73,7 +73,7 @@ pids+=("$viewer_pid")
 
 device_rc=0
 "$bin/snapthread-device" --backend virtual-hand --scene "$scene" --session "$session" \
-    --lcm-url "$url" --duration "$duration" --no-rt --summary "$out/device.json" \
+    --lcm-url "$url" --duration "$duration" --summary "$out/device.json" \
     --trace "$out/device_trace.csv" > "$out/device.txt" 2>&1 || device_rc=$?
 server_rc=0
 wait "$server_pid" || server_rc=$?
@@ -96,6 +96,12 @@ echo "  summaries:      $out/server.json $out/device.json"
 echo "  process output: $out/{server,device,viewer,report,logger}.txt"
 echo
 sed -n '/^channels/,/^$/p' "$out/report/summary.txt" 2>/dev/null || true
+sed -n '/^force:/,$p' "$out/report/summary.txt" 2>/dev/null | grep -v '^  snap at' || true
+if [ -f "$out/device.json" ]; then
+  echo "device summary ($out/device.json):"
+  grep -E '"(tick_rate_hz|lateness_us_p50|lateness_us_p99|round_trip_us_p50|round_trip_us_p99|snaps_felt|max_force_n|force_clamps|stiffness_clamps|slew_limits|fade_ticks|nonfinite_outputs|realtime)"' \
+      "$out/device.json" | tr -d ' ,"' | sed 's/^/  /'
+fi
 if ((device_rc || server_rc || viewer_rc || report_rc)); then
   echo "run_session: FAILED (see the process output files above)" >&2
   exit 1

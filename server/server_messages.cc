@@ -42,7 +42,9 @@ int8_t ClassifyStatus(const TrackResult* result) {
       !result->force.allFinite() || !result->stiffness.allFinite()) {
     return force_model_t::STATUS_INVALID;
   }
-  if (result->snapped || result->summary.snapped) return force_model_t::STATUS_SNAPPED;
+  // The tracker decides a snap from the state's jump to another branch; the solver's own
+  // flag only says its snap minimiser ran (it can land back on the same branch).
+  if (result->snapped) return force_model_t::STATUS_SNAPPED;
   if (result->stiffness_regularized ||
       result->summary.status == EquilibriumStatus::kNearFold) {
     return force_model_t::STATUS_NEAR_FOLD;
