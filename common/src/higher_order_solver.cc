@@ -218,20 +218,17 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   s.termination = Termination::kBudgetSpent;
   bool newton_stalled = false;
   int reduction_stalls = 0;
-  while (true) {
-    if (!std::isfinite(r)) {
-      xr = last_good_;
-      s.termination = Termination::kNonFinite;
-      s.message = "non-finite gradient; state restored";
-      break;
+  // Finishes a snap inside this update (DESIGN.md #4) and ends the iteration loop.
+  auto snap_and_stop = [&] {
+    if (!FinishSnap(u, &xr, &s)) {
+      s.termination = Termination::kLinearSolverFailed;
+      s.message = "snap minimiser did not converge";
     }
-    if (r < options_.cutoff) {
+    r = EvalGradient(xr, u, &g_, &s);
+    if (s.termination != Termination::kLinearSolverFailed && r < options_.cutoff)
       s.termination = Termination::kConverged;
-      break;
-    }
-    if (!BudgetLeft(s)) break;
-    ++s.iterations;
-    last_good_ = xr;
+  };
+  while (NextIteration(r, x, &s)) {
     const LinearSolverStatus st = FactorAt(xr, u, &s);
     bool degenerate = true;
     double lambda0 = 0.0;
@@ -253,13 +250,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       // quadratic model holds: the control step has carried the state over a fold while
       // lambda_0 still looked regular (DESIGN.md's open case). Finish it as a snap.
       if (dx_.lpNorm<Eigen::Infinity>() > options_.max_reduction_step) {
-        if (!FinishSnap(u, &xr, &s)) {
-          s.termination = Termination::kLinearSolverFailed;
-          s.message = "snap minimiser did not converge";
-        }
-        r = EvalGradient(xr, u, &g_, &s);
-        if (s.termination != Termination::kLinearSolverFailed && r < options_.cutoff)
-          s.termination = Termination::kConverged;
+        snap_and_stop();
         break;
       }
       // Approaching a fold (lambda_0 below half its reference) a Newton step must also
@@ -295,13 +286,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
         res = ReductionStep(u, &xr, &s);
       }
       if (res == StepResult::kSnap || many_negative) {
-        if (!FinishSnap(u, &xr, &s)) {
-          s.termination = Termination::kLinearSolverFailed;
-          s.message = "snap minimiser did not converge";
-        }
-        r = EvalGradient(xr, u, &g_, &s);
-        if (s.termination != Termination::kLinearSolverFailed && r < options_.cutoff)
-          s.termination = Termination::kConverged;
+        snap_and_stop();
         break;
       }
       if (res == StepResult::kFailed) {
@@ -322,27 +307,13 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       r = EvalGradient(xr, u, &g_, &s);
       reduction_stalls = (r < 0.5 * r_before) ? 0 : reduction_stalls + 1;
       if (reduction_stalls >= 2 || r > r_before) {
-        if (!FinishSnap(u, &xr, &s)) {
-          s.termination = Termination::kLinearSolverFailed;
-          s.message = "snap minimiser did not converge";
-        }
-        r = EvalGradient(xr, u, &g_, &s);
-        if (s.termination != Termination::kLinearSolverFailed && r < options_.cutoff)
-          s.termination = Termination::kConverged;
+        snap_and_stop();
         break;
       }
       continue;
     }
   }
-  bool gradient_current = s.termination != Termination::kNonFinite;
-  if (!xr.allFinite()) {
-    xr = last_good_;
-    s.termination = Termination::kNonFinite;
-    gradient_current = false;
-  }
-  Finish(xr, u, &s, gradient_current);
-  LeaveSaddle(u, &xr, &s);
-  Classify(&s);
+  Conclude(u, x, &s, /*leave_saddles=*/true);
   return s;
 }
 

@@ -59,6 +59,35 @@ void SolverBase::BeginSolve(SolverSummary* s) {
   factor_valid_ = false;
 }
 
+bool SolverBase::NextIteration(double r, Vec* x, SolverSummary* s) {
+  if (!std::isfinite(r)) {
+    *x = last_good_;
+    s->termination = Termination::kNonFinite;
+    s->message = "non-finite gradient; state restored";
+    return false;
+  }
+  if (r < options_.cutoff) {
+    s->termination = Termination::kConverged;
+    return false;
+  }
+  if (!BudgetLeft(*s)) return false;
+  ++s->iterations;
+  last_good_ = *x;
+  return true;
+}
+
+void SolverBase::Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_saddles) {
+  bool gradient_current = s->termination != Termination::kNonFinite;
+  if (!x->allFinite()) {
+    *x = last_good_;
+    s->termination = Termination::kNonFinite;
+    gradient_current = false;
+  }
+  Finish(*x, u, s, gradient_current);
+  if (leave_saddles) LeaveSaddle(u, x, s);
+  Classify(s);
+}
+
 bool SolverBase::BudgetLeft(const SolverSummary& s) const {
   if (s.iterations >= Budget()) return false;
   if (options_.max_time_us > 0.0) {
@@ -220,54 +249,31 @@ SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
   SolverSummary s;
   BeginSolve(&s);
   const bool line_search = options_.method == Method::kNewtonLineSearch;
-  Vec& x_ref = *x;
-  Vec& last_good = last_good_;  // last finite state, restored on NaN
-  last_good = x_ref;
-  double r = EvalGradient(x_ref, u, &g_, &s);
+  last_good_ = *x;
+  double r = EvalGradient(*x, u, &g_, &s);
   s.termination = Termination::kBudgetSpent;
-  while (true) {
-    if (!std::isfinite(r)) {
-      x_ref = last_good;
-      s.termination = Termination::kNonFinite;
-      s.message = "non-finite gradient; state restored";
-      break;
-    }
-    if (r < options_.cutoff) {
-      s.termination = Termination::kConverged;
-      break;
-    }
-    if (!BudgetLeft(s)) break;
-    ++s.iterations;
-    last_good = x_ref;
+  while (NextIteration(r, x, &s)) {
     if (line_search) {
-      if (!GlobalizedStep(u, &x_ref, &g_, &s)) {
+      if (!GlobalizedStep(u, x, &g_, &s)) {
         s.termination = Termination::kLinearSolverFailed;
         s.message = "no descent step found";
         break;
       }
     } else {
       // (2.18): linearise the field E_x at x_i, solve for its zero.
-      if (FactorAt(x_ref, u, &s) != LinearSolverStatus::kSuccess ||
+      if (FactorAt(*x, u, &s) != LinearSolverStatus::kSuccess ||
           factor_->Solve(g_, &dx_) != LinearSolverStatus::kSuccess) {
         s.termination = Termination::kLinearSolverFailed;
         s.message = std::string("factorisation failed: ") + factor_->message();
         break;
       }
-      x_ref -= dx_;
+      *x -= dx_;
     }
-    r = EvalGradient(x_ref, u, &g_, &s);
+    r = EvalGradient(*x, u, &g_, &s);
   }
-  bool gradient_current = s.termination != Termination::kNonFinite;
-  if (!x_ref.allFinite()) {
-    x_ref = last_good;
-    s.termination = Termination::kNonFinite;
-    gradient_current = false;
-  }
-  Finish(x_ref, u, &s, gradient_current);
   // Plain Newton (2.18) is kept as the seed's baseline: it may sit on a maximum or a
   // saddle (Fig 2.5). The globalised variant may not.
-  if (line_search) LeaveSaddle(u, &x_ref, &s);
-  Classify(&s);
+  Conclude(u, x, &s, line_search);
   return s;
 }
 

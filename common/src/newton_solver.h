@@ -41,6 +41,13 @@ class SolverBase : public EquilibriumSolver {
   // with gradient g. Returns false if no decrease could be found.
   bool GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s);
   int Budget() const;
+  // Loop head shared by every method: stops on a non-finite residual (restoring the last
+  // finite state), on convergence or when the budget is spent; otherwise counts the
+  // iteration, remembers the state and returns true.
+  bool NextIteration(double r, Vec* x, SolverSummary* s);
+  // Loop tail: restore a non-finite state, Finish(), leave a saddle (globalised methods
+  // only), Classify().
+  void Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_saddles);
   // Globalised minimisation to the cutoff past the iteration budget (a snap is finished
   // inside its control step, DESIGN.md #4). From a saddle, where the gradient vanishes,
   // it first leaves along the negative mode of E_xx (the side that lowers E).
