@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include "snapthread/models.h"
 #include "sweep.h"
 
@@ -117,6 +119,81 @@ TEST_P(FoldPlacement, CuspJumpsOn27X2EqualsMinus4Y3) {
   for (const auto& r : rows) {
     const double t = r.probe;
     EXPECT_NEAR(t * t * t + y * t + r.u[0], 0.0, 1e-5);
+  }
+}
+
+// The fold of curve2d_snap solved independently of any sweep, as a continuation code
+// would: the Moore-Spence system E_x(x, Y) = 0, E_xx(x, Y) v = 0, v_k = 1 in the
+// unknowns (x, v, Y), by Newton with a finite-difference Jacobian, started from the last
+// state before the snap.
+double Curve2dFoldY(const Model& model, double x_grasp, Vec x, Vec v, double y) {
+  const int n = model.NumStates();
+  int k = 0;
+  v.cwiseAbs().maxCoeff(&k);
+  v /= v[k];
+  SparseMatrix h = model.HessianPattern();
+  auto residual = [&](const Vec& z) {
+    Vec u(2), g;
+    u << x_grasp, z[2 * n];
+    const Vec xs = z.head(n), vs = z.segment(n, n);
+    model.Gradient(xs, u, &g);
+    model.Hessian(xs, u, &h);
+    Vec r(2 * n + 1);
+    r.head(n) = g;
+    r.segment(n, n) = h * vs;
+    r[2 * n] = vs[k] - 1.0;
+    return r;
+  };
+  Vec z(2 * n + 1);
+  z << x, v, y;
+  for (int it = 0; it < 30; ++it) {
+    const Vec r = residual(z);
+    if (r.norm() < 1e-11) break;
+    Mat jac(2 * n + 1, 2 * n + 1);
+    for (int j = 0; j < 2 * n + 1; ++j) {
+      const double d = 1e-7 * std::max(1.0, std::abs(z[j]));
+      Vec zp = z, zm = z;
+      zp[j] += d;
+      zm[j] -= d;
+      jac.col(j) = (residual(zp) - residual(zm)) / (2 * d);
+    }
+    z -= jac.fullPivLu().solve(r);
+  }
+  EXPECT_LT(residual(z).norm(), 1e-8);
+  return z[2 * n];
+}
+
+TEST(FoldPlacement, Curve2dSnapsOnTheFirstStepPastTheMooreSpenceFold) {
+  const Scene scene = LoadScene(std::string(SNAPTHREAD_TEST_SOURCE_DIR) + "/scenes/curve2d_snap.yaml");
+  for (int budget : {2, 3, 0}) {
+    Scene sc = scene;
+    sc.solver.method = Method::kHigherOrder;
+    sc.solver.max_iterations = budget;
+    auto tracker = MakeTracker(sc);
+    const double step = 0.002;
+    Vec u(2);
+    u << 9.0, 3.0;
+    tracker->Reset(u);
+    Vec x_before, v_before;
+    double y_before = 0.0, y_snap = 0.0;
+    for (int i = 1; i <= 400 && y_snap == 0.0; ++i) {
+      x_before = tracker->state();
+      y_before = u[1];
+      u[1] = 3.0 + step * i;
+      const TrackResult& r = tracker->Update(u);
+      if (r.snapped) y_snap = u[1];
+    }
+    ASSERT_GT(y_snap, 0.0) << "no snap between Y = 3.0 and 3.8";
+    // The lowest mode at the last state before the snap seeds the fold solve.
+    auto model = MakeModel(sc.params);
+    SparseMatrix h = model->HessianPattern();
+    Vec ub(2);
+    ub << 9.0, y_before;
+    model->Hessian(x_before, ub, &h);
+    Eigen::SelfAdjointEigenSolver<Mat> eig{Mat(h)};
+    const double fold = Curve2dFoldY(*model, 9.0, x_before, eig.eigenvectors().col(0), y_before);
+    EXPECT_GT(fold, y_snap - step - 1e-9) << "budget " << budget;
+    EXPECT_LE(fold, y_snap + 1e-9) << "budget " << budget;
   }
 }
 
