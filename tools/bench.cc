@@ -753,6 +753,37 @@ std::vector<Vec> HandSpeedPath(const Scene& scene) {
   return PathControls(scene, steps);
 }
 
+std::vector<SweepRow> TightTrace(const Scene& scene_in, const std::vector<Vec>& controls, int substeps,
+                                 int max_iterations) {
+  Scene scene = scene_in;
+  scene.solver.method = Method::kNewtonLineSearch;
+  scene.solver.cutoff = 1e-10;
+  scene.solver.max_iterations = max_iterations;
+  std::vector<Vec> fine{controls.front()};
+  for (size_t i = 1; i < controls.size(); ++i)
+    for (int k = 1; k <= substeps; ++k) {
+      Vec u = controls[i - 1] + (static_cast<double>(k) / substeps) * (controls[i] - controls[i - 1]);
+      if (scene.params.grip_direction) u.tail(3).normalize();
+      if (k == substeps) u = controls[i];
+      fine.push_back(u);
+    }
+  auto tracker = MakeTracker(scene);
+  const auto all = RunSweep(tracker.get(), fine);
+  std::vector<SweepRow> rows;
+  rows.reserve(controls.size());
+  bool snapped = false;
+  for (size_t j = 0; j < all.size(); ++j) {
+    snapped = snapped || all[j].snapped;
+    if (j % substeps == 0) {
+      rows.push_back(all[j]);
+      rows.back().step = static_cast<int>(j / substeps);
+      rows.back().snapped = snapped;
+      snapped = false;
+    }
+  }
+  return rows;
+}
+
 int SelectCheapest(const std::vector<AdviceCandidate>& c, double te, double tr) {
   double fastest = -1.0;
   for (const auto& x : c)
@@ -795,7 +826,7 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
   }
   const double scale = ForceScaleOf(ref_scene);
   const auto t_ref = Clock::now();
-  const auto ref = ReferenceTrace(ref_scene, path, std::max(1, o.substeps));
+  const auto ref = TightTrace(ref_scene, path, std::max(1, o.substeps), o.tight_max_iterations);
   if (progress)
     *progress << "advise: " << scene.name << ": " << path.size() << " updates along grasp.path; reference"
               << (chain ? " n=" + std::to_string(a.reference_n) : std::string()) << " in " << std::fixed
@@ -806,12 +837,7 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
     const Scene sc = chain ? ResizeChain(scene, n) : scene;
     if (chain) {
       // The model's own error: the n-segment chain solved tightly, against the fine one.
-      Scene tight = sc;
-      tight.solver.method = Method::kNewtonLineSearch;
-      tight.solver.cutoff = 1e-10;
-      tight.solver.max_iterations = 0;
-      auto tracker = MakeTracker(tight);
-      const double e = RelativeRmsForceError(RunSweep(tracker.get(), path), ref, scale);
+      const double e = RelativeRmsForceError(TightTrace(sc, path, 1, o.tight_max_iterations), ref, scale);
       a.model_errors.push_back({n, e});
       if (progress) *progress << "advise: n=" << n << ": model error " << Sci(e) << '\n' << std::flush;
       if (e > a.target_force_error) continue;

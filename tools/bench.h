@@ -198,6 +198,10 @@ struct AdvisorOptions {
   int repetitions = 3;
   double min_time_s = 0.05;  // per repetition (short sweeps are repeated)
   int substeps = 4;       // reference trace: fine steps per row
+  // Iteration cap of the tight (newton-ls, cutoff 1e-10) solves of the reference and the
+  // model-error rungs: from n ~ 200 up, round-off keeps ||E_x|| near 1e-10 and an
+  // unlimited budget would spend the 10000-iteration safety cap on every update.
+  int tight_max_iterations = 100;
   // Overrides of the scene's targets (0 = use the scene's).
   double target_force_error = 0.0;
   double target_rate_hz = 0.0;
@@ -236,6 +240,11 @@ struct Advice {
   std::vector<AdviceCandidate> candidates;    // every configuration timed
   std::string message;                        // why this choice / why none
 };
+
+// Like ReferenceTrace (newton-ls, cutoff 1e-10, `substeps` fine steps per row) with an
+// iteration cap per update instead of an unlimited budget.
+std::vector<SweepRow> TightTrace(const Scene& scene, const std::vector<Vec>& controls, int substeps,
+                                 int max_iterations);
 
 // Index of the cheapest acceptable candidate (both targets, no chatter), -1 if none is:
 // the fastest, where rates within kRateTieFraction of the fastest count as equal (noise)
