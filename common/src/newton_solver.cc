@@ -71,6 +71,19 @@ bool SolverBase::NextIteration(double r, Vec* x, SolverSummary* s) {
     return false;
   }
   if (!BudgetLeft(*s)) return false;
+  // Stagnation: |E_x| has not halved for 20 iterations although it is within 1000x of
+  // the cutoff — the cutoff is below the gradient's round-off (1e-10 on a long thread),
+  // where an unlimited budget would otherwise spin for kUnlimitedIterations. Far from
+  // the cutoff a globalised descent may legitimately crawl through a fold's bottleneck:
+  // there only 200 iterations without halving stop it.
+  if (s->iterations == 0 || r < 0.5 * best_residual_) {
+    best_residual_ = r;
+    stalled_iterations_ = 0;
+  } else if (++stalled_iterations_ >= (r < 1e3 * options_.cutoff ? 20 : 200)) {
+    s->message = "no progress in " + std::to_string(stalled_iterations_) +
+                 " iterations (residual at round-off?)";
+    return false;
+  }
   ++s->iterations;
   last_good_ = *x;
   return true;

@@ -66,6 +66,8 @@ class SolverBase : public EquilibriumSolver {
   std::unique_ptr<SymmetricLinearSolver> factor_, alt_factor_;
   bool factor_valid_ = false;
   double lambda_ref_ = -1.0;  // lambda_0 at the last regular converged state
+  double best_residual_ = 0.0;  // stagnation tracking in NextIteration
+  int stalled_iterations_ = 0;
   std::vector<int> diag_index_;  // position of (i,i) in h_.valuePtr()
   SmallestEigenpair eig_;
   Vec g_, dx_, trial_, last_good_, dx_scratch_;
