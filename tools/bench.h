@@ -190,7 +190,7 @@ bool IsChain(const Scene& scene);
 std::vector<Vec> HandSpeedPath(const Scene& scene);
 
 struct AdvisorOptions {
-  std::vector<int> n_ladder = {5, 8, 10, 15, 20, 30, 50, 80, 100};
+  std::vector<int> n_ladder = {5, 8, 10, 15, 20, 30, 50, 80};
   int reference_n = 0;  // 0: 2 x max(the scene's n, the ladder's largest); rungs >= it are dropped
   std::vector<Method> methods = {Method::kNewton, Method::kNewtonLineSearch, Method::kHigherOrder};
   std::vector<double> cutoffs = {1e-4, 1e-6, 1e-8, 1e-10};
@@ -201,7 +201,7 @@ struct AdvisorOptions {
   // Iteration cap of the tight (newton-ls, cutoff 1e-10) solves of the reference and the
   // model-error rungs: from n ~ 200 up, round-off keeps ||E_x|| near 1e-10 and an
   // unlimited budget would spend the 10000-iteration safety cap on every update.
-  int tight_max_iterations = 100;
+  int tight_max_iterations = 30;
   // Overrides of the scene's targets (0 = use the scene's).
   double target_force_error = 0.0;
   double target_rate_hz = 0.0;

@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--target-rate-hz", target_rate_hz, "advise: rate target in updates/s (overrides the scene's)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--ladder", ladder_text, "advise: segment counts to try (default 5,8,10,15,20,30,50,80,100)");
+  app.add_option("--ladder", ladder_text, "advise: segment counts to try (default 5,8,10,15,20,30,50,80; reference 160)");
   app.add_option("--reference-n", reference_n, "advise: segments of the reference model (default 2 max(n, ladder max))")
       ->check(CLI::Range(2, 100000));
   try {
