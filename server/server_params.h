@@ -6,10 +6,12 @@
 #include <cstddef>
 #include <string>
 
+#include "snapthread/transport/channels.h"
+
 namespace snapthread::server {
 
 // LCM channel names are at most 63 bytes; the longest channel suffix is 14 bytes.
-inline constexpr size_t kMaxSessionLength = 63 - 14;
+inline constexpr size_t kMaxSessionLength = transport::kMaxSessionNameLength;
 
 struct ServerParams {
   // LCM provider URL. Empty: the environment's LCM_DEFAULT_URL if set, else the loopback

@@ -163,6 +163,13 @@ TEST(TransportChannelsTest, RejectsInvalidSessionNames) {
     EXPECT_THROW(Channels{bad}, std::invalid_argument) << bad;
     EXPECT_FALSE(IsValidSessionName(bad)) << bad;
   }
+  // Every channel must stay within LCM's 63-byte channel names.
+  const std::string longest(kMaxSessionNameLength, 'S');
+  EXPECT_TRUE(IsValidSessionName(longest));
+  EXPECT_LE(Channels(longest).solver_status.size(), 63u);
+  EXPECT_LE(Channels(longest).device_status.size(), 63u);
+  EXPECT_FALSE(IsValidSessionName(longest + "S"));
+  EXPECT_THROW(Channels{longest + "S"}, std::invalid_argument);
   try {
     Channels c("bad name");
     FAIL() << "no exception";

@@ -5,7 +5,7 @@
 namespace snapthread::transport {
 
 bool IsValidSessionName(const std::string& session) {
-  if (session.empty()) return false;
+  if (session.empty() || session.size() > kMaxSessionNameLength) return false;
   for (char c : session) {
     const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') ||
                     (c >= '0' && c <= '9') || c == '_';
@@ -17,7 +17,8 @@ bool IsValidSessionName(const std::string& session) {
 Channels::Channels(const std::string& session_name) : session(session_name) {
   if (!IsValidSessionName(session_name)) {
     throw std::invalid_argument("invalid session name '" + session_name +
-                                "': expected one or more of [A-Za-z0-9_]");
+                                "': expected 1 to " + std::to_string(kMaxSessionNameLength) +
+                                " characters of [A-Za-z0-9_] (LCM channel names are at most 63 bytes)");
   }
   device_state = session + "_DEVICE_STATE";
   force_model = session + "_FORCE_MODEL";

@@ -2,6 +2,7 @@
 // prefixing every channel with the session name (shared/DESIGN.md "Messages").
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace snapthread::transport {
@@ -22,7 +23,12 @@ struct Channels {
   std::string command;        // <SESSION>_COMMAND        command_t
 };
 
-// True when `session` matches [A-Za-z0-9_]+.
+// LCM refuses channel names longer than 63 bytes (at publish time, sending nothing);
+// the longest suffix, "_SOLVER_STATUS" / "_DEVICE_STATUS", takes 14 of them.
+inline constexpr size_t kMaxSessionNameLength = 63 - 14;
+
+// True when `session` matches [A-Za-z0-9_]+ and has at most kMaxSessionNameLength
+// characters, so every channel of the session is a name LCM accepts.
 bool IsValidSessionName(const std::string& session);
 
 }  // namespace snapthread::transport
