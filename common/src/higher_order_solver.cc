@@ -253,12 +253,12 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
         snap_and_stop();
         break;
       }
-      // Approaching a fold (lambda_0 below half its reference) a Newton step must also
+      // Approaching a fold (lambda_0 below its reference) a Newton step must also
       // lower the energy; one that raises it is aimed at the saddle that is about to
       // meet the followed minimum, so this iteration uses the reduction instead.
       const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : lambda0;
       bool take_newton = true;
-      if (lambda0 < 0.5 * ref) {
+      if (lambda0 < 1.0 * ref) {
         xs_ = xr - dx_;
         take_newton = model_.Energy(xs_, u) <= model_.Energy(xr, u);
       }
