@@ -190,6 +190,23 @@ TEST(BenchTiming, TimedSweepRecordsTheSameTraceAsRunSweep) {
   EXPECT_EQ((longer.rows.back().force - plain.back().force).norm(), 0.0);
 }
 
+TEST(BenchTiming, RegularRowsLeaveOutRowsNearSnaps) {
+  std::vector<SweepRow> ref(20), trace(20);
+  for (int i = 0; i < 20; ++i) {
+    ref[i].force = Vec::Zero(2);
+    trace[i].force = Vec::Constant(2, 0.0);
+    trace[i].force[0] = 0.1;  // a uniform error of 0.1 ...
+  }
+  ref[10].snapped = true;
+  trace[11].snapped = true;  // ... and a snap one row late: a large error at row 10
+  trace[10].force[0] = 50.0;
+  // Rows 8..13 are within kSnapMargin = 2 of a snap; the rest carry the uniform 0.1.
+  EXPECT_NEAR(RegularRowsForceError(trace, ref, 2.0), 0.1 / 2.0, 1e-12);
+  // Without snaps every row counts, the late one too.
+  ref[10].snapped = trace[11].snapped = false;
+  EXPECT_NEAR(RegularRowsForceError(trace, ref, 2.0), std::sqrt((19 * 0.01 + 2500.0) / 20) / 2.0, 1e-12);
+}
+
 TEST(BenchService, JsonNumberReadsFlatFields) {
   const std::string j = "{\n  \"backend\": \"virtual-hand\",\n  \"round_trip_us_p50\": 412.5,\n"
                         "  \"round_trip_us_p99\": 1.2e3,\n  \"realtime\": false\n}\n";

@@ -193,6 +193,22 @@ TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int r
 
 // ---------------------------------------------------------------- accuracy
 
+double RegularRowsForceError(const std::vector<SweepRow>& trace, const std::vector<SweepRow>& ref, double scale) {
+  const int n = static_cast<int>(std::min(trace.size(), ref.size()));
+  std::vector<char> near(n, 0);
+  for (int i = 0; i < n; ++i)
+    if (trace[i].snapped || ref[i].snapped)
+      for (int k = std::max(0, i - kSnapMargin); k <= std::min(n - 1, i + kSnapMargin); ++k) near[k] = 1;
+  double sum2 = 0.0;
+  int count = 0;
+  for (int i = 0; i < n; ++i)
+    if (!near[i]) {
+      sum2 += (trace[i].force - ref[i].force).squaredNorm();
+      ++count;
+    }
+  return count > 0 ? std::sqrt(sum2 / count) / scale : 0.0;
+}
+
 std::vector<AccuracyRow> RunAccuracyBench(const std::string& scenes_dir, const AccuracyOptions& o,
                                           std::ostream* progress) {
   std::vector<AccuracyRow> out;
@@ -228,6 +244,7 @@ std::vector<AccuracyRow> RunAccuracyBench(const std::string& scenes_dir, const A
           row.rate_hz = t.rate_hz;
           row.force_scale = scale;
           row.stability = Compare(t.rows, ref);
+          row.force_error_rel_rms_regular = RegularRowsForceError(t.rows, ref, scale);
           row.stability.sweep = name;
           row.stability.method = m;
           row.stability.budget = budget;
@@ -260,7 +277,8 @@ void MarkParetoFronts(std::vector<AccuracyRow>* rows) {
 void WriteAccuracyCsv(const std::vector<AccuracyRow>& rows, std::ostream& out) {
   out << "sweep,method,cutoff,budget,rate_hz_median,rate_hz_min,rate_hz_max,repetitions,force_scale,"
          "force_error_rms,force_error_max,force_error_rel_rms,state_error_max,spurious_reversals,reversals,"
-         "reference_reversals,snaps,reference_snaps,snap_error_steps,gradients_per_update,hessians_per_update,pareto\n";
+         "reference_reversals,snaps,reference_snaps,snap_error_steps,gradients_per_update,hessians_per_update,pareto,"
+         "force_error_rel_rms_away_from_snaps\n";
   out << std::setprecision(6);
   for (const auto& r : rows) {
     const StabilityRow& s = r.stability;
@@ -269,24 +287,25 @@ void WriteAccuracyCsv(const std::vector<AccuracyRow>& rows, std::ostream& out) {
         << s.force_error_rms << ',' << s.force_error_max << ',' << r.RelativeForceErrorRms() << ','
         << s.state_error_max << ',' << s.spurious_reversals << ',' << s.reversals << ',' << s.reference_reversals
         << ',' << s.snaps << ',' << s.reference_snaps << ',' << s.snap_error_steps << ',' << s.mean_gradients << ','
-        << s.mean_hessians << ',' << (r.pareto ? 1 : 0) << '\n';
+        << s.mean_hessians << ',' << (r.pareto ? 1 : 0) << ',' << r.force_error_rel_rms_regular << '\n';
   }
 }
 
 void PrintAccuracyTable(const std::vector<AccuracyRow>& rows, bool pareto_only, std::ostream& out) {
   char buf[320];
-  std::snprintf(buf, sizeof buf, "%-14s %-12s %7s %6s %11s %17s %10s %10s %8s %9s %7s %6s\n", "sweep", "method",
-                "cutoff", "budget", "rate(1/s)", "rate min..max", "|dF|/Fs", "|dx|max", "chatter", "snap_err",
-                "grad/up", "front");
+  std::snprintf(buf, sizeof buf, "%-14s %-12s %7s %6s %11s %17s %10s %10s %10s %8s %9s %7s %6s\n", "sweep", "method",
+                "cutoff", "budget", "rate(1/s)", "rate min..max", "|dF|/Fs", "off-snap", "|dx|max", "chatter",
+                "snap_err", "grad/up", "front");
   out << buf;
   for (const auto& r : rows) {
     if (pareto_only && !r.pareto) continue;
     const StabilityRow& s = r.stability;
     const std::string snap = s.snap_error_steps < 0 ? "missed" : std::to_string(s.snap_error_steps);
     const std::string span = Sci(r.rate_hz.min, 1) + ".." + Sci(r.rate_hz.max, 1);
-    std::snprintf(buf, sizeof buf, "%-14s %-12s %7.0e %6s %11.3e %17s %10.2e %10.2e %8d %9s %7.2f %6s\n",
+    std::snprintf(buf, sizeof buf, "%-14s %-12s %7.0e %6s %11.3e %17s %10.2e %10.2e %10.2e %8d %9s %7.2f %6s\n",
                   r.sweep.c_str(), ToString(r.method), r.cutoff, BudgetText(r.budget).c_str(), r.rate_hz.median,
-                  span.c_str(), r.RelativeForceErrorRms(), s.state_error_max, s.spurious_reversals, snap.c_str(),
+                  span.c_str(), r.RelativeForceErrorRms(), r.force_error_rel_rms_regular, s.state_error_max,
+                  s.spurious_reversals, snap.c_str(),
                   s.mean_gradients, r.pareto ? "*" : "");
     out << buf;
   }
@@ -969,11 +988,13 @@ std::string ParetoGnuplot(const std::vector<AccuracyRow>& rows, const std::strin
   for (const auto& s : sweeps) {
     for (Method m : methods) {
       std::ofstream f(dir + "/pareto_" + s + "_" + ToString(m) + ".csv");
-      f << "rate_hz,force_error_rel_rms,state_error_max,cutoff,budget\n" << std::setprecision(6);
+      f << "rate_hz,force_error_rel_rms,state_error_max,cutoff,budget,force_error_rel_rms_away_from_snaps\n"
+        << std::setprecision(6);
       for (const auto& r : rows)
         if (r.sweep == s && r.method == m)
           f << r.rate_hz.median << ',' << std::max(r.RelativeForceErrorRms(), 1e-16) << ','
-            << std::max(r.stability.state_error_max, 1e-16) << ',' << r.cutoff << ',' << r.budget << '\n';
+            << std::max(r.stability.state_error_max, 1e-16) << ',' << r.cutoff << ',' << r.budget << ','
+            << std::max(r.force_error_rel_rms_regular, 1e-16) << '\n';
     }
     std::vector<const AccuracyRow*> front;
     for (const auto& r : rows)
@@ -985,23 +1006,27 @@ std::string ParetoGnuplot(const std::vector<AccuracyRow>& rows, const std::strin
   }
   std::ostringstream gp;
   const int n = static_cast<int>(sweeps.size());
-  gp << "set terminal pngcairo size 1400," << 380 * n + 60 << " font 'DejaVu Sans,10'\n"
+  gp << "set terminal pngcairo size 1900," << 380 * n + 60 << " font 'DejaVu Sans,10'\n"
      << "set output '" << png << "'\n"
      << "set termoption noenhanced\nset datafile separator ','\nset grid\nset key outside right top\n"
      << "set logscale x\nset logscale y\nset format x '%.0e'\nset format y '%.0e'\n"
-     << "set multiplot layout " << n << ",2 title 'Speed against accuracy on the standard sweeps "
+     << "set multiplot layout " << n << ",3 title 'Speed against accuracy on the standard sweeps "
      << "(each point: one cutoff x budget; reference newton-ls 1e-10, finer steps)'\n";
+  const char* titles[] = {": force error, all rows", ": force error away from snaps (> 2 rows)", ": state error"};
+  const char* ylabels[] = {"rms |F - F_ref| / force scale", "rms |F - F_ref| / force scale",
+                           "max |probe - probe_ref|"};
+  const int columns[] = {2, 6, 3};
   for (const auto& s : sweeps) {
-    for (int panel = 0; panel < 2; ++panel) {
-      gp << "set title '" << s << (panel == 0 ? ": force error" : ": state error") << "'\n"
+    for (int panel = 0; panel < 3; ++panel) {
+      gp << "set title '" << s << titles[panel] << "'\n"
          << "set xlabel 'updates per second (median)'\n"
-         << "set ylabel '" << (panel == 0 ? "rms |F - F_ref| / force scale" : "max |probe - probe_ref|") << "'\n"
+         << "set ylabel '" << ylabels[panel] << "'\n"
          << "plot ";
       bool first = true;
       for (Method m : methods) {
         if (!first) gp << ", ";
         first = false;
-        gp << "'" << dir << "/pareto_" << s << "_" << ToString(m) << ".csv' every ::1 using 1:" << (panel == 0 ? 2 : 3)
+        gp << "'" << dir << "/pareto_" << s << "_" << ToString(m) << ".csv' every ::1 using 1:" << columns[panel]
            << " with points pt 7 ps 0.8 lc rgb '" << MethodColor(m) << "' title '" << ToString(m) << "'";
       }
       if (panel == 0)

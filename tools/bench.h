@@ -88,8 +88,15 @@ struct AccuracyRow {
   double force_scale = 1.0;  // the model's ForceScale()
   StabilityRow stability;    // errors, chatter, snaps, cost per update
   bool pareto = false;       // on the front of its sweep (rate vs relative rms force error)
+  // rms |F - F_ref| / force_scale over the rows more than kSnapMargin rows away from every
+  // snap of the trace or the reference: the accuracy of following a branch, without the
+  // few rows where a snap one update early or late dominates the rms.
+  double force_error_rel_rms_regular = 0.0;
   double RelativeForceErrorRms() const { return stability.force_error_rms / force_scale; }
 };
+constexpr int kSnapMargin = 2;
+// The rms force error over rows away from snaps (see AccuracyRow), relative to `scale`.
+double RegularRowsForceError(const std::vector<SweepRow>& trace, const std::vector<SweepRow>& ref, double scale);
 
 std::vector<AccuracyRow> RunAccuracyBench(const std::string& scenes_dir, const AccuracyOptions& options,
                                           std::ostream* progress);
