@@ -46,16 +46,9 @@ TEST_P(StandardSweepTest, HigherOrderIsChatterFreeAndSnapsWhereTheReferenceDoes)
     SCOPED_TRACE("budget " + std::to_string(key.second));
     EXPECT_EQ(r.spurious_reversals, 0) << r.reversals << " reversals vs " << r.reference_reversals;
     ASSERT_GE(r.snap_error_steps, 0) << "a reference snap was missed";
-    // The 3D loop's return snap can come one update late when the budget ends inside
-    // the fold's bottleneck (README, "open cases"); every other sweep snaps exactly.
-    EXPECT_LE(r.snap_error_steps, sw.name == "thread3d_loop" ? 1 : 0);
-    // cusp_through passes the cusp point itself, where dT/dX is infinite: the state
-    // moves further than the jump detector's threshold in one update for every method
-    // and budget although no branch vanishes (the 10x finer reference does not).
-    if (sw.name != "cusp_through") {
-      EXPECT_LE(r.extra_snaps, sw.name == "thread3d_loop" ? 1 : 0);
-      EXPECT_EQ(r.snaps - r.extra_snaps, r.reference_snaps);
-    }
+    EXPECT_EQ(r.snap_error_steps, 0);
+    EXPECT_EQ(r.extra_snaps, 0);
+    EXPECT_EQ(r.snaps, r.reference_snaps);
   }
   // With an unlimited budget the force follows the reference trace closely. At the cusp
   // point a residual of 1e-6 leaves T uncertain by ~(1e-6)^(1/3) (the seed's Fig 2.9

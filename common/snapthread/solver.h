@@ -36,7 +36,8 @@ struct SolverOptions {
   double degeneracy_ratio = 0.1;
   // higher-order: |s*| cap in model units (DESIGN.md #3).
   double max_reduction_step = 0.5;
-  // Warm-start from the secant 2 x_{i-1} - x_{i-2} (DESIGN.md #5). Used by the tracker.
+  // Predictor for the warm start (DESIGN.md #5), used by the tracker: the tangent
+  // -E_xx^-1 E_xu du where the last state was regular, else the secant 2 x_{i-1} - x_{i-2}.
   bool secant_predictor = true;
 
   static constexpr int kUnlimitedIterations = 10000;

@@ -67,24 +67,27 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
 const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   if (u.size() != model_->NumControls())
     throw std::invalid_argument("EquilibriumTracker::Update: control size mismatch");
-  // DESIGN.md #5: warm start from the secant 2 x_{i-1} - x_{i-2}, scaled by how much of
-  // the previous control step the new one repeats (exactly the secant for equal steps),
-  // and reset after a snap.
-  // Without a secant (after a reset or a snap) use the tangent dx/du = -E_xx^-1 E_xu
-  // from the last implicit differentiation (sol_, regularised near folds): a warm start
-  // that leaves the grasped segment stretched makes E_xx indefinite there.
+  // Warm start (DESIGN.md #5). Where the last state was regular, the tangent
+  // dx/du = -E_xx^-1 E_xu from its implicit differentiation (sol_, already computed for
+  // K) is the better predictor: exact to first order without history, and unaffected
+  // by a budget-limited previous update or by the grasp turning round. Near a fold
+  // (the floored eigenvalue makes the tangent arbitrary) fall back to the secant
+  // 2 x_{i-1} - x_{i-2}, scaled by how much of the previous control step the new one
+  // repeats (the secant is reset by a snap; the tangent at the new branch is valid).
   x_pred_ = x_;
-  if (options_.secant_predictor && have_prev_) {
+  const bool tangent_ok = have_tangent_ && !result_.stiffness_regularized &&
+                          result_.summary.status != EquilibriumStatus::kNearFold;
+  if (options_.secant_predictor && tangent_ok) {
+    scratch_.noalias() = sol_ * (u - u_);
+    const double step = scratch_.lpNorm<Eigen::Infinity>();
+    const double cap = 5.0 * snap_threshold_;
+    x_pred_ -= (step > cap ? cap / step : 1.0) * scratch_;
+  } else if (options_.secant_predictor && have_prev_) {
     const double d2 = (u_ - u_prev_).squaredNorm();
     if (d2 > 0.0) {
       const double a = std::clamp((u - u_).dot(u_ - u_prev_) / d2, 0.0, 2.0);
       x_pred_ += a * (x_ - x_prev_);
     }
-  } else if (options_.secant_predictor && have_tangent_) {
-    scratch_.noalias() = sol_ * (u - u_);
-    const double step = scratch_.lpNorm<Eigen::Infinity>();
-    const double cap = 5.0 * snap_threshold_;
-    x_pred_ -= (step > cap ? cap / step : 1.0) * scratch_;
   }
   x_prev_ = x_;
   u_prev_ = u_;
