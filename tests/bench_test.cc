@@ -141,6 +141,23 @@ TEST(BenchPaths, HandSpeedControlMovesSlowlyAndStaysNearTheStart) {
   EXPECT_NEAR(s.grasp_start[1] - lo, 0.05 * total, 0.003);
 }
 
+TEST(BenchPaths, FixedLengthHandSpeedSceneKeepsTheThread) {
+  const Scene base = testing::SceneFile("thread3d_loop.yaml");
+  const double total = base.params.n * base.params.segment_length;
+  for (int n : {5, 40, 400}) {
+    const Scene s = HandSpeedScene(base, n, Method::kNewton, "auto", 1e-6, true);
+    EXPECT_EQ(s.params.n, n);
+    EXPECT_FALSE(s.params.grip_direction);
+    EXPECT_NEAR(s.params.n * s.params.segment_length, total, 1e-12);
+    EXPECT_NEAR(s.params.bending * s.params.segment_length, base.params.bending * base.params.segment_length, 1e-9);
+    EXPECT_NEAR(s.grasp_start[0], 0.9 * total, 1e-12);
+    Vec u0, u1;
+    HandSpeedControl(s, 0, &u0, 0.002 * base.params.segment_length);
+    HandSpeedControl(s, 1, &u1, 0.002 * base.params.segment_length);
+    EXPECT_NEAR((u1 - u0).norm(), 0.002 * base.params.segment_length, 1e-12);  // the hand's step, not l's
+  }
+}
+
 TEST(BenchScaling, HandSpeedUpdatesConvergeWithoutSnapping) {
   const Scene base = testing::SceneFile("thread3d_loop.yaml");
   ScalingOptions o;

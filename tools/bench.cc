@@ -313,12 +313,14 @@ void PrintAccuracyTable(const std::vector<AccuracyRow>& rows, bool pareto_only, 
 
 // ---------------------------------------------------------------- scaling
 
-Scene HandSpeedScene(const Scene& base, int n, Method method, const std::string& backend, double cutoff) {
+Scene HandSpeedScene(const Scene& base, int n, Method method, const std::string& backend, double cutoff,
+                     bool fixed_length) {
   if (base.params.model != "thread3d") throw std::invalid_argument("bench: the scaling scene must be a thread3d scene");
   Scene s = base;
+  s.params.grip_direction = false;
+  if (fixed_length) s = ResizeChain(s, n);
   s.name = base.name + "_n" + std::to_string(n);
   s.params.n = n;
-  s.params.grip_direction = false;
   const double total = n * s.params.segment_length;
   s.grasp_start = Vec(3);
   s.grasp_start << 0.9 * total, 0.1 * total, 0.05 * total;
@@ -330,12 +332,12 @@ Scene HandSpeedScene(const Scene& base, int n, Method method, const std::string&
   return s;
 }
 
-void HandSpeedControl(const Scene& scene, long i, Vec* u) {
+void HandSpeedControl(const Scene& scene, long i, Vec* u, double step) {
   if (u->size() != 3) u->resize(3);
   const double l = scene.params.segment_length;
   const double total = scene.params.n * l;
   const double a = 0.05 * total;  // amplitude of the back-and-forth in y
-  const double t = std::fmod(i * 0.002 * l, 4 * a);
+  const double t = std::fmod(i * (step > 0 ? step : 0.002 * l), 4 * a);
   const double dy = t < a ? t : (t < 3 * a ? 2 * a - t : t - 4 * a);
   (*u)[0] = scene.grasp_start[0];
   (*u)[1] = scene.grasp_start[1] + dy;
@@ -353,7 +355,7 @@ ScalingRow TimeHandSpeed(const Scene& scene, const ScalingOptions& o) {
   long i = 0;
   // Warm-up: the secant predictor needs two previous states, caches get warm.
   for (int k = 0; k < 20; ++k) {
-    HandSpeedControl(scene, ++i, &u);
+    HandSpeedControl(scene, ++i, &u, o.hand_step);
     tracker->Update(u);
   }
   std::vector<double> rates;
@@ -364,7 +366,7 @@ ScalingRow TimeHandSpeed(const Scene& scene, const ScalingOptions& o) {
     const auto t0 = Clock::now();
     double s = 0.0;
     while (true) {
-      HandSpeedControl(scene, ++i, &u);
+      HandSpeedControl(scene, ++i, &u, o.hand_step);
       const TrackResult& r = tracker->Update(u);
       ++count;
       iterations += r.summary.iterations;
@@ -391,8 +393,12 @@ ScalingRow TimeHandSpeed(const Scene& scene, const ScalingOptions& o) {
   return row;
 }
 
-std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const ScalingOptions& o, std::ostream* progress) {
+std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const ScalingOptions& options,
+                                        std::ostream* progress) {
   const Scene base = LoadScene(scenes_dir + "/thread3d_loop.yaml");
+  ScalingOptions o = options;
+  // Fixed length: the hand moves 0.002 L_base per update whatever the discretisation.
+  if (o.fixed_length && o.hand_step <= 0) o.hand_step = 0.002 * base.params.segment_length;
   std::vector<ScalingRow> rows;
   std::vector<int> ns = o.ns;
   std::sort(ns.begin(), ns.end());
@@ -417,7 +423,7 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
           }
         }
         const auto t0 = Clock::now();
-        ScalingRow r = TimeHandSpeed(HandSpeedScene(base, n, m, backend, o.cutoff), o);
+        ScalingRow r = TimeHandSpeed(HandSpeedScene(base, n, m, backend, o.cutoff, o.fixed_length), o);
         rows.push_back(r);
         last[key] = {n, 1e6 / std::max(r.rate_hz.median, 1e-9)};
         if (progress)
@@ -1040,7 +1046,7 @@ std::string ParetoGnuplot(const std::vector<AccuracyRow>& rows, const std::strin
 }
 
 std::string ScalingGnuplot(const std::vector<ScalingRow>& rows, const std::vector<ScalingFit>& fits,
-                           const std::string& dir, const std::string& png) {
+                           const std::string& dir, const std::string& png, bool fixed_length) {
   std::vector<Method> methods;
   for (const auto& r : rows)
     if (std::find(methods.begin(), methods.end(), r.method) == methods.end()) methods.push_back(r.method);
@@ -1061,7 +1067,8 @@ std::string ScalingGnuplot(const std::vector<ScalingRow>& rows, const std::vecto
      << "set logscale x\nset logscale y\nset format y '%.0e'\n"
      << "set xlabel 'n (segments)'\nset ylabel 'hand-speed updates per second'\n"
      << "set multiplot layout 1," << n << " title 'thread3d equilibrium-update rate against n (cutoff 1e-6, "
-     << "0.002 L per update in y); error bars: min..max over repetitions'\n";
+     << (fixed_length ? "fixed total length 10 L, 0.002 L per update in y" : "n segments of length L, 0.002 L per update in y")
+     << "); error bars: min..max over repetitions'\n";
   for (Method m : methods) {
     gp << "set title '" << ToString(m) << "'\nplot ";
     bool first = true;

@@ -117,6 +117,11 @@ struct ScalingOptions {
   // Larger n is skipped for a method/backend once an update took longer than this.
   double max_update_us = 20000.0;
   double cutoff = 1e-6;
+  // false (the set-up): n segments of the base scene's L, the thread grows with n.
+  // true: the base scene's total length for every n (ResizeChain), the hand step stays
+  // 0.002 L_base: the same physical thread, finer discretisations.
+  bool fixed_length = false;
+  double hand_step = 0.0;  // model units per update; 0 = 0.002 x the scene's segment length
 };
 
 struct ScalingRow {
@@ -130,13 +135,15 @@ struct ScalingRow {
   int snaps = 0;                   // should be 0: the path stays away from folds
 };
 
-// The hand-speed scene: thread3d with n segments of the base scene's segment length L,
-// no grip direction, grasp at (0.9 nL, 0.1 nL, 0.05 nL), the given cutoff, unlimited
+// The hand-speed scene: thread3d with n segments of the base scene's segment length L
+// (fixed_length: n segments of the base scene's total length, see ResizeChain), no grip
+// direction, grasp at (0.9, 0.1, 0.05) x the total length, the given cutoff, unlimited
 // iterations (each update converges).
-Scene HandSpeedScene(const Scene& thread3d_base, int n, Method method, const std::string& backend, double cutoff);
-// Control of hand-speed update i: y moves 0.002 L per update, back and forth over
-// +-0.05 nL (a triangle wave) so long runs stay near the start.
-void HandSpeedControl(const Scene& scene, long i, Vec* u);
+Scene HandSpeedScene(const Scene& thread3d_base, int n, Method method, const std::string& backend, double cutoff,
+                     bool fixed_length = false);
+// Control of hand-speed update i: y moves `step` per update (0: 0.002 L), back and forth
+// over +-0.05 x the total length (a triangle wave) so long runs stay near the start.
+void HandSpeedControl(const Scene& scene, long i, Vec* u, double step = 0.0);
 ScalingRow TimeHandSpeed(const Scene& scene, const ScalingOptions& options);
 
 std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const ScalingOptions& options,
@@ -273,6 +280,6 @@ bool RunGnuplot(const std::string& script_path);
 // next to them.
 std::string ParetoGnuplot(const std::vector<AccuracyRow>& rows, const std::string& csv_dir, const std::string& png);
 std::string ScalingGnuplot(const std::vector<ScalingRow>& rows, const std::vector<ScalingFit>& fits,
-                           const std::string& csv_dir, const std::string& png);
+                           const std::string& csv_dir, const std::string& png, bool fixed_length = false);
 
 }  // namespace snapthread

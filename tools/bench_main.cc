@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
               bin_dir = ExeDir(), advise, methods_text, cutoffs_text, budgets_text, ns_text, backends_text,
               sweeps_text, ladder_text, service_scenes;
   std::vector<std::string> sets;
-  bool quick = false, no_plot = false;
+  bool quick = false, no_plot = false, fixed_length = false;
   int repetitions = 0, reference_n = 0;
   double service_duration = 0.0, target_force_error = 0.0, target_rate_hz = 0.0;
   app.add_flag("--quick", quick, "small grids, one repetition, short service run (for development)");
@@ -116,6 +116,8 @@ int main(int argc, char** argv) {
   app.add_option("--budgets", budgets_text, "accuracy/advise: iteration budgets, inf = unlimited (default 1,2,3,5,10,inf)");
   app.add_option("--sweeps", sweeps_text, "accuracy: standard sweeps (default zeeman_folds,cusp_folds,curve2d_snap,thread3d_loop)");
   app.add_option("--ns", ns_text, "scaling: segment counts (default 5,10,20,50,100,200,500,1000,2000)");
+  app.add_flag("--fixed-length", fixed_length,
+               "scaling: keep the thread's total length (finer segments) instead of n segments of length L");
   app.add_option("--backends", backends_text, "scaling: linear solvers (default auto,banded,cholmod,dense)");
   app.add_option("--service-scenes", service_scenes, "service: scene names (default curve2d_snap,thread3d_loop)");
   app.add_option("--service-duration", service_duration, "service: seconds per run (default 10, quick 3)")
@@ -220,19 +222,21 @@ int main(int argc, char** argv) {
       if (!methods_text.empty()) o.methods = ParseMethods(methods_text);
       if (!backends_text.empty()) o.backends = Split(backends_text);
       if (repetitions > 0) o.repetitions = repetitions;
+      o.fixed_length = fixed_length;
       const auto rows = RunScalingBench(scenes_dir, o, &std::cerr);
       const auto fits = FitScaling(rows);
       std::ofstream csv(fs::path(out_dir) / "scaling.csv");
       WriteScalingCsv(rows, csv);
       std::ostringstream table;
-      table << "== scaling: thread3d hand-speed update rate (median of " << o.repetitions << " repetitions)\n";
+      table << "== scaling: thread3d hand-speed update rate (median of " << o.repetitions << " repetitions; "
+            << (fixed_length ? "fixed total length" : "n segments of length L") << ")\n";
       PrintScalingTable(rows, fits, table);
       PrintScalingTargets(rows, fits, table);
       std::cout << table.str();
       summary << table.str() << '\n';
       if (!no_plot) {
         const std::string script = (fs::path(out_dir) / "bench_scaling.gp").string();
-        std::ofstream(script) << ScalingGnuplot(rows, fits, out_abs, out_abs + "/bench_scaling.png");
+        std::ofstream(script) << ScalingGnuplot(rows, fits, out_abs, out_abs + "/bench_scaling.png", fixed_length);
         plots_ok = RunGnuplot(script) && plots_ok;
       }
     }
