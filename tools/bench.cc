@@ -918,8 +918,18 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
     // Fast enough but every fast configuration is too inaccurate: a finer model may help.
   }
   std::ostringstream msg;
-  msg << "no configuration meets both targets: no n in the ladder (up to " << ladder.back()
-      << ") reaches a force error of " << Sci(a.target_force_error) << " with a fast enough configuration";
+  msg << "no configuration meets both targets: ";
+  if (chain) {
+    const ModelErrorRow* best = nullptr;
+    for (const auto& m : a.model_errors)
+      if (!best || m.force_error < best->force_error) best = &m;
+    msg << "along the ladder (up to n = " << ladder.back() << ") the smallest model error is "
+        << Sci(best ? best->force_error : 0.0) << " (n = " << (best ? best->n : 0) << ")";
+    if (!a.candidates.empty()) msg << "; where the model was fine enough, no fast configuration was accurate enough";
+    msg << ", target " << Sci(a.target_force_error);
+  } else {
+    msg << "no fast enough configuration reaches a force error of " << Sci(a.target_force_error);
+  }
   a.message = msg.str();
   return a;
 }
