@@ -313,6 +313,16 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
     }
   }
   Conclude(u, x, &s, /*leave_saddles=*/true);
+  // The budget ran out on an indefinite E_xx: the state
+  // is past the fold, where the followed minimum no longer exists. Finish the snap in
+  // this update (DESIGN.md #4) instead of crawling over the next ones. (If a minimum is
+  // right there after all, the minimiser simply converges to it: no jump, no snap.)
+  if (s.termination == Termination::kBudgetSpent && s.negative_pivots > 0) {
+    s.snapped = true;
+    if (MinimizeFully(u, x, &s)) s.termination = Termination::kConverged;
+    Finish(*x, u, &s);
+    Classify(&s);
+  }
   return s;
 }
 
