@@ -266,7 +266,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       }
     }
     if (!degenerate) {
-      xr -= dx_;
+      TakeNewtonStep(&xr);
       // Where E_xx is regular Newton converges quadratically; a step that does not
       // even halve |E_x| says the quadratic model has failed (a fold is close): the
       // next iteration uses the reduction.

@@ -57,6 +57,18 @@ void SolverBase::BeginSolve(SolverSummary* s) {
   *s = SolverSummary{};
   start_ = Clock::now();
   factor_valid_ = false;
+  factor_before_tiny_step_ = false;
+}
+
+// A Newton step this small (model length units) changes E_xx by a relative O(1e-6):
+// the factorisation at the state before it still serves K (error O(step)) and the
+// inertia, and the update saves a Hessian assembly and factorisation — at n = 10 about a
+// third of its cost. Near folds steps are far larger and the factor is always fresh.
+constexpr double kReuseStep = 1e-6;
+
+void SolverBase::TakeNewtonStep(Vec* x) {
+  *x -= dx_;
+  factor_before_tiny_step_ = dx_.lpNorm<Eigen::Infinity>() <= kReuseStep;
 }
 
 bool SolverBase::NextIteration(double r, Vec* x, SolverSummary* s) {
@@ -122,6 +134,7 @@ LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummar
   ++s->factorizations;
   const LinearSolverStatus st = factor_->Factorize(h_);
   factor_valid_ = st == LinearSolverStatus::kSuccess;
+  factor_before_tiny_step_ = false;
   return st;
 }
 
@@ -193,8 +206,10 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradi
   s->residual = gradient_current ? g_.norm() : EvalGradient(x, u, &g_, s);
   s->energy = model_.Energy(x, u);
   // The factorisation at the returned state serves implicit differentiation (K) and
-  // the eigenvalue estimate.
-  const LinearSolverStatus st = FactorAt(x, u, s);
+  // the eigenvalue estimate (or the one before a tiny last Newton step, kReuseStep).
+  const LinearSolverStatus st =
+      (factor_before_tiny_step_ && factor_valid_) ? LinearSolverStatus::kSuccess : FactorAt(x, u, s);
+  factor_before_tiny_step_ = false;
   if (st == LinearSolverStatus::kSuccess) {
     s->negative_pivots = factor_->NegativePivots();
     // Two warm-started steps track the eigenpair; a cold start or a new branch needs more.
@@ -280,7 +295,7 @@ SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
         s.message = std::string("factorisation failed: ") + factor_->message();
         break;
       }
-      *x -= dx_;
+      TakeNewtonStep(x);
     }
     r = EvalGradient(*x, u, &g_, &s);
   }

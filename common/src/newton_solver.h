@@ -41,6 +41,9 @@ class SolverBase : public EquilibriumSolver {
   // with gradient g. Returns false if no decrease could be found.
   bool GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s);
   int Budget() const;
+  // Takes the plain Newton step x -= dx_ (factor_ is E_xx at x) and records whether it
+  // was small enough for Finish() to keep using factor_.
+  void TakeNewtonStep(Vec* x);
   // Loop head shared by every method: stops on a non-finite residual (restoring the last
   // finite state), on convergence or when the budget is spent; otherwise counts the
   // iteration, remembers the state and returns true.
@@ -65,6 +68,9 @@ class SolverBase : public EquilibriumSolver {
   SparseMatrix h_, h_mod_;
   std::unique_ptr<SymmetricLinearSolver> factor_, alt_factor_;
   bool factor_valid_ = false;
+  // factor_ holds E_xx at the state before the last, tiny, plain Newton step: Finish()
+  // may use it instead of factorising again (see kReuseStep in newton_solver.cc).
+  bool factor_before_tiny_step_ = false;
   double lambda_ref_ = -1.0;  // lambda_0 at the last regular converged state
   double best_residual_ = 0.0;  // stagnation tracking in NextIteration
   int stalled_iterations_ = 0;
