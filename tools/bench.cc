@@ -778,35 +778,9 @@ std::vector<Vec> HandSpeedPath(const Scene& scene) {
   return PathControls(scene, steps);
 }
 
-std::vector<SweepRow> TightTrace(const Scene& scene_in, const std::vector<Vec>& controls, int substeps,
+std::vector<SweepRow> TightTrace(const Scene& scene, const std::vector<Vec>& controls, int substeps,
                                  int max_iterations) {
-  Scene scene = scene_in;
-  scene.solver.method = Method::kNewtonLineSearch;
-  scene.solver.cutoff = 1e-10;
-  scene.solver.max_iterations = max_iterations;
-  std::vector<Vec> fine{controls.front()};
-  for (size_t i = 1; i < controls.size(); ++i)
-    for (int k = 1; k <= substeps; ++k) {
-      Vec u = controls[i - 1] + (static_cast<double>(k) / substeps) * (controls[i] - controls[i - 1]);
-      if (scene.params.grip_direction) u.tail(3).normalize();
-      if (k == substeps) u = controls[i];
-      fine.push_back(u);
-    }
-  auto tracker = MakeTracker(scene);
-  const auto all = RunSweep(tracker.get(), fine);
-  std::vector<SweepRow> rows;
-  rows.reserve(controls.size());
-  bool snapped = false;
-  for (size_t j = 0; j < all.size(); ++j) {
-    snapped = snapped || all[j].snapped;
-    if (j % substeps == 0) {
-      rows.push_back(all[j]);
-      rows.back().step = static_cast<int>(j / substeps);
-      rows.back().snapped = snapped;
-      snapped = false;
-    }
-  }
-  return rows;
+  return ReferenceTrace(scene, controls, substeps, max_iterations);
 }
 
 int SelectCheapest(const std::vector<AdviceCandidate>& c, double te, double tr) {

@@ -70,11 +70,12 @@ std::vector<StandardSweep> StandardSweeps(const std::string& dir) {
   return s;
 }
 
-std::vector<SweepRow> ReferenceTrace(const Scene& scene_in, const std::vector<Vec>& controls, int substeps) {
+std::vector<SweepRow> ReferenceTrace(const Scene& scene_in, const std::vector<Vec>& controls, int substeps,
+                                     int max_iterations) {
   Scene scene = scene_in;
   scene.solver.method = Method::kNewtonLineSearch;
   scene.solver.cutoff = 1e-10;
-  scene.solver.max_iterations = 0;
+  scene.solver.max_iterations = max_iterations;
   std::vector<Vec> fine{controls.front()};
   for (size_t i = 1; i < controls.size(); ++i)
     for (int k = 1; k <= substeps; ++k) {

@@ -39,9 +39,11 @@ struct StabilityRow {
   double mean_gradients = 0.0, mean_hessians = 0.0, mean_us = 0.0;  // per update
 };
 
-// Reference: newton-ls, cutoff 1e-10, unlimited iterations, `substeps` fine steps
-// between rows (only the rows are kept).
-std::vector<SweepRow> ReferenceTrace(const Scene& scene, const std::vector<Vec>& controls, int substeps);
+// Reference: newton-ls, cutoff 1e-10, `max_iterations` per update (0 = unlimited),
+// `substeps` fine steps between rows (only the rows are kept; a row is snapped when any
+// fine step since the previous row snapped).
+std::vector<SweepRow> ReferenceTrace(const Scene& scene, const std::vector<Vec>& controls, int substeps,
+                                     int max_iterations = 0);
 
 // Compares a trace with the reference trace of the same rows.
 StabilityRow Compare(const std::vector<SweepRow>& trace, const std::vector<SweepRow>& ref);
