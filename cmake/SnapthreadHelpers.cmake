@@ -3,7 +3,7 @@
 function(snapthread_add_test name)
   cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
-  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main)
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main snapthread::warnings)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
@@ -21,4 +21,21 @@ function(snapthread_add_test name)
                # list), so it goes through ENVIRONMENT_MODIFICATION.
                ENVIRONMENT_MODIFICATION "SNAPTHREAD_BIN_DIR=set:${PROJECT_BINARY_DIR}/bin"
     DISCOVERY_TIMEOUT 60)
+endfunction()
+
+# The one warnings target: strict warnings as errors on the project's own code only
+# (third-party headers come in as SYSTEM includes and are not affected).
+if(NOT TARGET snapthread_warnings)
+  add_library(snapthread_warnings INTERFACE)
+  add_library(snapthread::warnings ALIAS snapthread_warnings)
+  target_compile_options(snapthread_warnings INTERFACE -Wall -Wextra -Wpedantic -Werror)
+endif()
+
+# snapthread_project_code(TARGET): a library or program of this project (warnings, PIC).
+function(snapthread_project_code target)
+  target_link_libraries(${target} PRIVATE snapthread::warnings)
+  get_target_property(_type ${target} TYPE)
+  if(_type STREQUAL "STATIC_LIBRARY")
+    set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  endif()
 endfunction()

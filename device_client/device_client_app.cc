@@ -22,12 +22,12 @@
 #include "snapthread/device_state_t.hpp"
 #include "snapthread/device_status_t.hpp"
 #include "snapthread/force_model_t.hpp"
-#include "snapthread/scene.h"
-#include "snapthread/transport/channels.h"
-#include "snapthread/transport/clock.h"
-#include "snapthread/transport/lcm_url.h"
-#include "snapthread/transport/percentiles.h"
-#include "snapthread/transport/validate.h"
+#include "scene/scene.h"
+#include "messages/channels.h"
+#include "realtime/clock.h"
+#include "messages/lcm_url.h"
+#include "realtime/percentiles.h"
+#include "messages/validate.h"
 
 namespace snapthread::device {
 namespace {

@@ -1,7 +1,7 @@
 #include "device_factory.h"
 
 #include "sim_path_device.h"
-#include "snapthread/transport/clock.h"
+#include "realtime/clock.h"
 #if SNAPTHREAD_HAVE_PHANTOM
 #include "phantom_device.h"
 #endif

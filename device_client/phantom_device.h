@@ -13,7 +13,7 @@
 #include <HD/hd.h>
 
 #include "haptic_device.h"
-#include "snapthread/transport/latest_value.h"
+#include "realtime/latest_value.h"
 
 namespace snapthread::device {
 

@@ -6,7 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "snapthread/transport/validate.h"
+#include "messages/validate.h"
 
 namespace snapthread::device {
 

@@ -19,7 +19,7 @@
 
 #include "haptic_device.h"
 #include "snapthread/force_model_t.hpp"
-#include "snapthread/scene.h"
+#include "scene/scene.h"
 
 namespace snapthread::device {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "snapthread/scene.h"
+#include "scene/scene.h"
 
 namespace snapthread::device {
 

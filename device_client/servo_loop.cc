@@ -10,7 +10,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "snapthread/transport/clock.h"
+#include "realtime/clock.h"
 
 namespace snapthread::device {
 

@@ -13,8 +13,8 @@
 
 #include "haptic_device.h"
 #include "safety.h"
-#include "snapthread/transport/latest_value.h"
-#include "snapthread/transport/spsc_ring.h"
+#include "realtime/latest_value.h"
+#include "realtime/spsc_ring.h"
 
 namespace snapthread::device {
 

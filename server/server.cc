@@ -9,12 +9,12 @@
 
 #include <spdlog/spdlog.h>
 
-#include "pose_mapping.h"
+#include "messages/pose_mapping.h"
 #include "server_messages.h"
-#include "snapthread/models.h"
-#include "snapthread/transport/clock.h"
-#include "snapthread/transport/lcm_url.h"
-#include "snapthread/transport/validate.h"
+#include "models/models.h"
+#include "realtime/clock.h"
+#include "messages/lcm_url.h"
+#include "messages/validate.h"
 
 namespace snapthread::server {
 namespace {

@@ -28,10 +28,10 @@
 
 #include "server_inbox.h"
 #include "server_params.h"
-#include "snapthread/scene.h"
-#include "snapthread/tracker.h"
-#include "snapthread/transport/channels.h"
-#include "snapthread/transport/percentiles.h"
+#include "scene/scene.h"
+#include "tracking/tracker.h"
+#include "messages/channels.h"
+#include "realtime/percentiles.h"
 
 namespace snapthread::server {
 

@@ -20,7 +20,7 @@
 
 #include "server.h"
 #include "server_params.h"
-#include "snapthread/scene.h"
+#include "scene/scene.h"
 
 namespace {
 

@@ -5,7 +5,7 @@
 
 #include <Eigen/Geometry>
 
-#include "pose_mapping.h"
+#include "messages/pose_mapping.h"
 
 namespace snapthread::server {
 namespace {

@@ -9,12 +9,12 @@
 #include <Eigen/Core>
 
 #include "snapthread/force_model_t.hpp"
-#include "snapthread/model.h"
-#include "snapthread/scene.h"
+#include "models/model.h"
+#include "scene/scene.h"
 #include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
-#include "snapthread/tracker.h"
-#include "snapthread/types.h"
+#include "tracking/tracker.h"
+#include "numeric/types.h"
 
 namespace snapthread::server {
 

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "snapthread/solver.h"
-#include "snapthread/transport/channels.h"
+#include "solvers/solver.h"
+#include "messages/channels.h"
 
 namespace snapthread::server {
 namespace {

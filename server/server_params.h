@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <string>
 
-#include "snapthread/transport/channels.h"
+#include "messages/channels.h"
 
 namespace snapthread::server {
 

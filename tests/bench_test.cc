@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "bench.h"
-#include "snapthread/models.h"
+#include "models/models.h"
 #include "test_util.h"
 
 namespace snapthread {
@@ -343,8 +343,9 @@ TEST(BenchAdvisor, PicksTheSmallestModelAndCheapestConfigurationOrReportsNone) {
   ASSERT_EQ(a.candidates.size(), 2u * 2u * 2u);
   for (const auto& c : a.candidates) {
     EXPECT_EQ(c.n, 16);
-    if (c.Acceptable(o.target_force_error, o.target_rate_hz))
+    if (c.Acceptable(o.target_force_error, o.target_rate_hz)) {
       EXPECT_LE(c.rate_hz, a.choice.rate_hz / (1.0 - kRateTieFraction));
+    }
   }
 
   // The same accuracy at an unreachable rate: reported, with the evidence.

@@ -6,7 +6,7 @@
 
 #include <Eigen/Dense>
 
-#include "snapthread/models.h"
+#include "models/models.h"
 #include "sweep.h"
 
 namespace snapthread {

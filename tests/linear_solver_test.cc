@@ -17,8 +17,8 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include "snapthread/linear_solver.h"
-#include "snapthread/models.h"
+#include "linalg/linear_solver.h"
+#include "models/models.h"
 
 // ---------------------------------------------------------------------------------
 // Allocation counting. glibc lets a program replace malloc; the replacements forward

@@ -22,7 +22,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
-#include "snapthread/models.h"
+#include "models/models.h"
 
 // ---------------------------------------------------------------------------------
 // Allocation counting (Drake's LimitMalloc idea): this test binary interposes glibc's

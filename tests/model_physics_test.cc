@@ -11,7 +11,7 @@
 
 #include <Eigen/Dense>
 
-#include "snapthread/models.h"
+#include "models/models.h"
 
 namespace snapthread {
 namespace {

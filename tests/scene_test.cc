@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "snapthread/scene.h"
+#include "scene/scene.h"
 #include "test_util.h"
 
 namespace snapthread {

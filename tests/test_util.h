@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "snapthread/scene.h"
+#include "scene/scene.h"
 
 namespace snapthread::testing {
 

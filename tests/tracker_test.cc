@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "snapthread/models.h"
-#include "snapthread/tracker.h"
+#include "models/models.h"
+#include "tracking/tracker.h"
 #include "sweep.h"
 
 namespace snapthread {

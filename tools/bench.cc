@@ -20,7 +20,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "snapthread/models.h"
+#include "models/models.h"
 
 extern char** environ;
 

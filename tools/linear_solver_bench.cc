@@ -1,7 +1,7 @@
 // snapthread-linear-bench: Factorize + Solve time of each LDL^T backend on banded SPD
 // matrices with the bandwidth of a 3-D thread chain (thread3d couples nodes up to two
 // apart, 3 coordinates per node: half-bandwidth 2*3 + 2 = 8), for growing n. The
-// numbers set the "auto" rule in common/src/linear_solver.cc. With --thread3d the
+// numbers set the "auto" rule in common/linalg/linear_solver.cc. With --thread3d the
 // matrices are real thread3d Hessians instead (n is then the number of segments; the
 // thread is compressed to 80% so the Hessian is indefinite, as near a buckle).
 //
@@ -17,8 +17,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "snapthread/linear_solver.h"
-#include "snapthread/models.h"
+#include "linalg/linear_solver.h"
+#include "models/models.h"
 
 namespace snapthread {
 namespace {

@@ -5,7 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "snapthread/models.h"
+#include "models/models.h"
 
 namespace snapthread {
 

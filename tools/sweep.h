@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "snapthread/scene.h"
-#include "snapthread/tracker.h"
+#include "scene/scene.h"
+#include "tracking/tracker.h"
 
 namespace snapthread {
 

@@ -1,9 +1,9 @@
 #include "grasp_publisher.h"
 
 #include "snapthread/device_state_t.hpp"
-#include "snapthread/transport/channels.h"
-#include "snapthread/transport/clock.h"
-#include "snapthread/transport/validate.h"
+#include "messages/channels.h"
+#include "realtime/clock.h"
+#include "messages/validate.h"
 
 namespace snapthread::viewer {
 

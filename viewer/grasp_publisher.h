@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 #include <lcm/lcm-cpp.hpp>
 
-#include "snapthread/scene.h"
+#include "scene/scene.h"
 
 namespace snapthread::viewer {
 

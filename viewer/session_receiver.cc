@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "shape_check.h"
-#include "snapthread/transport/channels.h"
+#include "messages/channels.h"
 
 namespace snapthread::viewer {
 

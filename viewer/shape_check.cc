@@ -1,6 +1,6 @@
 #include "shape_check.h"
 
-#include "snapthread/transport/validate.h"
+#include "messages/validate.h"
 
 namespace snapthread::viewer {
 

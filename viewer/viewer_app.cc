@@ -17,8 +17,8 @@
 #include "png_writer.h"
 #include "renderer.h"
 #include "session_receiver.h"
-#include "snapthread/scene.h"
-#include "snapthread/transport/lcm_url.h"
+#include "scene/scene.h"
+#include "messages/lcm_url.h"
 
 namespace snapthread::viewer {
 namespace {

@@ -4,8 +4,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "snapthread/transport/channels.h"
-#include "snapthread/transport/lcm_url.h"
+#include "messages/channels.h"
+#include "messages/lcm_url.h"
 #include "viewer_app.h"
 
 int main(int argc, char** argv) {

@@ -33,8 +33,8 @@
 
 #include <lcm/lcm-cpp.hpp>
 
-#include "snapthread/transport/channels.h"
-#include "snapthread/transport/validate.h"
+#include "messages/channels.h"
+#include "messages/validate.h"
 
 extern char** environ;
 

@@ -12,7 +12,7 @@
 #include "safety.h"
 #include "scripted_path.h"
 #include "sim_path_device.h"
-#include "snapthread/scene.h"
+#include "scene/scene.h"
 #include "virtual_hand_device.h"
 
 namespace snapthread::device {

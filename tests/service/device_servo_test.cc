@@ -12,7 +12,7 @@
 #include "scripted_path.h"
 #include "servo_loop.h"
 #include "sim_path_device.h"
-#include "snapthread/transport/clock.h"
+#include "realtime/clock.h"
 
 namespace snapthread::device {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "safety.h"
-#include "snapthread/transport/percentiles.h"
+#include "realtime/percentiles.h"
 #include "servo_loop.h"
 #include "sim_path_device.h"
 #include "virtual_hand_device.h"

@@ -26,10 +26,10 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "pose_mapping.h"
-#include "snapthread/models.h"
-#include "snapthread/scene.h"
-#include "snapthread/tracker.h"
+#include "messages/pose_mapping.h"
+#include "models/models.h"
+#include "scene/scene.h"
+#include "tracking/tracker.h"
 
 extern char** environ;
 

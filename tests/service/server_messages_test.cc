@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include "pose_mapping.h"
+#include "messages/pose_mapping.h"
 #include "server_messages.h"
-#include "snapthread/models.h"
-#include "snapthread/transport/validate.h"
+#include "models/models.h"
+#include "messages/validate.h"
 
 namespace snapthread::server {
 namespace {

@@ -19,13 +19,13 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "pose_mapping.h"
+#include "messages/pose_mapping.h"
 #include "server.h"
 #include "server_messages.h"
-#include "snapthread/models.h"
-#include "snapthread/scene.h"
-#include "snapthread/tracker.h"
-#include "snapthread/transport/validate.h"
+#include "models/models.h"
+#include "scene/scene.h"
+#include "tracking/tracker.h"
+#include "messages/validate.h"
 
 namespace snapthread::server {
 namespace {
@@ -338,7 +338,9 @@ TEST_F(ServerTest, ThreadGripDirectionFromOrientation) {
     force_model_t m;
     ASSERT_TRUE(probe_->WaitModel(static_cast<int64_t>(i), &m));
     const Vec u = PoseToControls(scene.device, model, poses[i], q, rest);
-    if (i < 20) EXPECT_NEAR((u.segment<3>(3) - rest).norm(), 0.0, 1e-15);
+    if (i < 20) {
+      EXPECT_NEAR((u.segment<3>(3) - rest).norm(), 0.0, 1e-15);
+    }
     const TrackResult& r = direct.Update(u);
     if (r.snapped) ++direct_snaps;
     ASSERT_NE(m.status, force_model_t::STATUS_INVALID);

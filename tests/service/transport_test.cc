@@ -15,13 +15,13 @@
 
 #include <lcm/lcm-cpp.hpp>
 
-#include "snapthread/transport/channels.h"
-#include "snapthread/transport/clock.h"
-#include "snapthread/transport/latest_value.h"
-#include "snapthread/transport/lcm_url.h"
-#include "snapthread/transport/percentiles.h"
-#include "snapthread/transport/spsc_ring.h"
-#include "snapthread/transport/validate.h"
+#include "messages/channels.h"
+#include "realtime/clock.h"
+#include "realtime/latest_value.h"
+#include "messages/lcm_url.h"
+#include "realtime/percentiles.h"
+#include "realtime/spsc_ring.h"
+#include "messages/validate.h"
 
 namespace snapthread::transport {
 namespace {

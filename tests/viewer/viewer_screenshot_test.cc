@@ -14,10 +14,10 @@
 #include "grasp_publisher.h"
 #include "hud_layout.h"
 #include "snapthread/device_state_t.hpp"
-#include "snapthread/scene.h"
+#include "scene/scene.h"
 #include "orbit_camera.h"
 #include "snapthread/thread_shape_t.hpp"
-#include "snapthread/transport/channels.h"
+#include "messages/channels.h"
 #include "spline.h"
 #include "test_support.h"
 

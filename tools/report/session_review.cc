@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "snapthread/transport/validate.h"
+#include "messages/validate.h"
 
 namespace snapthread::report {
 namespace {

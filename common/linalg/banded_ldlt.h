@@ -1,0 +1,44 @@
+// Band LDL^T without pivoting, for chains (curve2d, thread3d: E_xx couples each node
+// with its neighbours only, so its half-bandwidth b is a small constant).
+//
+// Storage is row-band: column i of a (b+1) x n column-major array holds
+// [L(i,i-b) ... L(i,i-1), d_i], so the dot products of the factorisation and of both
+// triangular solves run over contiguous memory. O(n b^2) factorisation, O(n b) solve,
+// no allocation after Analyze() (Solve() allocates only if *x has the wrong size).
+//
+// Without pivoting the factorisation exists iff every leading principal minor is
+// non-zero; for a symmetric matrix this is enough for indefinite Hessians (the
+// higher-order solver needs their inertia), and a zero / non-finite pivot is reported
+// as kNumericalIssue.
+#pragma once
+
+#include <string_view>
+
+#include "linalg/ldlt_support.h"
+#include "linalg/linear_solver.h"
+
+namespace snapthread {
+
+class BandedLdlt final : public SymmetricLinearSolver {
+ public:
+  std::string_view Name() const override { return "banded"; }
+  LinearSolverStatus Analyze(const SparseMatrix& a) override;
+  LinearSolverStatus Factorize(const SparseMatrix& a) override;
+  LinearSolverStatus Solve(const Vec& b, Vec* x) const override;
+  int NegativePivots() const override { return negative_pivots_; }
+  double MinAbsPivot() const override { return min_abs_pivot_; }
+
+  // Half-bandwidth max |i - j| of the analysed pattern (-1 before Analyze()).
+  int HalfBandwidth() const { return bandwidth_; }
+
+ private:
+  internal::PatternCopy pattern_;
+  int n_ = 0;
+  int bandwidth_ = -1;
+  Mat band_;  // (b+1) x n, see the file comment
+  bool factorized_ = false;
+  int negative_pivots_ = 0;
+  double min_abs_pivot_ = 0.0;
+};
+
+}  // namespace snapthread

@@ -1,0 +1,60 @@
+// Sparse symmetric (possibly indefinite) LDL^T factorisation behind one interface,
+// after Ceres' SparseCholesky and libigl's precompute/solve split: Analyze() once per
+// sparsity pattern, then Factorize() (numeric only) and Solve() each step.
+//
+// Numeric code reports status (Eigen style), it never throws.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "numeric/types.h"
+
+namespace snapthread {
+
+enum class LinearSolverStatus {
+  kSuccess,
+  kNumericalIssue,  // zero / non-finite pivot: the matrix is singular to working precision
+  kInvalidInput,    // wrong size, pattern differs from the analysed one, not analysed
+};
+const char* ToString(LinearSolverStatus s);
+
+class SymmetricLinearSolver {
+ public:
+  virtual ~SymmetricLinearSolver() = default;
+  virtual std::string_view Name() const = 0;
+
+  // Symbolic analysis of a full symmetric pattern (both triangles stored; a pattern that
+  // is not structurally symmetric is kInvalidInput). Allocates.
+  virtual LinearSolverStatus Analyze(const SparseMatrix& a) = 0;
+  // Numeric LDL^T of a matrix with the analysed pattern. Every backend reads only the
+  // values of the lower triangle. Does not allocate after the first call for a pattern
+  // (backends that cannot promise this say so in Name()).
+  virtual LinearSolverStatus Factorize(const SparseMatrix& a) = 0;
+  // x = A^-1 b with the last successful factorisation. x may alias nothing.
+  virtual LinearSolverStatus Solve(const Vec& b, Vec* x) const = 0;
+
+  // Inertia from the pivots of D in A = L D L^T (Sylvester's law of inertia): the
+  // number of negative eigenvalues of A (valid after a successful Factorize()).
+  virtual int NegativePivots() const = 0;
+  // Smallest |d_ii|: a cheap singularity indicator.
+  virtual double MinAbsPivot() const = 0;
+
+  // Text of the last failure ("" after success).
+  const std::string& message() const { return message_; }
+
+ protected:
+  std::string message_;
+};
+
+// Backends: "cholmod" (SuiteSparse simplicial LDL^T, AMD ordering), "dense" (Eigen,
+// for small n), "banded" (band LDL^T without pivoting, for chains), "auto" (picks by n
+// and bandwidth; see MakeLinearSolver in linear_solver.cc for the measured rule).
+// Returns nullptr and sets *error for an unknown name.
+std::unique_ptr<SymmetricLinearSolver> MakeLinearSolver(std::string_view name, int n,
+                                                        int bandwidth, std::string* error);
+std::vector<std::string> LinearSolverNames();
+
+}  // namespace snapthread

@@ -1,0 +1,222 @@
+// The planar elastic strip of the seed (2.1–2.2): n segments, nodes p_0 .. p_n,
+//   E = Σ_{i=1..n} γ (|v_i| - l)²  +  Σ_{i=1..n-1} β (1 - t_i · t_{i+1}),
+// v_i = p_i - p_{i-1}, t_i = v_i / |v_i|. The seed writes the bending sum as Σ b_i with
+// b_i = 1 - t_{i-1}·t_i: bending lives only at the interior nodes 1..n-1 that join two
+// segments. p_0 = (0, 0) and y_1 = 0 clamp the first segment to the x-axis (2.1); the
+// grasp holds p_n = (X, Y) = u. State x = [x_1, x_2, y_2, ..., x_{n-1}, y_{n-1}] (2n - 3).
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "models/hessian_assembly.h"
+#include "models/models.h"
+
+namespace snapthread {
+namespace {
+
+using internal::BendTerm;
+using internal::HessianAssembly;
+using internal::StretchTerm;
+using V2 = Eigen::Vector2d;
+
+class Curve2dModel final : public Model {
+ public:
+  explicit Curve2dModel(const ModelParams& params)
+      : n_(params.n),
+        l_(params.segment_length),
+        beta_(params.bending),
+        gamma_(params.stretching),
+        nx_(2 * params.n - 3),
+        assembly_(2 * params.n - 3, 2) {
+    // Term order: stretching of segments 1..n, then bending at joints 1..n-1.
+    for (int i = 1; i <= n_; ++i) AddTerm(false, i - 1);
+    for (int j = 1; j <= n_ - 1; ++j) AddTerm(true, j - 1);
+    assembly_.Finalize();
+    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+      if (assembly_.TouchesControls(t)) control_terms_.push_back(t);
+    }
+  }
+
+  std::string_view Name() const override { return "curve2d"; }
+  int NumStates() const override { return nx_; }
+  int NumControls() const override { return 2; }
+  int SpatialDimension() const override { return 2; }
+
+  double Energy(const Vec& x, const Vec& u) const override {
+    double e = 0.0;
+    for (const Term& term : terms_) {
+      const int a = term.first_node;
+      e += term.bend ? BendTerm<2>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u), beta_,
+                                   nullptr, nullptr)
+                     : StretchTerm<2>(Node(a, x, u), Node(a + 1, x, u), gamma_, l_, nullptr,
+                                      nullptr);
+    }
+    return e;
+  }
+
+  void Gradient(const Vec& x, const Vec& u, Vec* g) const override {
+    if (g->size() != nx_) g->resize(nx_);
+    g->setZero();
+    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+      Local(t, x, u, /*want_h=*/false,
+            [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
+    }
+  }
+
+  const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
+
+  void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
+    const SparseMatrix& pattern = assembly_.Pattern();
+    if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
+        !h->isCompressed()) {
+      *h = pattern;
+    }
+    double* values = h->valuePtr();
+    std::fill(values, values + pattern.nonZeros(), 0.0);
+    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+      Local(t, x, u, /*want_h=*/true, [&](const double*, const double* lh, int ld) {
+        assembly_.AddHessian(t, lh, ld, values);
+      });
+    }
+  }
+
+  void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override {
+    if (eu->size() != 2) eu->resize(2);
+    eu->setZero();
+    for (int t : control_terms_) {
+      Local(t, x, u, false, [&](const double* lg, const double*, int) {
+        assembly_.AddControlGradient(t, lg, eu->data());
+      });
+    }
+  }
+
+  void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override {
+    if (exu->rows() != nx_ || exu->cols() != 2) exu->resize(nx_, 2);
+    exu->setZero();
+    for (int t : control_terms_) {
+      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
+        assembly_.AddMixedHessian(t, lh, ld, exu);
+      });
+    }
+  }
+
+  void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override {
+    if (euu->rows() != 2 || euu->cols() != 2) euu->resize(2, 2);
+    euu->setZero();
+    for (int t : control_terms_) {
+      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
+        assembly_.AddControlHessian(t, lh, ld, euu);
+      });
+    }
+  }
+
+  // Nodes evenly spaced on the chord from (0, 0) to u, plus a bump 1e-3 l sin(π i / n)
+  // along the chord's normal. Why the bump: the perfectly straight compressed strip is an
+  // equilibrium by symmetry (every bending gradient vanishes), unstable past buckling,
+  // and Newton started exactly on it stays there for ever; the tiny deterministic bump
+  // picks one buckling side. y_1 = 0 is then re-imposed (the clamp).
+  Vec InitialState(const Vec& u) const override {
+    const V2 chord(u[0], u[1]);
+    const double length = chord.norm();
+    const V2 along = length > 1e-12 * l_ ? V2(chord / length) : V2(1.0, 0.0);
+    const V2 normal(-along.y(), along.x());
+    Vec x(nx_);
+    for (int i = 1; i <= n_ - 1; ++i) {
+      const V2 p = (static_cast<double>(i) / n_) * chord +
+                   (1e-3 * l_ * std::sin(std::numbers::pi * i / n_)) * normal;
+      if (i == 1) {
+        x[0] = p.x();
+      } else {
+        x[1 + 2 * (i - 2)] = p.x();
+        x[2 + 2 * (i - 2)] = p.y();
+      }
+    }
+    return x;
+  }
+
+  void NodePositions(const Vec& x, const Vec& u, Eigen::Matrix3Xd* nodes) const override {
+    if (nodes->cols() != n_ + 1) nodes->resize(3, n_ + 1);
+    for (int i = 0; i <= n_; ++i) {
+      const V2 p = Node(i, x, u);
+      nodes->col(i) << p.x(), p.y(), 0.0;
+    }
+  }
+  double Probe(const Vec& x, const Vec& u) const override { return Node(n_ / 2, x, u).y(); }
+  // Clamped–pinned Euler buckling load 20.19 EI / L² with EI = β l (β (1 - cos φ) ≈
+  // β φ²/2 = (β l) κ² l / 2 per joint) and L = n l.
+  double ForceScale() const override {
+    const double total = n_ * l_;
+    return 20.19 * beta_ * l_ / (total * total);
+  }
+  int HessianBandwidth() const override { return assembly_.Bandwidth(); }
+
+ private:
+  struct Term {
+    bool bend;
+    int first_node;
+  };
+
+  // Generalised index of coordinate k of node i (see hessian_assembly.h): -1 if fixed.
+  int NodeVar(int i, int k) const {
+    if (i == 0) return -1;
+    if (i == 1) return k == 0 ? 0 : -1;
+    if (i == n_) return nx_ + k;
+    return 1 + 2 * (i - 2) + k;
+  }
+  V2 Node(int i, const Vec& x, const Vec& u) const {
+    if (i == 0) return V2::Zero();
+    if (i == 1) return V2(x[0], 0.0);
+    if (i == n_) return V2(u[0], u[1]);
+    return V2(x[1 + 2 * (i - 2)], x[2 + 2 * (i - 2)]);
+  }
+  void AddTerm(bool bend, int first_node) {
+    int vars[6];
+    const int nodes = bend ? 3 : 2;
+    for (int a = 0; a < nodes; ++a) {
+      for (int k = 0; k < 2; ++k) vars[2 * a + k] = NodeVar(first_node + a, k);
+    }
+    assembly_.AddTerm(vars, 2 * nodes);
+    terms_.push_back({bend, first_node});
+  }
+  // Calls f(local gradient, local Hessian or null, leading dimension) for term t.
+  template <class F>
+  void Local(int t, const Vec& x, const Vec& u, bool want_h, F&& f) const {
+    const int a = terms_[t].first_node;
+    if (terms_[t].bend) {
+      Eigen::Matrix<double, 6, 1> lg;
+      Eigen::Matrix<double, 6, 6> lh;
+      BendTerm<2>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u), beta_, &lg,
+                  want_h ? &lh : nullptr);
+      f(lg.data(), lh.data(), 6);
+    } else {
+      Eigen::Matrix<double, 4, 1> lg;
+      Eigen::Matrix<double, 4, 4> lh;
+      StretchTerm<2>(Node(a, x, u), Node(a + 1, x, u), gamma_, l_, &lg, want_h ? &lh : nullptr);
+      f(lg.data(), lh.data(), 4);
+    }
+  }
+
+  const int n_;
+  const double l_;
+  const double beta_;
+  const double gamma_;
+  const int nx_;
+  HessianAssembly assembly_;
+  std::vector<Term> terms_;
+  std::vector<int> control_terms_;
+};
+
+}  // namespace
+
+std::unique_ptr<Model> MakeCurve2dModel(const ModelParams& params) {
+  ModelParams p = params;
+  p.model = "curve2d";
+  std::string error;
+  if (!p.IsValid(&error)) throw std::invalid_argument(error);
+  return std::make_unique<Curve2dModel>(p);
+}
+
+}  // namespace snapthread

@@ -1,0 +1,132 @@
+#include "models/hessian_assembly.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cstdlib>
+
+#include <Eigen/SparseCore>
+
+namespace snapthread::internal {
+
+HessianAssembly::HessianAssembly(int num_states, int num_controls)
+    : num_states_(num_states), num_controls_(num_controls) {}
+
+int HessianAssembly::AddTerm(const int* vars, int count) {
+  assert(count <= kMaxTermVars);
+  for (int i = 0; i < count; ++i) {
+    assert(vars[i] >= -1 && vars[i] < num_states_ + num_controls_);
+    vars_.push_back(vars[i]);
+  }
+  term_begin_.push_back(static_cast<int>(vars_.size()));
+  return NumTerms() - 1;
+}
+
+void HessianAssembly::Finalize() {
+  const int n = num_states_;
+  const int terms = NumTerms();
+  std::vector<Eigen::Triplet<double, int>> triplets;
+  touches_controls_.assign(terms, 0);
+  for (int t = 0; t < terms; ++t) {
+    const int* v = TermVars(t);
+    const int k = TermSize(t);
+    for (int i = 0; i < k; ++i) {
+      if (v[i] >= n) touches_controls_[t] = 1;
+      for (int j = 0; j < k; ++j) {
+        if (v[i] >= 0 && v[i] < n && v[j] >= 0 && v[j] < n) triplets.emplace_back(v[i], v[j], 0.0);
+      }
+    }
+  }
+  pattern_.resize(n, n);
+  // Duplicates are summed: values stay 0, only the structure matters here.
+  pattern_.setFromTriplets(triplets.begin(), triplets.end());
+  pattern_.makeCompressed();
+
+  bandwidth_ = 0;
+  for (int col = 0; col < n; ++col) {
+    for (SparseMatrix::InnerIterator it(pattern_, col); it; ++it) {
+      bandwidth_ = std::max(bandwidth_, std::abs(static_cast<int>(it.row()) - col));
+    }
+  }
+
+  // For each (local i, local j) of each term: the position in valuePtr(), found once by
+  // a binary search in column v[j]'s sorted row indices, then merged into runs.
+  run_begin_.assign(terms + 1, 0);
+  runs_.clear();
+  const int* outer = pattern_.outerIndexPtr();
+  const int* inner = pattern_.innerIndexPtr();
+  for (int t = 0; t < terms; ++t) {
+    run_begin_[t] = static_cast<int>(runs_.size());
+    const int* v = TermVars(t);
+    const int k = TermSize(t);
+    for (int j = 0; j < k; ++j) {
+      if (v[j] < 0 || v[j] >= n) continue;
+      for (int i = 0; i < k; ++i) {
+        if (v[i] < 0 || v[i] >= n) continue;
+        const int* first = inner + outer[v[j]];
+        const int* last = inner + outer[v[j] + 1];
+        const int* it = std::lower_bound(first, last, v[i]);
+        assert(it != last && *it == v[i]);
+        const int index = static_cast<int>(it - inner);
+        if (!runs_.empty() && static_cast<int>(runs_.size()) > run_begin_[t]) {
+          Run& run = runs_.back();
+          if (run.local_col == j && run.local_row + run.len == i && run.value + run.len == index) {
+            ++run.len;
+            continue;
+          }
+        }
+        runs_.push_back({i, j, 1, index});
+      }
+    }
+  }
+  run_begin_[terms] = static_cast<int>(runs_.size());
+}
+
+void HessianAssembly::AddGradient(int term, const double* local_g, double* g) const {
+  const int* v = TermVars(term);
+  const int k = TermSize(term);
+  for (int i = 0; i < k; ++i) {
+    if (v[i] >= 0 && v[i] < num_states_) g[v[i]] += local_g[i];
+  }
+}
+
+void HessianAssembly::AddControlGradient(int term, const double* local_g, double* eu) const {
+  const int* v = TermVars(term);
+  const int k = TermSize(term);
+  for (int i = 0; i < k; ++i) {
+    if (v[i] >= num_states_) eu[v[i] - num_states_] += local_g[i];
+  }
+}
+
+void HessianAssembly::AddHessian(int term, const double* local_h, int ld, double* values) const {
+  const Run* run = runs_.data() + run_begin_[term];
+  const Run* end = runs_.data() + run_begin_[term + 1];
+  for (; run != end; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    for (int r = 0; r < run->len; ++r) dst[r] += src[r];
+  }
+}
+
+void HessianAssembly::AddMixedHessian(int term, const double* local_h, int ld, Mat* exu) const {
+  const int* v = TermVars(term);
+  const int k = TermSize(term);
+  for (int j = 0; j < k; ++j) {
+    if (v[j] < num_states_) continue;
+    for (int i = 0; i < k; ++i) {
+      if (v[i] >= 0 && v[i] < num_states_) (*exu)(v[i], v[j] - num_states_) += local_h[i + j * ld];
+    }
+  }
+}
+
+void HessianAssembly::AddControlHessian(int term, const double* local_h, int ld, Mat* euu) const {
+  const int* v = TermVars(term);
+  const int k = TermSize(term);
+  for (int j = 0; j < k; ++j) {
+    if (v[j] < num_states_) continue;
+    for (int i = 0; i < k; ++i) {
+      if (v[i] >= num_states_) (*euu)(v[i] - num_states_, v[j] - num_states_) += local_h[i + j * ld];
+    }
+  }
+}
+
+}  // namespace snapthread::internal

@@ -1,0 +1,185 @@
+// Assembly of chain energies (curve2d, thread3d) from small per-term derivatives.
+//
+// A chain energy is a sum of terms that each touch a few nodes: a stretching term two
+// nodes, a bending term three. Each term is differentiated in closed form with respect
+// to its own few "local" variables; HessianAssembly then adds the local gradient and
+// Hessian into the global E_x, E_xx (sparse), E_u, E_xu and E_uu.
+//
+// Variables are numbered in one "generalised" index space: [0, num_states) are the state
+// x, [num_states, num_states + num_controls) the controls u, and -1 marks a coordinate
+// that is held fixed (p_0, the clamped y_1/z_1): such a coordinate simply has no column.
+//
+// The full symmetric pattern of E_xx is built once (Finalize), together with, for every
+// term, the index into SparseMatrix::valuePtr() of each (local i, local j) pair, so that
+// adding a term's Hessian is a table look-up without search or allocation.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "numeric/types.h"
+
+namespace snapthread::internal {
+
+class HessianAssembly {
+ public:
+  // Most variables one term can touch (thread3d's bending term next to the grip touches
+  // 3 + 3 + 7 = 13: two free nodes, then s, (X, Y, Z) and (dx, dy, dz)).
+  static constexpr int kMaxTermVars = 16;
+
+  HessianAssembly() = default;
+  HessianAssembly(int num_states, int num_controls);
+
+  // Registers a term whose local variables are vars[0..count) (generalised indices,
+  // -1 for fixed coordinates). Returns the term id (0, 1, ... in call order).
+  int AddTerm(const int* vars, int count);
+  // Builds the pattern and the scatter tables. Call once, after the last AddTerm.
+  void Finalize();
+
+  int NumStates() const { return num_states_; }
+  int NumControls() const { return num_controls_; }
+  int NumTerms() const { return static_cast<int>(term_begin_.size()) - 1; }
+  int TermSize(int term) const { return term_begin_[term + 1] - term_begin_[term]; }
+  const int* TermVars(int term) const { return vars_.data() + term_begin_[term]; }
+  // True when the term has at least one control variable (enters E_u, E_xu, E_uu).
+  bool TouchesControls(int term) const { return touches_controls_[term] != 0; }
+
+  // Full symmetric E_xx pattern (both triangles, compressed, values 0).
+  const SparseMatrix& Pattern() const { return pattern_; }
+  // max |i - j| over the pattern: the half-bandwidth of E_xx.
+  int Bandwidth() const { return bandwidth_; }
+
+  // The Add* functions accumulate (+=) one term's local derivatives. `local_h` is the
+  // term's full symmetric local Hessian, column-major with leading dimension `ld`.
+  void AddGradient(int term, const double* local_g, double* g) const;
+  void AddControlGradient(int term, const double* local_g, double* eu) const;
+  // `values` is valuePtr() of a matrix with exactly Pattern()'s structure.
+  void AddHessian(int term, const double* local_h, int ld, double* values) const;
+  // exu: num_states x num_controls, euu: num_controls x num_controls (presized).
+  void AddMixedHessian(int term, const double* local_h, int ld, Mat* exu) const;
+  void AddControlHessian(int term, const double* local_h, int ld, Mat* euu) const;
+
+ private:
+  int num_states_ = 0;
+  int num_controls_ = 0;
+  std::vector<int> term_begin_{0};    // term t's variables are vars_[begin[t], begin[t+1])
+  std::vector<int> vars_;
+  // E_xx scatter table. For each term, runs of local entries (rows i0 .. i0+len-1 of
+  // local column j) that land on consecutive valuePtr() positions value .. value+len-1:
+  // a node's coordinates are consecutive in both, so a 3D bending term needs 27 runs of 3
+  // rather than 81 separate look-ups.
+  struct Run {
+    int local_row;
+    int local_col;
+    int len;
+    int value;
+  };
+  std::vector<int> run_begin_;        // term t's runs are runs_[run_begin_[t], run_begin_[t+1])
+  std::vector<Run> runs_;
+  std::vector<char> touches_controls_;
+  SparseMatrix pattern_;
+  int bandwidth_ = 0;
+};
+
+// ---------------------------------------------------------------------------------
+// Closed-form per-term derivatives, in the coordinates of the term's nodes (D = 2 or 3).
+
+template <int D>
+using NodeVec = Eigen::Matrix<double, D, 1>;
+
+// Stretching c (|v| - rest)^2 of the segment v = p_b - p_a ((2.2); thread3d (3.7) with
+// c = gamma/2). Local variables (p_a, p_b). Returns the energy; g/h may be null.
+//   d/dv  = 2c (l - rest) w,                    w = v / l
+//   d2/dv2 = 2c [ (rest/l) w w^T + (1 - rest/l) I ]
+// and the node blocks follow from v = p_b - p_a: [[H, -H], [-H, H]].
+template <int D>
+inline double StretchTerm(const NodeVec<D>& pa, const NodeVec<D>& pb, double c, double rest,
+                          Eigen::Matrix<double, 2 * D, 1>* g,
+                          Eigen::Matrix<double, 2 * D, 2 * D>* h) {
+  const NodeVec<D> v = pb - pa;
+  const double l = v.norm();
+  const double dl = l - rest;
+  if (g != nullptr || h != nullptr) {
+    // Reciprocals once: divisions cost several times a multiplication here.
+    const double inv_l = 1.0 / l;
+    const NodeVec<D> w = v * inv_l;
+    if (g != nullptr) {
+      const NodeVec<D> gv = (2.0 * c * dl) * w;
+      g->template head<D>() = -gv;
+      g->template tail<D>() = gv;
+    }
+    if (h != nullptr) {
+      const double ratio = rest * inv_l;
+      Eigen::Matrix<double, D, D> hv = (2.0 * c * ratio) * (w * w.transpose());
+      hv.diagonal().array() += 2.0 * c * (1.0 - ratio);
+      h->template topLeftCorner<D, D>() = hv;
+      h->template topRightCorner<D, D>() = -hv;
+      h->template bottomLeftCorner<D, D>() = -hv;
+      h->template bottomRightCorner<D, D>() = hv;
+    }
+  }
+  return c * dl * dl;
+}
+
+// Bending c (1 - w1.w2) at the joint between v1 = p_b - p_a and v2 = p_c - p_b
+// ((2.2) with c = beta; thread3d (3.6) with c = beta/2). Local variables (p_a, p_b, p_c).
+// With cth = w1.w2, a = (w2 - cth w1)/l1 = d cth/d v1, b = (w1 - cth w2)/l2 = d cth/d v2:
+//   d/dv1 = -c a,  d/dv2 = -c b,
+//   d2/dv1^2  =  c [ (w1 a^T + a w1^T)/l1 + cth (I - w1 w1^T)/l1^2 ]
+//   d2/dv1dv2 = -c [ I - w1 w1^T - w2 w2^T + cth w1 w2^T ] / (l1 l2)
+//   d2/dv2^2  =  c [ (w2 b^T + b w2^T)/l2 + cth (I - w2 w2^T)/l2^2 ]
+// and the node blocks follow from the chain rule through v1 = p_b - p_a, v2 = p_c - p_b.
+template <int D>
+inline double BendTerm(const NodeVec<D>& pa, const NodeVec<D>& pb, const NodeVec<D>& pc,
+                       double c, Eigen::Matrix<double, 3 * D, 1>* g,
+                       Eigen::Matrix<double, 3 * D, 3 * D>* h) {
+  using M = Eigen::Matrix<double, D, D>;
+  const NodeVec<D> v1 = pb - pa;
+  const NodeVec<D> v2 = pc - pb;
+  // Reciprocals once: divisions cost several times a multiplication here.
+  const double inv1 = 1.0 / v1.norm();
+  const double inv2 = 1.0 / v2.norm();
+  const NodeVec<D> w1 = v1 * inv1;
+  const NodeVec<D> w2 = v2 * inv2;
+  const double cth = w1.dot(w2);
+  if (g != nullptr || h != nullptr) {
+    const NodeVec<D> a = (w2 - cth * w1) * inv1;
+    const NodeVec<D> b = (w1 - cth * w2) * inv2;
+    if (g != nullptr) {
+      g->template segment<D>(0) = c * a;
+      g->template segment<D>(D) = -c * a + c * b;
+      g->template segment<D>(2 * D) = -c * b;
+    }
+    if (h != nullptr) {
+      const M w1w1 = w1 * w1.transpose();
+      const M w2w2 = w2 * w2.transpose();
+      const M wa = w1 * a.transpose();
+      const M wb = w2 * b.transpose();
+      const double c11 = c * cth * inv1 * inv1;
+      const double c22 = c * cth * inv2 * inv2;
+      M h11 = (c * inv1) * (wa + wa.transpose()) - c11 * w1w1;
+      h11.diagonal().array() += c11;
+      M h22 = (c * inv2) * (wb + wb.transpose()) - c22 * w2w2;
+      h22.diagonal().array() += c22;
+      const double s12 = -c * inv1 * inv2;
+      M h12 = s12 * (cth * (w1 * w2.transpose()) - w1w1 - w2w2);
+      h12.diagonal().array() += s12;
+      // Jacobian of (v1, v2) w.r.t. (p_a, p_b, p_c): v1 = [-I, I, 0], v2 = [0, -I, I].
+      const M h21 = h12.transpose();
+      h->template block<D, D>(0, 0) = h11;
+      h->template block<D, D>(0, D) = h12 - h11;
+      h->template block<D, D>(0, 2 * D) = -h12;
+      h->template block<D, D>(D, 0) = h21 - h11;
+      h->template block<D, D>(D, D) = h11 - h12 - h21 + h22;
+      h->template block<D, D>(D, 2 * D) = h12 - h22;
+      h->template block<D, D>(2 * D, 0) = -h21;
+      h->template block<D, D>(2 * D, D) = h21 - h22;
+      h->template block<D, D>(2 * D, 2 * D) = h22;
+    }
+  }
+  return c * (1.0 - cth);
+}
+
+}  // namespace snapthread::internal

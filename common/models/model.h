@@ -1,0 +1,74 @@
+// The energy model interface: every system of the seed (zeeman, cusp, curve2d,
+// thread3d) is a smooth energy E(x, u) of internal state x and controls u (the grasp).
+//
+// Conventions
+//  * x has NumStates() entries, u has NumControls() entries.
+//  * All derivatives are analytic and are checked against finite differences in
+//    tests/model_derivative_test.cc.
+//  * The Hessian E_xx is stored as a full symmetric sparse matrix (both triangles)
+//    with a pattern fixed at construction (HessianPattern()). Hessian() overwrites the
+//    values of a matrix that already has that pattern and must not allocate then:
+//    the solvers reuse one matrix and one symbolic factorisation for every step.
+//  * Output vectors/matrices passed by pointer are resized by the callee only when
+//    their size is wrong (so a caller that keeps them allocated pays nothing).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include <Eigen/Core>
+
+#include "numeric/types.h"
+
+namespace snapthread {
+
+// What a grasp is, as a device sees it: a position with `spatial_dimension` coordinates
+// (2 for planar models, 3 in space), followed by a unit grip direction (3 numbers) when
+// the model constrains the direction of the held end. The scene carries it so the device
+// client and the viewers can map poses without building a model.
+struct GraspLayout {
+  int spatial_dimension = 2;
+  bool grip_direction = false;
+  int NumControls() const { return spatial_dimension + (grip_direction ? 3 : 0); }
+};
+
+class Model {
+ public:
+  virtual ~Model() = default;
+
+  // "zeeman", "cusp", "curve2d", "thread3d".
+  virtual std::string_view Name() const = 0;
+  virtual int NumStates() const = 0;
+  virtual int NumControls() const = 0;
+  // 2 for planar models (u = (X, Y)), 3 for thread3d.
+  virtual int SpatialDimension() const = 0;
+
+  virtual double Energy(const Vec& x, const Vec& u) const = 0;
+  // E_x, size NumStates().
+  virtual void Gradient(const Vec& x, const Vec& u, Vec* g) const = 0;
+  // E_xx with the fixed pattern of HessianPattern().
+  virtual const SparseMatrix& HessianPattern() const = 0;
+  virtual void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const = 0;
+  // E_u, size NumControls(). The force on the grasp is F = -E_u (envelope theorem, §2.3.4).
+  virtual void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const = 0;
+  // E_xu, NumStates() x NumControls() (dense: only a few rows are non-zero).
+  virtual void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const = 0;
+  // E_uu, NumControls() x NumControls().
+  virtual void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const = 0;
+
+  // A natural starting state for controls u (straight thread, wheel at theta = 0, ...).
+  virtual Vec InitialState(const Vec& u) const = 0;
+  // Node positions for drawing (3 x k, z = 0 for planar models). For zeeman: the
+  // wheel centre, the wheel point and both string anchors; for cusp: (T, 0, 0).
+  virtual void NodePositions(const Vec& x, const Vec& u, Eigen::Matrix3Xd* nodes) const = 0;
+  // One scalar summary of the state for sweeps: theta (zeeman), T (cusp), y of node
+  // floor(n/2) (curve2d, thread3d).
+  virtual double Probe(const Vec& x, const Vec& u) const = 0;
+  // A characteristic magnitude of grasp forces in model units, for relative tolerances.
+  virtual double ForceScale() const = 0;
+  // Half-bandwidth of E_xx in the variable ordering (for banded factorisations).
+  virtual int HessianBandwidth() const = 0;
+};
+
+}  // namespace snapthread

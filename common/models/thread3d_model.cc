@@ -1,0 +1,359 @@
+// The 3D thread of the seed (3.1–3.10, 3.15): N segments, nodes p_0 .. p_N,
+//   E = Σ_i E_i,  E_i = γ/2 (l_i - L)² + β/2 (b_i - B)                         (3.7), (3.9)
+//   b_i = ((1 - w_{i+1}·w_i) + (1 - w_{i-1}·w_i)) / 2,  w_i = v_i / l_i         (3.6)
+// with a missing neighbour's term counting 0 at the two ends. Every joint j (between
+// segments j and j+1) appears in b_j and b_{j+1} with weight 1/2 each, so
+//   E = Σ_{i=1..N} γ/2 (l_i - L)² + Σ_{j=1..N-1} β/2 (1 - w_j·w_{j+1}) - N β B / 2,
+// which is how it is evaluated (B only shifts the energy). p_0 = 0, y_1 = z_1 = 0 (the
+// clamp), p_N = (X, Y, Z) = u. State x = [x_1, x_2, y_2, z_2, ..., z_{N-1}] (3N - 5).
+//
+// Grip direction (params.grip_direction): u = (X, Y, Z, dx, dy, dz) and the held last
+// segment points along d: p_{N-1} = p_N - s d/|d| with the scalar s a state variable
+// replacing node N-1's three coordinates (3N - 7 states, s last). Terms that touch node
+// N-1 are differentiated in node coordinates as usual and then carried to (s, P, d)
+// by the chain rule, including the curvature of p_{N-1}(s, d).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "models/hessian_assembly.h"
+#include "models/models.h"
+
+namespace snapthread {
+namespace {
+
+using internal::BendTerm;
+using internal::HessianAssembly;
+using internal::StretchTerm;
+using V3 = Eigen::Vector3d;
+constexpr int kMaxVars = HessianAssembly::kMaxTermVars;
+using LocalVec = Eigen::Matrix<double, kMaxVars, 1>;
+using LocalMat = Eigen::Matrix<double, kMaxVars, kMaxVars>;
+
+class Thread3dModel final : public Model {
+ public:
+  explicit Thread3dModel(const ModelParams& params)
+      : n_(params.n),
+        rest_(params.segment_length),
+        half_beta_(0.5 * params.bending),
+        half_gamma_(0.5 * params.stretching),
+        energy_shift_(-params.n * params.bending * params.reference_bend / 2.0),
+        grip_(params.grip_direction),
+        nx_(params.grip_direction ? 3 * params.n - 7 : 3 * params.n - 5),
+        nu_(params.grip_direction ? 6 : 3),
+        assembly_(nx_, nu_) {
+    for (int i = 1; i <= n_; ++i) AddTerm(false, i - 1);
+    for (int j = 1; j <= n_ - 1; ++j) AddTerm(true, j - 1);
+    assembly_.Finalize();
+    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+      if (assembly_.TouchesControls(t)) control_terms_.push_back(t);
+    }
+  }
+
+  std::string_view Name() const override { return "thread3d"; }
+  int NumStates() const override { return nx_; }
+  int NumControls() const override { return nu_; }
+  int SpatialDimension() const override { return 3; }
+
+  double Energy(const Vec& x, const Vec& u) const override {
+    double e = energy_shift_;
+    for (const Term& term : terms_) {
+      const int a = term.first_node;
+      e += term.bend ? BendTerm<3>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u),
+                                   half_beta_, nullptr, nullptr)
+                     : StretchTerm<3>(Node(a, x, u), Node(a + 1, x, u), half_gamma_, rest_,
+                                      nullptr, nullptr);
+    }
+    return e;
+  }
+
+  void Gradient(const Vec& x, const Vec& u, Vec* g) const override {
+    if (g->size() != nx_) g->resize(nx_);
+    g->setZero();
+    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+      Local(t, x, u, false,
+            [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
+    }
+  }
+
+  const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
+
+  void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
+    const SparseMatrix& pattern = assembly_.Pattern();
+    if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
+        !h->isCompressed()) {
+      *h = pattern;
+    }
+    double* values = h->valuePtr();
+    std::fill(values, values + pattern.nonZeros(), 0.0);
+    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
+        assembly_.AddHessian(t, lh, ld, values);
+      });
+    }
+  }
+
+  void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override {
+    if (eu->size() != nu_) eu->resize(nu_);
+    eu->setZero();
+    for (int t : control_terms_) {
+      Local(t, x, u, false, [&](const double* lg, const double*, int) {
+        assembly_.AddControlGradient(t, lg, eu->data());
+      });
+    }
+  }
+
+  void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override {
+    if (exu->rows() != nx_ || exu->cols() != nu_) exu->resize(nx_, nu_);
+    exu->setZero();
+    for (int t : control_terms_) {
+      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
+        assembly_.AddMixedHessian(t, lh, ld, exu);
+      });
+    }
+  }
+
+  void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override {
+    if (euu->rows() != nu_ || euu->cols() != nu_) euu->resize(nu_, nu_);
+    euu->setZero();
+    for (int t : control_terms_) {
+      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
+        assembly_.AddControlHessian(t, lh, ld, euu);
+      });
+    }
+  }
+
+  // Nodes evenly spaced on the chord from 0 to p_N, plus a bump 1e-3 L sin(π i / N) in a
+  // fixed normal direction (the part of +y orthogonal to the chord; +z if the chord is
+  // along y). Why: the straight compressed thread is an equilibrium by symmetry that
+  // Newton never leaves; the bump picks a buckling side deterministically. The clamp
+  // y_1 = z_1 = 0 is re-imposed; with a grip s = |chord| / N (one even segment).
+  Vec InitialState(const Vec& u) const override {
+    const V3 chord = u.head<3>();
+    const double length = chord.norm();
+    const V3 along = length > 1e-12 * rest_ ? V3(chord / length) : V3::UnitX();
+    V3 normal = V3::UnitY() - along.y() * along;
+    if (normal.norm() < 1e-3) normal = V3::UnitZ() - along.z() * along;
+    normal.normalize();
+    Vec x(nx_);
+    const int last_free = grip_ ? n_ - 2 : n_ - 1;
+    for (int i = 1; i <= last_free; ++i) {
+      const V3 p = (static_cast<double>(i) / n_) * chord +
+                   (1e-3 * rest_ * std::sin(std::numbers::pi * i / n_)) * normal;
+      if (i == 1) {
+        x[0] = p.x();
+      } else {
+        x.segment<3>(1 + 3 * (i - 2)) = p;
+      }
+    }
+    if (grip_) x[nx_ - 1] = length / n_;
+    return x;
+  }
+
+  void NodePositions(const Vec& x, const Vec& u, Eigen::Matrix3Xd* nodes) const override {
+    if (nodes->cols() != n_ + 1) nodes->resize(3, n_ + 1);
+    for (int i = 0; i <= n_; ++i) nodes->col(i) = Node(i, x, u);
+  }
+  double Probe(const Vec& x, const Vec& u) const override { return Node(n_ / 2, x, u).y(); }
+  // Clamped–pinned Euler load 20.19 EI / L_total² with EI = (β/2) L (see curve2d).
+  double ForceScale() const override {
+    const double total = n_ * rest_;
+    return 20.19 * half_beta_ * rest_ / (total * total);
+  }
+  int HessianBandwidth() const override { return assembly_.Bandwidth(); }
+
+ private:
+  struct Term {
+    bool bend = false;
+    int first_node = 0;
+    // Grip terms only (they touch node N-1 = p_N - s d/|d|): which local node that is,
+    // and where each variable sits in the term's assembly variable list.
+    bool grip = false;
+    int grip_local = -1;
+    std::array<int, 9> coord_pos{};  // coordinate 3a+k of another local node, or -1
+    std::array<int, 7> grip_pos{};   // s, X, Y, Z, dx, dy, dz
+  };
+
+  // Generalised index of coordinate k of node i (-1 if fixed). Not for the grip node.
+  int NodeVar(int i, int k) const {
+    if (i == 0) return -1;
+    if (i == 1) return k == 0 ? 0 : -1;
+    if (i == n_) return nx_ + k;
+    return 1 + 3 * (i - 2) + k;
+  }
+  bool IsGripNode(int i) const { return grip_ && i == n_ - 1; }
+  V3 Node(int i, const Vec& x, const Vec& u) const {
+    if (i == 0) return V3::Zero();
+    if (i == 1 && !IsGripNode(1)) return V3(x[0], 0.0, 0.0);
+    if (i == n_) return u.head<3>();
+    if (IsGripNode(i)) {
+      const V3 d = u.segment<3>(3);
+      return u.head<3>() - (x[nx_ - 1] / d.norm()) * d;
+    }
+    return x.segment<3>(1 + 3 * (i - 2));
+  }
+
+  void AddTerm(bool bend, int first_node) {
+    Term term;
+    term.bend = bend;
+    term.first_node = first_node;
+    const int nodes = bend ? 3 : 2;
+    for (int a = 0; a < nodes; ++a) {
+      if (IsGripNode(first_node + a)) term.grip_local = a;
+    }
+    term.grip = term.grip_local >= 0;
+    int vars[kMaxVars];
+    int count = 0;
+    if (!term.grip) {
+      for (int a = 0; a < nodes; ++a) {
+        for (int k = 0; k < 3; ++k) vars[count++] = NodeVar(first_node + a, k);
+      }
+    } else {
+      // Unique variable list: the other nodes' free coordinates, then s, P, d.
+      auto position = [&](int var) {
+        for (int m = 0; m < count; ++m) {
+          if (vars[m] == var) return m;
+        }
+        vars[count] = var;
+        return count++;
+      };
+      term.coord_pos.fill(-1);
+      for (int a = 0; a < nodes; ++a) {
+        if (a == term.grip_local) continue;
+        for (int k = 0; k < 3; ++k) {
+          const int var = NodeVar(first_node + a, k);
+          if (var >= 0) term.coord_pos[3 * a + k] = position(var);
+        }
+      }
+      term.grip_pos[0] = position(nx_ - 1);
+      for (int k = 0; k < 6; ++k) term.grip_pos[1 + k] = position(nx_ + k);
+    }
+    assembly_.AddTerm(vars, count);
+    terms_.push_back(term);
+  }
+
+  // Calls f(local gradient, local Hessian (valid if want_h), leading dimension) for
+  // term t, in the term's assembly variables.
+  template <class F>
+  void Local(int t, const Vec& x, const Vec& u, bool want_h, F&& f) const {
+    const Term& term = terms_[t];
+    const int a = term.first_node;
+    Eigen::Matrix<double, 9, 1> lg;
+    Eigen::Matrix<double, 9, 9> lh;
+    if (term.bend) {
+      BendTerm<3>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u), half_beta_, &lg,
+                  want_h ? &lh : nullptr);
+    } else {
+      Eigen::Matrix<double, 6, 1> g6;
+      Eigen::Matrix<double, 6, 6> h6;
+      StretchTerm<3>(Node(a, x, u), Node(a + 1, x, u), half_gamma_, rest_, &g6,
+                     want_h ? &h6 : nullptr);
+      if (!term.grip) {
+        f(g6.data(), h6.data(), 6);
+        return;
+      }
+      lg.head<6>() = g6;
+      lg.tail<3>().setZero();
+      if (want_h) {
+        lh.setZero();
+        lh.topLeftCorner<6, 6>() = h6;
+      }
+    }
+    if (!term.grip) {
+      f(lg.data(), lh.data(), 9);
+      return;
+    }
+    // Chain rule to the term's variables through p_{N-1} = P - s d̂, d̂ = d/ρ, ρ = |d|.
+    // Its Jacobian w.r.t. g = (s, X, Y, Z, dx, dy, dz) is A = [-d̂ | I | -s Q/ρ] with
+    // Q = I - d̂ d̂^T; the other nodes' coordinates map one-to-one. So (G = grip rows)
+    //   E_g = A^T e_G,  E_rg = (H_rG A),  E_gg = A^T H_GG A + curvature, where
+    //   Σ_k e_k ∂²p_k/∂s∂d_j   = -(Q e)_j / ρ,
+    //   Σ_k e_k ∂²p_k/∂d_i∂d_j = s [e_i d̂_j + d̂_i e_j + (e·d̂)(δ_ij - 3 d̂_i d̂_j)] / ρ².
+    // Variables shared with node N (X, Y, Z) simply accumulate.
+    const V3 d = u.segment<3>(3);
+    const double rho = d.norm();
+    const V3 dh = d / rho;
+    const double s = x[nx_ - 1];
+    Eigen::Matrix3d q = -dh * dh.transpose();
+    q.diagonal().array() += 1.0;
+    Eigen::Matrix<double, 3, 7> jac_grip;
+    jac_grip.col(0) = -dh;
+    jac_grip.middleCols<3>(1).setIdentity();
+    jac_grip.rightCols<3>() = (-s / rho) * q;
+    const int nodes = term.bend ? 3 : 2;
+    const int g0 = 3 * term.grip_local;
+    const int k = assembly_.TermSize(t);
+    const V3 eg = lg.segment<3>(g0);
+    LocalVec gg;
+    gg.head(k).setZero();
+    for (int r = 0; r < 3 * nodes; ++r) {
+      if (r < g0 || r >= g0 + 3) {
+        if (term.coord_pos[r] >= 0) gg[term.coord_pos[r]] += lg[r];
+      }
+    }
+    const Eigen::Matrix<double, 7, 1> ag = jac_grip.transpose() * eg;
+    for (int m = 0; m < 7; ++m) gg[term.grip_pos[m]] += ag[m];
+    LocalMat hh;
+    if (want_h) {
+      hh.topLeftCorner(k, k).setZero();
+      const Eigen::Matrix<double, 9, 7> b = lh.middleCols<3>(g0) * jac_grip;
+      for (int c = 0; c < 3 * nodes; ++c) {
+        if (c >= g0 && c < g0 + 3) continue;
+        const int pc = term.coord_pos[c];
+        if (pc < 0) continue;
+        for (int r = 0; r < 3 * nodes; ++r) {
+          if (r >= g0 && r < g0 + 3) continue;
+          if (term.coord_pos[r] >= 0) hh(term.coord_pos[r], pc) += lh(r, c);
+        }
+        for (int m = 0; m < 7; ++m) {
+          hh(pc, term.grip_pos[m]) += b(c, m);
+          hh(term.grip_pos[m], pc) += b(c, m);
+        }
+      }
+      Eigen::Matrix<double, 7, 7> gg_block = jac_grip.transpose() * b.middleRows<3>(g0);
+      const V3 qe = q * eg / rho;
+      const double ed = eg.dot(dh);
+      const double cs = s / (rho * rho);
+      for (int j = 0; j < 3; ++j) {
+        gg_block(0, 4 + j) -= qe[j];
+        gg_block(4 + j, 0) -= qe[j];
+        for (int i = 0; i < 3; ++i) {
+          gg_block(4 + i, 4 + j) +=
+              cs * (eg[i] * dh[j] + dh[i] * eg[j] + ed * ((i == j ? 1.0 : 0.0) - 3.0 * dh[i] * dh[j]));
+        }
+      }
+      for (int m2 = 0; m2 < 7; ++m2) {
+        for (int m = 0; m < 7; ++m) hh(term.grip_pos[m], term.grip_pos[m2]) += gg_block(m, m2);
+      }
+    }
+    f(gg.data(), hh.data(), kMaxVars);
+  }
+
+  const int n_;
+  const double rest_;        // L
+  const double half_beta_;   // β/2
+  const double half_gamma_;  // γ/2
+  const double energy_shift_;  // -N β B / 2
+  const bool grip_;
+  const int nx_;
+  const int nu_;
+  HessianAssembly assembly_;
+  std::vector<Term> terms_;
+  std::vector<int> control_terms_;
+};
+
+}  // namespace
+
+std::unique_ptr<Model> MakeThread3dModel(const ModelParams& params) {
+  ModelParams p = params;
+  p.model = "thread3d";
+  std::string error;
+  if (!p.IsValid(&error)) throw std::invalid_argument(error);
+  return std::make_unique<Thread3dModel>(p);
+}
+
+}  // namespace snapthread

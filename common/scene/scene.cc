@@ -1,0 +1,264 @@
+#include "scene/scene.h"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+namespace snapthread {
+namespace {
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
+    throw SceneError(file_ + ": " + key + ": " + what);
+  }
+
+  template <class T>
+  T Get(const YAML::Node& node, const std::string& key, const char* expected) const {
+    try {
+      return node.as<T>();
+    } catch (const YAML::Exception&) {
+      Fail(key, std::string("expected ") + expected + ", got '" + Dump(node) + "'");
+    }
+  }
+  double Number(const YAML::Node& parent, const std::string& name, const std::string& key,
+                double fallback, bool required = false) const {
+    const YAML::Node n = parent[name];
+    if (!n) {
+      if (required) Fail(key, "missing (expected a number)");
+      return fallback;
+    }
+    const double v = Get<double>(n, key, "a number");
+    if (!std::isfinite(v)) Fail(key, "expected a finite number");
+    return v;
+  }
+  double Positive(const YAML::Node& parent, const std::string& name, const std::string& key,
+                  double fallback, bool required = false) const {
+    const double v = Number(parent, name, key, fallback, required);
+    if (!(v > 0.0)) Fail(key, "expected a number > 0, got " + Num(v));
+    return v;
+  }
+  Vec Vector(const YAML::Node& n, const std::string& key, int size) const {
+    if (!n.IsSequence() || static_cast<int>(n.size()) != size)
+      Fail(key, "expected a list of " + std::to_string(size) + " numbers, got '" + Dump(n) + "'");
+    Vec v(size);
+    for (int i = 0; i < size; ++i) {
+      v[i] = Get<double>(n[i], key, "a number");
+      if (!std::isfinite(v[i])) Fail(key, "expected finite numbers");
+    }
+    return v;
+  }
+  void CheckKeys(const YAML::Node& n, const std::string& key, std::set<std::string> allowed) const {
+    if (!n.IsMap()) Fail(key, "expected a mapping, got '" + Dump(n) + "'");
+    for (const auto& kv : n) {
+      const std::string k = kv.first.as<std::string>();
+      if (!allowed.count(k)) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        Fail(key.empty() ? k : key + "." + k, "unknown key (expected one of: " + list + ")");
+      }
+    }
+  }
+  static std::string Dump(const YAML::Node& n) {
+    std::stringstream ss;
+    ss << n;
+    std::string s = ss.str();
+    for (char& c : s)
+      if (c == '\n') c = ' ';
+    return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+  }
+  static std::string Num(double v) {
+    std::ostringstream ss;
+    ss << v;
+    return ss.str();
+  }
+
+ private:
+  std::string file_;
+};
+
+void ApplyOverrides(YAML::Node root, const std::vector<SceneOverride>& overrides, const Reader& rd) {
+  for (const auto& o : overrides) {
+    YAML::Node value;
+    try {
+      value = YAML::Load(o.value);
+    } catch (const YAML::Exception& e) {
+      rd.Fail(o.key, "override value '" + o.value + "' is not valid YAML");
+    }
+    std::vector<std::string> parts;
+    std::stringstream ss(o.key);
+    for (std::string p; std::getline(ss, p, '.');) {
+      if (p.empty()) rd.Fail(o.key, "malformed override key");
+      parts.push_back(p);
+    }
+    if (parts.empty()) rd.Fail(o.key, "malformed override key");
+    // yaml-cpp nodes are handles: walk with fresh handles via reset().
+    std::vector<YAML::Node> chain{root};
+    for (size_t i = 0; i + 1 < parts.size(); ++i) {
+      YAML::Node child = chain.back()[parts[i]];
+      if (!child || !child.IsMap()) {
+        chain.back()[parts[i]] = YAML::Node(YAML::NodeType::Map);
+        child = chain.back()[parts[i]];
+      }
+      chain.push_back(child);
+    }
+    chain.back()[parts.back()] = value;
+  }
+}
+
+}  // namespace
+
+SceneOverride ParseOverride(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
+    throw SceneError("--set '" + text + "': expected key=value, e.g. params.n=20");
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
+                 const std::vector<SceneOverride>& overrides) {
+  Reader rd(file_label);
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw SceneError(file_label + ": not valid YAML: " + e.what());
+  }
+  if (!root || !root.IsMap()) throw SceneError(file_label + ": expected a YAML mapping at the top level");
+  ApplyOverrides(root, overrides, rd);
+  rd.CheckKeys(root, "", {"name", "description", "model", "params", "grasp", "solver", "device", "targets"});
+
+  Scene sc;
+  sc.file = file_label;
+  if (!root["model"]) rd.Fail("model", "missing (expected one of zeeman, cusp, curve2d, thread3d)");
+  sc.params.model = rd.Get<std::string>(root["model"], "model", "a model name");
+  if (sc.params.model != "zeeman" && sc.params.model != "cusp" && sc.params.model != "curve2d" &&
+      sc.params.model != "thread3d")
+    rd.Fail("model", "expected one of zeeman, cusp, curve2d, thread3d, got '" + sc.params.model + "'");
+  sc.name = root["name"] ? rd.Get<std::string>(root["name"], "name", "a string") : sc.params.model;
+  if (root["description"]) sc.description = rd.Get<std::string>(root["description"], "description", "a string");
+
+  const bool chain = sc.params.model == "curve2d" || sc.params.model == "thread3d";
+  if (root["params"]) {
+    const YAML::Node p = root["params"];
+    rd.CheckKeys(p, "params", {"n", "segment_length", "bending", "stretching", "reference_bend", "grip_direction"});
+    if (!chain && p.size() > 0) rd.Fail("params", sc.params.model + " takes no parameters");
+    if (p["n"]) {
+      sc.params.n = rd.Get<int>(p["n"], "params.n", "an integer");
+    }
+    sc.params.segment_length = rd.Positive(p, "segment_length", "params.segment_length", sc.params.segment_length);
+    sc.params.bending = rd.Positive(p, "bending", "params.bending", sc.params.bending);
+    sc.params.stretching = rd.Positive(p, "stretching", "params.stretching", sc.params.stretching);
+    sc.params.reference_bend = rd.Number(p, "reference_bend", "params.reference_bend", 0.0);
+    if (p["grip_direction"])
+      sc.params.grip_direction = rd.Get<bool>(p["grip_direction"], "params.grip_direction", "true or false");
+  } else if (chain) {
+    rd.Fail("params", "missing (expected n, segment_length, bending, stretching)");
+  }
+  std::string error;
+  if (!sc.params.IsValid(&error)) throw SceneError(file_label + ": " + error);
+
+  // Controls: (X, Y) for planar models, (X, Y, Z) for thread3d (+ direction with a grip).
+  const int pos_dim = sc.params.model == "thread3d" ? 3 : 2;
+  const int m = sc.params.grip_direction ? 6 : pos_dim;
+  if (!root["grasp"]) rd.Fail("grasp", "missing (expected start and path)");
+  const YAML::Node g = root["grasp"];
+  rd.CheckKeys(g, "grasp", {"start", "direction", "path"});
+  if (!g["start"]) rd.Fail("grasp.start", "missing (expected a list of " + std::to_string(pos_dim) + " numbers)");
+  Vec start = rd.Vector(g["start"], "grasp.start", pos_dim);
+  Vec dir;
+  if (sc.params.grip_direction) {
+    if (!g["direction"]) rd.Fail("grasp.direction", "missing: params.grip_direction needs a list of 3 numbers");
+    dir = rd.Vector(g["direction"], "grasp.direction", 3);
+    if (!(dir.norm() > 1e-9)) rd.Fail("grasp.direction", "expected a non-zero vector");
+    dir.normalize();
+  } else if (g["direction"]) {
+    rd.Fail("grasp.direction", "only allowed with params.grip_direction: true");
+  }
+  sc.grasp_layout.spatial_dimension = pos_dim;
+  sc.grasp_layout.grip_direction = sc.params.grip_direction;
+  sc.grasp_start.resize(m);
+  sc.grasp_start.head(pos_dim) = start;
+  if (sc.params.grip_direction) sc.grasp_start.tail(3) = dir;
+  if (g["path"]) {
+    const YAML::Node path = g["path"];
+    if (!path.IsSequence() || path.size() < 1) rd.Fail("grasp.path", "expected a list of points");
+    for (size_t i = 0; i < path.size(); ++i) {
+      const std::string key = "grasp.path[" + std::to_string(i) + "]";
+      Vec p(m);
+      // With a grip direction a waypoint may also turn the grip: X,Y,Z,dx,dy,dz.
+      if (sc.params.grip_direction && path[i].IsSequence() && path[i].size() == 6) {
+        p = rd.Vector(path[i], key, 6);
+        if (!(p.tail(3).norm() > 1e-9)) rd.Fail(key, "expected a non-zero grip direction");
+        p.tail(3).normalize();
+      } else {
+        p.head(pos_dim) = rd.Vector(path[i], key, pos_dim);
+        if (sc.params.grip_direction) p.tail(3) = dir;
+      }
+      sc.path.push_back(p);
+    }
+  }
+
+  if (root["solver"]) {
+    const YAML::Node s = root["solver"];
+    rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "max_time_us", "linear_solver",
+                               "degeneracy_ratio", "max_reduction_step", "secant_predictor"});
+    if (s["method"]) {
+      const std::string name = rd.Get<std::string>(s["method"], "solver.method", "a method name");
+      if (!ParseMethod(name, &sc.solver.method))
+        rd.Fail("solver.method", "expected one of newton, newton-ls, higher-order, got '" + name + "'");
+    }
+    sc.solver.cutoff = rd.Positive(s, "cutoff", "solver.cutoff", sc.solver.cutoff);
+    if (s["max_iterations"]) {
+      sc.solver.max_iterations = rd.Get<int>(s["max_iterations"], "solver.max_iterations", "an integer >= 0");
+    }
+    sc.solver.max_time_us = rd.Number(s, "max_time_us", "solver.max_time_us", 0.0);
+    if (s["linear_solver"])
+      sc.solver.linear_solver = rd.Get<std::string>(s["linear_solver"], "solver.linear_solver", "a backend name");
+    sc.solver.degeneracy_ratio = rd.Number(s, "degeneracy_ratio", "solver.degeneracy_ratio", sc.solver.degeneracy_ratio);
+    sc.solver.max_reduction_step =
+        rd.Number(s, "max_reduction_step", "solver.max_reduction_step", sc.solver.max_reduction_step);
+    if (s["secant_predictor"])
+      sc.solver.secant_predictor = rd.Get<bool>(s["secant_predictor"], "solver.secant_predictor", "true or false");
+    if (!sc.solver.IsValid(&error)) throw SceneError(file_label + ": " + error);
+  }
+
+  if (root["device"]) {
+    const YAML::Node d = root["device"];
+    rd.CheckKeys(d, "device", {"model_units_per_metre", "newtons_per_model_force", "max_force_n",
+                               "max_stiffness_n_per_m", "workspace_radius_m", "model_origin"});
+    DeviceMapping& dm = sc.device;
+    dm.model_units_per_metre = rd.Positive(d, "model_units_per_metre", "device.model_units_per_metre", dm.model_units_per_metre);
+    dm.newtons_per_model_force =
+        rd.Positive(d, "newtons_per_model_force", "device.newtons_per_model_force", dm.newtons_per_model_force);
+    dm.max_force_n = rd.Positive(d, "max_force_n", "device.max_force_n", dm.max_force_n);
+    dm.max_stiffness_n_per_m = rd.Positive(d, "max_stiffness_n_per_m", "device.max_stiffness_n_per_m", dm.max_stiffness_n_per_m);
+    dm.workspace_radius_m = rd.Positive(d, "workspace_radius_m", "device.workspace_radius_m", dm.workspace_radius_m);
+    if (d["model_origin"]) {
+      const Vec o = rd.Vector(d["model_origin"], "device.model_origin", 3);
+      dm.model_origin = {o[0], o[1], o[2]};
+    }
+  }
+  if (root["targets"]) {
+    const YAML::Node t = root["targets"];
+    rd.CheckKeys(t, "targets", {"force_error", "rate_hz"});
+    sc.target_force_error = rd.Positive(t, "force_error", "targets.force_error", 0.01);
+    sc.target_rate_hz = rd.Positive(t, "rate_hz", "targets.rate_hz", 1000.0);
+  }
+  return sc;
+}
+
+Scene LoadScene(const std::string& path, const std::vector<SceneOverride>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path + ": cannot open scene file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ParseScene(ss.str(), path, overrides);
+}
+
+}  // namespace snapthread

@@ -1,0 +1,61 @@
+// Scenes: YAML files in scenes/ describing a model, its grasp, solver and device mapping.
+// A bad scene is refused at load with the file, the key and what was expected.
+#pragma once
+
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "models/models.h"
+#include "solvers/options.h"
+
+namespace snapthread {
+
+// Maps device metres to model units and model forces to newtons, with the device
+// limits the scene asks for (the device client also clamps to its own capabilities).
+struct DeviceMapping {
+  double model_units_per_metre = 100.0;  // 1 cm of hand motion = 1 model unit
+  double newtons_per_model_force = 1.0;
+  double max_force_n = 3.0;
+  double max_stiffness_n_per_m = 800.0;
+  double workspace_radius_m = 0.08;
+  // Model-space point that the device origin maps to.
+  std::array<double, 3> model_origin = {0.0, 0.0, 0.0};
+};
+
+struct Scene {
+  std::string file;         // where it was loaded from ("<string>" for text)
+  std::string name;
+  std::string description;
+  ModelParams params;
+  GraspLayout grasp_layout;  // the model's controls as a device sees them
+  Vec grasp_start;          // initial controls u (size = model controls)
+  // Scripted path of the grasp through the scene's snaps (waypoints in control space),
+  // used by the demo, the device client's scripted backends and the tests.
+  std::vector<Vec> path;
+  SolverOptions solver;
+  DeviceMapping device;
+  // Optional targets for "model no more than a scene needs".
+  double target_force_error = 0.0;  // relative to the model's force scale; 0 = none
+  double target_rate_hz = 0.0;
+};
+
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// key=value overrides, value parsed as YAML ("params.n=20", "solver.method=newton").
+struct SceneOverride {
+  std::string key;
+  std::string value;
+};
+
+Scene LoadScene(const std::string& path, const std::vector<SceneOverride>& overrides = {});
+Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
+                 const std::vector<SceneOverride>& overrides = {});
+// Parses "a.b=value"; throws SceneError for a malformed one.
+SceneOverride ParseOverride(const std::string& text);
+
+}  // namespace snapthread

@@ -1,0 +1,329 @@
+#include "solvers/higher_order_solver.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace snapthread {
+namespace {
+
+// Step for the central differences of the analytic gradient along v' (|v'|_inf = 1 in
+// model units): r = D^3E[v',v'] to O(h^2) with round-off ~ eps |E_x| / h^2.
+constexpr double kDifferenceStep = 1e-2;
+
+double QuarticSlope(const ReducedQuartic& q, double s) {
+  return q.phi1 + s * (2.0 * q.phi2 + s * (3.0 * q.phi3 + s * 4.0 * q.phi4));
+}
+double QuarticCurvature(const ReducedQuartic& q, double s) {
+  return 2.0 * q.phi2 + s * (6.0 * q.phi3 + s * 12.0 * q.phi4);
+}
+
+}  // namespace
+
+bool FollowedMinimum(const ReducedQuartic& q, double cap, double* s_out) {
+  // Downhill direction. At phi1 == 0 exactly the state is already stationary along v':
+  // it is the followed minimum if phi2 > 0, else move to the side where the cubic has
+  // its minimum (sign(phi3)).
+  double dir;
+  if (q.phi1 != 0.0) {
+    dir = q.phi1 > 0.0 ? -1.0 : 1.0;
+  } else if (q.phi2 > 0.0) {
+    *s_out = 0.0;
+    return true;
+  } else {
+    dir = q.phi3 >= 0.0 ? 1.0 : -1.0;
+  }
+  // Roots of 3 phi3 s^2 + 2 phi2 s + phi1, the cubic truncation's slope. The stable
+  // form (q = -(b + sign(b) sqrt(disc))/2, roots q/a and c/q) keeps a near-zero root
+  // exact even when the other is huge (DESIGN.md #3).
+  const double a = 3.0 * q.phi3, b = 2.0 * q.phi2, c = q.phi1;
+  double roots[2];
+  int count = 0;
+  const double scale = std::max({std::abs(a), std::abs(b), std::abs(c)});
+  if (scale == 0.0) return false;
+  if (std::abs(a) <= 1e-14 * scale) {
+    if (b != 0.0) roots[count++] = -c / b;
+  } else {
+    const double disc = b * b - 4.0 * a * c;
+    if (disc < 0.0) return false;  // no stationary point of the cubic: the minimum is gone
+    const double sq = std::sqrt(disc);
+    const double qq = -0.5 * (b + (b >= 0.0 ? sq : -sq));
+    if (qq != 0.0) {
+      roots[count++] = c / qq;
+      roots[count++] = qq / a;
+    } else {
+      roots[count++] = 0.0;  // b == 0 and c == 0
+    }
+  }
+  double best = 0.0;
+  bool found = false;
+  for (int i = 0; i < count; ++i) {
+    const double r = roots[i];
+    if (!std::isfinite(r) || r * dir < 0.0) continue;
+    if (!found || std::abs(r) < std::abs(best)) {
+      best = r;
+      found = true;
+    }
+  }
+  if (!found) return false;
+  // A minimum of the cubic model has non-negative curvature there.
+  if (2.0 * q.phi2 + 6.0 * q.phi3 * best < 0.0) return false;
+  // Refine on the quartic (a few safeguarded Newton steps on phi').
+  double s = best;
+  for (int it = 0; it < 8; ++it) {
+    const double curv = QuarticCurvature(q, s);
+    if (!(curv > 0.0)) break;
+    const double next = s - QuarticSlope(q, s) / curv;
+    if (!std::isfinite(next) || next * dir < 0.0) break;
+    if (std::abs(next - s) <= 1e-15 * std::max(1.0, std::abs(s))) {
+      s = next;
+      break;
+    }
+    s = next;
+  }
+  if (std::abs(s) > cap) {
+    // A minimum far outside the range where the expansion was sampled is spurious
+    // (DESIGN.md #3): step to the cap in the downhill direction instead.
+    s = dir * cap;
+  }
+  *s_out = s;
+  return true;
+}
+
+HigherOrderSolver::HigherOrderSolver(const Model& model, const SolverOptions& options)
+    : SolverBase(model, options) {
+  for (Vec* v : {&delta_, &vt_, &w_, &rhs_, &gp_, &gm_, &xs_}) v->resize(n_);
+  col_k_rows_.reserve(64);
+  col_k_pos_.reserve(64);
+  row_k_pos_.reserve(64);
+}
+
+LinearSolverStatus HigherOrderSolver::FactorRestricted(int k, SolverSummary* s) {
+  // H_{-k,-k} of (2.52): the same pattern with row and column k replaced by e_k, so the
+  // symbolic analysis is shared and a solve returns vectors with component k equal to
+  // the right-hand side's k-th entry.
+  std::copy(h_.valuePtr(), h_.valuePtr() + h_.nonZeros(), h_mod_.valuePtr());
+  const int* outer = h_mod_.outerIndexPtr();
+  const int* inner = h_mod_.innerIndexPtr();
+  double* val = h_mod_.valuePtr();
+  for (int p = outer[k]; p < outer[k + 1]; ++p) {
+    const int i = inner[p];
+    val[p] = (i == k) ? 1.0 : 0.0;
+    if (i == k) continue;
+    // Entry (k, i) in column i (sorted inner indices).
+    const int* b = inner + outer[i];
+    const int* e = inner + outer[i + 1];
+    const int* it = std::lower_bound(b, e, k);
+    if (it != e && *it == k) val[it - inner] = 0.0;
+  }
+  ++s->factorizations;
+  return alt_factor_->Factorize(h_mod_);
+}
+
+HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec* x,
+                                                               SolverSummary* s) {
+  s->used_reduction = true;
+  const Vec& v = eig_.vector();
+  // Scale v so its largest-modulus component v_k = 1 (2.44).
+  int k = 0;
+  v.cwiseAbs().maxCoeff(&k);
+  if (FactorRestricted(k, s) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+
+  // DESIGN.md #2: the graph tangent v' with v'_k = 1, H_{-k,-k} v'_{-k} = -H_{-k,k}.
+  // It equals v at the fold and makes the correction exactly Newton on a quadratic.
+  rhs_.setZero();
+  {
+    const int* outer = h_.outerIndexPtr();
+    const int* inner = h_.innerIndexPtr();
+    const double* val = h_.valuePtr();
+    for (int p = outer[k]; p < outer[k + 1]; ++p) rhs_[inner[p]] = -val[p];
+  }
+  rhs_[k] = 1.0;
+  if (alt_factor_->Solve(rhs_, &vt_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+
+  // Newton in the complement: delta with delta_k = 0 and (E_x + H delta)_{-k} = 0.
+  rhs_ = -g_;
+  rhs_[k] = 0.0;
+  if (alt_factor_->Solve(rhs_, &delta_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+
+  // r = D^3E[v', v'] by central differences of the analytic gradient (2.37), and
+  // q = (g+ - g-)/2h = H v' + h^2/6 D^4E[v',v',v'] for the quartic coefficient.
+  const double h = kDifferenceStep;
+  xs_ = *x + h * vt_;
+  EvalGradient(xs_, u, &gp_, s);
+  xs_ = *x - h * vt_;
+  EvalGradient(xs_, u, &gm_, s);
+  // r into rhs_ (scratch), q into gp_.
+  rhs_ = (gp_ - 2.0 * g_ + gm_) / (h * h);
+  gp_ = (gp_ - gm_) / (2.0 * h);
+
+  // Hv' has zero components off k by construction of v'; (Hv')_k = H_{k,:} v'.
+  double hvv = 0.0;
+  {
+    const int* outer = h_.outerIndexPtr();
+    const int* inner = h_.innerIndexPtr();
+    const double* val = h_.valuePtr();
+    for (int p = outer[k]; p < outer[k + 1]; ++p) hvv += val[p] * vt_[inner[p]];
+  }
+  const double r_v = rhs_.dot(vt_);           // D^3E[v',v',v']
+  const double d4 = 6.0 * (gp_.dot(vt_) - hvv) / (h * h);  // D^4E[v',v',v',v']
+
+  // (2.52): H_{-k,-k} w_{-k} = -1/2 r_{-k}, w_k = 0.
+  gm_ = -0.5 * rhs_;
+  gm_[k] = 0.0;
+  if (alt_factor_->Solve(gm_, &w_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+  const double r_w = rhs_.dot(w_);            // D^3E[v',v',w]
+
+  // (2.54-2.55) along c(s) = x + delta + s v' + s^2 w. With (Hv')_{-k} = 0, w_k = 0
+  // and (E_x + H delta)_{-k} = 0 the cross terms collapse:
+  //   phi1 = E_x.v'   phi2 = 1/2 v'^T H v'   phi3 = 1/6 D^3[v'^3] + v'^T H w = 1/6 D^3[v'^3]
+  //   phi4 = 1/2 w^T H w + 1/2 D^3[v',v',w] + 1/24 D^4[v'^4] = 1/4 r.w + 1/24 D^4[v'^4]
+  ReducedQuartic q;
+  q.phi1 = g_.dot(vt_);
+  q.phi2 = 0.5 * hvv;
+  q.phi3 = r_v / 6.0;
+  q.phi4 = 0.25 * r_w + d4 / 24.0;
+
+  double s_star = 0.0;
+  if (!FollowedMinimum(q, options_.max_reduction_step, &s_star)) return StepResult::kSnap;
+
+  // Energy decrease (Armijo-type) on every higher-order step (DESIGN.md #4): backtrack
+  // along the curve; a step that cannot decrease the energy is refused.
+  const double e0 = model_.Energy(*x, u);
+  double alpha = 1.0;
+  for (int it = 0; it < 12; ++it) {
+    const double ss = alpha * s_star;
+    xs_ = *x + alpha * delta_ + ss * vt_ + (ss * ss) * w_;
+    const double e = model_.Energy(xs_, u);
+    if (std::isfinite(e) && e <= e0 + 1e-14 * std::abs(e0)) {
+      x->swap(xs_);
+      return StepResult::kAccepted;
+    }
+    alpha *= 0.5;
+  }
+  return StepResult::kFailed;
+}
+
+bool HigherOrderSolver::FinishSnap(const Vec& u, Vec* x, SolverSummary* s) {
+  s->snapped = true;
+  return MinimizeFully(u, x, s);
+}
+
+SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
+  SolverSummary s;
+  BeginSolve(&s);
+  Vec& xr = *x;
+  last_good_ = xr;
+  double r = EvalGradient(xr, u, &g_, &s);
+  s.termination = Termination::kBudgetSpent;
+  bool newton_stalled = false;
+  int reduction_stalls = 0;
+  // Finishes a snap inside this update (DESIGN.md #4) and ends the iteration loop.
+  auto snap_and_stop = [&] {
+    if (!FinishSnap(u, &xr, &s)) {
+      s.termination = Termination::kLinearSolverFailed;
+      s.message = "snap minimiser did not converge";
+    }
+    r = EvalGradient(xr, u, &g_, &s);
+    if (s.termination != Termination::kLinearSolverFailed && r < options_.cutoff)
+      s.termination = Termination::kConverged;
+  };
+  while (NextIteration(r, x, &s)) {
+    const LinearSolverStatus st = FactorAt(xr, u, &s);
+    bool degenerate = true;
+    double lambda0 = 0.0;
+    if (st == LinearSolverStatus::kSuccess) {
+      lambda0 = eig_.Update(*factor_, h_, 1);
+      // DESIGN.md #1: degeneracy against a reference lambda_0, never against the
+      // largest diagonal entry (stretching sets the diagonal).
+      const bool indefinite = factor_->NegativePivots() > 0;
+      const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : lambda0;
+      degenerate = indefinite || !(lambda0 > options_.degeneracy_ratio * ref) || newton_stalled;
+    }
+    if (!degenerate) {
+      // Regular: the Newton step (2.18).
+      if (factor_->Solve(g_, &dx_) != LinearSolverStatus::kSuccess) {
+        s.termination = Termination::kLinearSolverFailed;
+        break;
+      }
+      // A Newton step longer than the reduction's cap leaves the region where the
+      // quadratic model holds: the control step has carried the state over a fold while
+      // lambda_0 still looked regular (DESIGN.md's open case). Finish it as a snap.
+      if (dx_.lpNorm<Eigen::Infinity>() > options_.max_reduction_step) {
+        snap_and_stop();
+        break;
+      }
+      // Approaching a fold (lambda_0 below its reference) a Newton step must also
+      // lower the energy; one that raises it is aimed at the saddle that is about to
+      // meet the followed minimum, so this iteration uses the reduction instead.
+      const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : lambda0;
+      bool take_newton = true;
+      if (lambda0 < 1.0 * ref) {
+        xs_ = xr - dx_;
+        take_newton = model_.Energy(xs_, u) <= model_.Energy(xr, u);
+      }
+      if (!take_newton) {
+        degenerate = true;
+      }
+    }
+    if (!degenerate) {
+      TakeNewtonStep(&xr);
+      // Where E_xx is regular Newton converges quadratically; a step that does not
+      // even halve |E_x| says the quadratic model has failed (a fold is close): the
+      // next iteration uses the reduction.
+      const double r_before = r;
+      r = EvalGradient(xr, u, &g_, &s);
+      newton_stalled = !(r < 0.5 * r_before);
+      continue;
+    }
+    {
+      // A factorisation that failed on an exactly singular E_xx still allows the
+      // reduction: it needs only the restricted factor and the last eigenvector.
+      const bool many_negative = st == LinearSolverStatus::kSuccess && factor_->NegativePivots() > 1;
+      StepResult res = StepResult::kFailed;
+      if (!many_negative) {
+        eig_.EnsureInitialized(n_);
+        res = ReductionStep(u, &xr, &s);
+      }
+      if (res == StepResult::kSnap || many_negative) {
+        snap_and_stop();
+        break;
+      }
+      if (res == StepResult::kFailed) {
+        // The reduction could not decrease the energy: one globalised step instead.
+        if (!GlobalizedStep(u, &xr, &g_, &s)) {
+          s.termination = Termination::kLinearSolverFailed;
+          s.message = "no descent step found";
+          break;
+        }
+      }
+      // On the quartic the reduction converges like Newton. Where the followed minimum
+      // has just vanished its ghost still attracts the quartic model, and the steps
+      // crawl through the bottleneck: two steps in a row that do not halve |E_x| mean
+      // the minimum is gone — finish the snap now rather than over the next updates.
+      // A reduction step that raises |E_x| (the energy fell, the force grew) says the
+      // same at once.
+      const double r_before = r;
+      r = EvalGradient(xr, u, &g_, &s);
+      reduction_stalls = (r < 0.5 * r_before) ? 0 : reduction_stalls + 1;
+      if (reduction_stalls >= 2 || r > r_before) {
+        snap_and_stop();
+        break;
+      }
+      continue;
+    }
+  }
+  Conclude(u, x, &s, /*leave_saddles=*/true);
+  // The budget ran out on an indefinite E_xx: the state
+  // is past the fold, where the followed minimum no longer exists. Finish the snap in
+  // this update (DESIGN.md #4) instead of crawling over the next ones. (If a minimum is
+  // right there after all, the minimiser simply converges to it: no jump, no snap.)
+  if (s.termination == Termination::kBudgetSpent && s.negative_pivots > 0) {
+    s.snapped = true;
+    if (MinimizeFully(u, x, &s)) s.termination = Termination::kConverged;
+    Finish(*x, u, &s);
+    Classify(&s);
+  }
+  return s;
+}
+
+}  // namespace snapthread

@@ -1,0 +1,40 @@
+#include "solvers/options.h"
+
+#include <cmath>
+
+namespace snapthread {
+
+const char* ToString(Method m) {
+  switch (m) {
+    case Method::kNewton: return "newton";
+    case Method::kNewtonLineSearch: return "newton-ls";
+    case Method::kHigherOrder: return "higher-order";
+  }
+  return "unknown";
+}
+
+bool ParseMethod(std::string_view name, Method* m) {
+  if (name == "newton") *m = Method::kNewton;
+  else if (name == "newton-ls") *m = Method::kNewtonLineSearch;
+  else if (name == "higher-order") *m = Method::kHigherOrder;
+  else return false;
+  return true;
+}
+
+bool SolverOptions::IsValid(std::string* error) const {
+  auto fail = [&](const char* m) {
+    if (error) *error = m;
+    return false;
+  };
+  if (!(cutoff > 0.0) || !std::isfinite(cutoff)) return fail("solver.cutoff: expected a finite number > 0");
+  if (max_iterations < 0) return fail("solver.max_iterations: expected an integer >= 0 (0 = unlimited)");
+  if (!(max_time_us >= 0.0) || !std::isfinite(max_time_us))
+    return fail("solver.max_time_us: expected a finite number >= 0 (0 = none)");
+  if (!(degeneracy_ratio > 0.0 && degeneracy_ratio < 1.0))
+    return fail("solver.degeneracy_ratio: expected a number in (0, 1)");
+  if (!(max_reduction_step > 0.0) || !std::isfinite(max_reduction_step))
+    return fail("solver.max_reduction_step: expected a finite number > 0");
+  return true;
+}
+
+}  // namespace snapthread

@@ -1,0 +1,156 @@
+#include "tracking/tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace snapthread {
+
+EquilibriumTracker::EquilibriumTracker(std::unique_ptr<Model> model, const SolverOptions& options)
+    : model_(std::move(model)), options_(options) {
+  if (!model_) throw std::invalid_argument("EquilibriumTracker: null model");
+  solver_ = MakeSolver(*model_, options_);
+  const int n = model_->NumStates(), m = model_->NumControls();
+  x_ = Vec::Zero(n);
+  x_prev_ = x_;
+  x_pred_ = x_;
+  u_ = Vec::Zero(m);
+  u_prev_ = u_;
+  eu_.resize(m);
+  scratch_.resize(n);
+  exu_.resize(n, m);
+  euu_.resize(m, m);
+  sol_.resize(n, m);
+  result_.force = Vec::Zero(m);
+  result_.stiffness = Mat::Zero(m, m);
+}
+
+void EquilibriumTracker::SetOptions(const SolverOptions& options) {
+  options_ = options;
+  solver_ = MakeSolver(*model_, options_);
+  have_prev_ = false;
+}
+
+const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
+  if (u.size() != model_->NumControls())
+    throw std::invalid_argument("EquilibriumTracker::Reset: control size mismatch");
+  solver_->Reset();
+  x_ = model_->InitialState(u);
+  u_ = u;
+  // A reset must start on an equilibrium: unlimited, globalised solve.
+  SolverOptions strict = options_;
+  strict.max_iterations = 0;
+  strict.max_time_us = 0.0;
+  strict.method = Method::kNewtonLineSearch;
+  auto start_solver = MakeSolver(*model_, strict);
+  result_.summary = start_solver->Solve(u, &x_);
+  // The globalised solve can still stop on a saddle when the start is symmetric (a
+  // straight compressed thread): leave along the negative mode until the inertia says
+  // it is a minimum (no negative pivot).
+  for (int k = 0; k < 8 && result_.summary.negative_pivots > 0; ++k) {
+    const Vec& v = start_solver->LowestEigenvector();
+    if (v.size() != x_.size()) break;
+    x_ += (0.1 * snap_threshold_ / std::max(v.lpNorm<Eigen::Infinity>(), 1e-300)) * v;
+    result_.summary = start_solver->Solve(u, &x_);
+  }
+  // Re-solve with the tracking solver so its factorisation and eigenpair are current.
+  result_.summary = solver_->Solve(u, &x_);
+  result_.snapped = false;
+  have_prev_ = false;
+  have_tangent_ = false;
+  x_prev_ = x_;
+  u_prev_ = u_;
+  ComputeForces();
+  return result_;
+}
+
+const TrackResult& EquilibriumTracker::Update(const Vec& u) {
+  if (u.size() != model_->NumControls())
+    throw std::invalid_argument("EquilibriumTracker::Update: control size mismatch");
+  // Warm start (DESIGN.md #5). Where the last state was regular, the tangent
+  // dx/du = -E_xx^-1 E_xu from its implicit differentiation (sol_, already computed for
+  // K) is the better predictor: exact to first order without history, and unaffected
+  // by a budget-limited previous update or by the grasp turning round. Near a fold
+  // (the floored eigenvalue makes the tangent arbitrary) fall back to the secant
+  // 2 x_{i-1} - x_{i-2}, scaled by how much of the previous control step the new one
+  // repeats (the secant is reset by a snap; the tangent at the new branch is valid).
+  x_pred_ = x_;
+  const bool tangent_ok = have_tangent_ && !result_.stiffness_regularized &&
+                          result_.summary.status != EquilibriumStatus::kNearFold;
+  if (options_.secant_predictor && tangent_ok) {
+    scratch_.noalias() = sol_ * (u - u_);
+    const double step = scratch_.lpNorm<Eigen::Infinity>();
+    const double cap = 5.0 * snap_threshold_;
+    x_pred_ -= (step > cap ? cap / step : 1.0) * scratch_;
+  } else if (options_.secant_predictor && have_prev_) {
+    const double d2 = (u_ - u_prev_).squaredNorm();
+    if (d2 > 0.0) {
+      const double a = std::clamp((u - u_).dot(u_ - u_prev_) / d2, 0.0, 2.0);
+      x_pred_ += a * (x_ - x_prev_);
+    }
+  }
+  x_prev_ = x_;
+  u_prev_ = u_;
+  x_ = x_pred_;
+  u_ = u;
+  result_.summary = solver_->Solve(u, &x_);
+  // A snap is a jump to another branch: the state left the predicted one by more than
+  // the threshold (for every method alike, so the charts compare like with like).
+  const double jump = (x_ - x_pred_).lpNorm<Eigen::Infinity>();
+  result_.snapped = jump > snap_threshold_;
+  if (result_.snapped) result_.summary.status = EquilibriumStatus::kSnapped;
+  // After a snap the secant would point along the jump: restart it.
+  have_prev_ = !result_.snapped;
+  ComputeForces();
+  return result_;
+}
+
+void EquilibriumTracker::ComputeForces() {
+  const Model& m = *model_;
+  // F = -E_u at the equilibrium (envelope theorem, §2.3.4); at a degenerate point this
+  // is still the finite, continuous force of (2.16-2.17).
+  m.ControlGradient(x_, u_, &eu_);
+  result_.force = -eu_;
+  result_.energy = result_.summary.energy;
+  result_.probe = m.Probe(x_, u_);
+
+  // K = dF/du = -(E_uu - E_ux E_xx^-1 E_xu) (implicit differentiation, (2.14-2.15)).
+  m.ControlHessian(x_, u_, &euu_);
+  m.MixedHessian(x_, u_, &exu_);
+  result_.stiffness_regularized = false;
+  const SymmetricLinearSolver* f = solver_->Factorization();
+  bool ok = f != nullptr;
+  for (int j = 0; ok && j < exu_.cols(); ++j) {
+    scratch_ = exu_.col(j);
+    ok = f->Solve(scratch_, &x_pred_) == LinearSolverStatus::kSuccess && x_pred_.allFinite();
+    sol_.col(j) = x_pred_;
+  }
+  const double lambda0 = result_.summary.lambda_min;
+  const bool regular_state = ok && result_.summary.negative_pivots == 0 &&
+                             result_.summary.status == EquilibriumStatus::kRegular;
+  if (regular_state) lambda_ref_ = lambda0;
+  if (ok && !regular_state && result_.summary.negative_pivots <= 1) {
+    // Near a fold E_xx^-1 blows up along its lowest mode v: floor that one eigenvalue
+    // at tau * lambda_ref (the spectral term v v^T / lambda_0 becomes v v^T / floor),
+    // so K is finite and continuous while the rest of the response is exact.
+    const Vec& v = solver_->LowestEigenvector();
+    const double floor = std::max(options_.degeneracy_ratio * std::max(lambda_ref_, 0.0), 1e-12);
+    if (v.size() == sol_.rows() && lambda0 < floor && lambda0 != 0.0) {
+      const double corr = 1.0 / floor - 1.0 / lambda0;
+      for (int j = 0; j < sol_.cols(); ++j) sol_.col(j) += v * (corr * v.dot(exu_.col(j)));
+      result_.stiffness_regularized = true;
+    }
+  }
+  have_tangent_ = ok;
+  if (ok) {
+    result_.stiffness = -(euu_ - exu_.transpose() * sol_);
+  }
+  if (!ok || !result_.stiffness.allFinite()) {
+    // No usable factorisation: the stiffness with the state held (no response), finite.
+    result_.stiffness = -euu_;
+    result_.stiffness_regularized = true;
+  }
+  result_.stiffness = 0.5 * (result_.stiffness + result_.stiffness.transpose()).eval();
+}
+
+}  // namespace snapthread

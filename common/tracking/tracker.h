@@ -1,0 +1,69 @@
+// EquilibriumTracker: follows the quasi-static equilibrium of a model as the grasp
+// moves, and gives the force on the grasp with its implicit derivative. This is the
+// one object the sweep tool, the stability suite, the benchmarks and the server share.
+#pragma once
+
+#include <memory>
+
+#include "models/model.h"
+#include "solvers/solver.h"
+
+namespace snapthread {
+
+struct TrackResult {
+  SolverSummary summary;
+  // F = -E_u at the equilibrium (envelope theorem, §2.3.4 / (2.16-2.17)).
+  Vec force;
+  // K = dF/du = -(E_uu - E_ux E_xx^-1 E_xu) by implicit differentiation (2.14-2.15),
+  // from the factorisation the solver already holds. Near a fold the one near-zero
+  // eigenvalue is floored (stiffness_regularized = true) so K stays finite; it is
+  // never NaN or infinite.
+  Mat stiffness;
+  bool stiffness_regularized = false;
+  double energy = 0.0;
+  double probe = 0.0;
+  // The state left the branch it followed at this update (a snap-through).
+  bool snapped = false;
+};
+
+class EquilibriumTracker {
+ public:
+  // Throws std::invalid_argument for invalid options.
+  EquilibriumTracker(std::unique_ptr<Model> model, const SolverOptions& options);
+
+  // Start again from the model's InitialState(u), solved to the cutoff with an
+  // unlimited budget (a reset must start on an equilibrium).
+  const TrackResult& Reset(const Vec& u);
+  // One control update: predictor, solve within the budget, force and stiffness.
+  const TrackResult& Update(const Vec& u);
+
+  // Switch method / budget / cutoff without losing the state.
+  void SetOptions(const SolverOptions& options);
+
+  const Model& model() const { return *model_; }
+  const SolverOptions& options() const { return options_; }
+  const Vec& state() const { return x_; }
+  const Vec& control() const { return u_; }
+  const TrackResult& last() const { return result_; }
+  // A state change larger than this (max norm, model units) against the predicted
+  // state counts as a jump to another branch (default 0.1; scenes set 0.1 l).
+  void SetSnapThreshold(double t) { snap_threshold_ = t; }
+
+ private:
+  void ComputeForces();
+
+  std::unique_ptr<Model> model_;
+  SolverOptions options_;
+  std::unique_ptr<EquilibriumSolver> solver_;
+  Vec x_, x_prev_, u_, u_prev_;
+  bool have_prev_ = false;
+  bool have_tangent_ = false;  // sol_ holds E_xx^-1 E_xu of the current state
+  double snap_threshold_ = 0.1;
+  double lambda_ref_ = -1.0;
+  TrackResult result_;
+  // scratch
+  Vec eu_, scratch_, x_pred_;
+  Mat exu_, euu_, sol_;
+};
+
+}  // namespace snapthread
