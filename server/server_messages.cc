@@ -96,7 +96,7 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
     // headroom for the device client's stiffness clamp, latency and the 1 kHz sample
     // rate (a spring at the stability limit would buzz).
     const double k_plane = PlanarStiffness(map);
-    m.f0[2] = -k_plane * (m.u0[2] - PlanarZ0(map));
+    m.f0[2] = -k_plane * (m.u0[2] - messages::PlanarZ0(map));
     m.K[2][2] = -k_plane;
   }
   if (nu >= dim + 3 && dim == 3) {
