@@ -58,7 +58,7 @@ class Probe {
     std::string why;
     const bool ok = transport::DecodeAndValidate(rbuf, &m, &why);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!ok || !IsFinite(m)) {
+    if (!ok || !transport::Validate(m, nullptr)) {
       ++invalid_;
       return;
     }
@@ -618,7 +618,7 @@ TEST_F(ServerTest, FarPosesNeverPublishNaN) {
   }
   EXPECT_EQ(probe_->models().size(), static_cast<size_t>(seq));
   EXPECT_EQ(probe_->invalid(), 0);
-  for (const auto& m : probe_->models()) EXPECT_TRUE(IsFinite(m));
+  for (const auto& m : probe_->models()) EXPECT_TRUE(transport::Validate(m, nullptr));
 }
 
 }  // namespace
