@@ -111,6 +111,12 @@ bool CheckWire(std::span<const Field<T>> fields, const void* data, int size, std
         if (!ReadI32(p, size, &ipos, &len) || len < 1 || len > size - ipos) {
           return Fail(why, type + ": malformed string length (" + f.name + ")");
         }
+        // lcm-gen's decoder reads the string up to its first NUL and skips the rest: a
+        // missing terminator or an embedded NUL would be accepted and lost (the message
+        // would not re-encode to the bytes received).
+        if (p[ipos + len - 1] != 0 || std::memchr(p + ipos, 0, len - 1) != nullptr) {
+          return Fail(why, type + ": string " + f.name + " is not one NUL-terminated string");
+        }
         pos = ipos + static_cast<int64_t>(len);
         break;
       }
