@@ -4,8 +4,8 @@
 //  * CheckWire, before decoding: lcm-gen 1.3.1's decoders trust the wire (a string length
 //    of INT32_MIN makes them read 2 GB past the buffer, a corrupted count makes them
 //    allocate whatever it says), so every string length and array count is checked
-//    against the bytes actually there. Offsets follow from the table; none is written
-//    by hand.
+//    against the bytes actually there, and the fields must fill the buffer exactly.
+//    Offsets follow from the table; none is written by hand.
 //  * CheckFields, after decoding: finiteness, integer ranges, string sizes and the few
 //    rules of their own (a quaternion's norm, rows that agree with their count).
 // Adding a field to a message is one row in its table.
@@ -26,7 +26,7 @@ inline constexpr size_t kMaxStringBytes = 4096;
 // How a field is encoded by LCM (big-endian; a string is an int32 length that counts the
 // terminating NUL, then the bytes).
 enum class Wire {
-  kInt8,
+  kInt8,        // `count` of them (byte mac[32] -> 32)
   kInt32,
   kInt64,
   kDouble,      // `count` doubles (a fixed array: double[3] -> 3, double[3][3] -> 9)
@@ -75,32 +75,21 @@ inline bool ReadI32(const uint8_t* p, int size, int* pos, int32_t* out) {
   return true;
 }
 
-inline bool IsVariable(Wire w) {
-  return w == Wire::kString || w == Wire::kCount || w == Wire::kCountedRows;
-}
-
 }  // namespace field_table_internal
 
-// Walks an encoded T (8-byte hash first) up to its last variable-length field and checks
-// every string length (in [1, bytes left]) and count (its [min, max], and its rows within
-// the buffer). Fixed-size reads are left to the decoder, which checks them.
+// Walks an encoded T (8-byte hash first) through every field of its table: each string
+// length must lie in [1, bytes left] and end in the string's only NUL, each count in its
+// [min, max] with its rows within the buffer, and the fields must fill the buffer
+// exactly. So a table that misses a field of the .lcm refuses every message (the tests
+// see it at once), and lcm-gen's decoder never meets a length it would trust blindly.
 template <class T>
 bool CheckWire(std::span<const Field<T>> fields, const void* data, int size, std::string* why) {
   using namespace field_table_internal;
   const std::string type = T::getTypeName();
   const auto* p = static_cast<const uint8_t*>(data);
-  size_t last_variable = 0;
-  bool any_variable = false;
-  for (size_t i = 0; i < fields.size(); ++i) {
-    if (IsVariable(fields[i].wire)) {
-      last_variable = i;
-      any_variable = true;
-    }
-  }
-  if (!any_variable) return true;  // fixed size: the decoder checks every read
   int64_t pos = 8;                 // the type hash
   int64_t rows = 0;
-  for (size_t i = 0; i <= last_variable; ++i) {
+  for (size_t i = 0; i < fields.size(); ++i) {
     const Field<T>& f = fields[i];
     switch (f.wire) {
       case Wire::kString: {
@@ -146,6 +135,14 @@ bool CheckWire(std::span<const Field<T>> fields, const void* data, int size, std
         pos += static_cast<int64_t>(WireBytes(f.wire)) * f.count;
         break;
     }
+  }
+  if (pos > size) {
+    return Fail(why, type + " truncated (" + std::to_string(size) + " bytes, the fields need " +
+                         std::to_string(pos) + ")");
+  }
+  if (pos < size) {
+    return Fail(why, "buffer has " + std::to_string(size - pos) +
+                         " trailing bytes after the message");
   }
   return true;
 }
@@ -219,8 +216,9 @@ Field<typename field_table_internal::MemberOf<decltype(M)>::Class> Member(const 
     f.wire = Wire::kString;
     f.text = &TextOf<M>;
   } else {
-    static_assert(std::is_integral_v<V>, "a message field is a double, a string or an integer");
-    f.wire = sizeof(V) == 1 ? Wire::kInt8 : sizeof(V) == 4 ? Wire::kInt32 : Wire::kInt64;
+    static_assert(std::is_integral_v<E>, "a message field is a double, a string or an integer");
+    f.wire = sizeof(E) == 1 ? Wire::kInt8 : sizeof(E) == 4 ? Wire::kInt32 : Wire::kInt64;
+    f.count = static_cast<int>(sizeof(V) / sizeof(E));  // byte mac[32] -> 32
   }
   return f;
 }

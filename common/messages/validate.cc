@@ -49,7 +49,8 @@ bool ShapePositions(const thread_shape_t& msg, std::string* why) {
 
 // ---- one table per message type: its fields in .lcm order (lcmtypes/*.lcm) -----------------
 // Every double must be finite and every string at most kMaxStringBytes (Member's default);
-// the ranges below are the rest.
+// the ranges below are the rest. The authentication fields (epoch, auth_seq, mac) are
+// checked by the receiver's auth layer (common/auth), not here.
 
 using D = device_state_t;
 const Field<D> kDeviceState[] = {
@@ -59,6 +60,9 @@ const Field<D> kDeviceState[] = {
     Member<&D::position>("position"),
     With(Member<&D::orientation>("orientation"), &QuaternionNorm),
     Member<&D::buttons>("buttons"),
+    Member<&D::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&D::auth_seq>("auth_seq"),
+    Member<&D::mac>("mac"),
 };
 
 using F = force_model_t;
@@ -77,6 +81,9 @@ const Field<F> kForceModel[] = {
     Member<&F::torque0>("torque0"),
     Member<&F::iterations>("iterations", 0, kInt32Max),
     Member<&F::residual>("residual"),
+    Member<&F::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&F::auth_seq>("auth_seq"),
+    Member<&F::mac>("mac"),
 };
 
 using S = thread_shape_t;
@@ -93,6 +100,9 @@ const Field<S> kThreadShape[] = {
     Member<&S::force_newtons>("force_newtons"),
     Member<&S::status>("status", F::STATUS_REGULAR, F::STATUS_INVALID),
     Member<&S::snaps>("snaps"),
+    Member<&S::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&S::auth_seq>("auth_seq"),
+    Member<&S::mac>("mac"),
 };
 
 using V = solver_status_t;
@@ -113,6 +123,9 @@ const Field<V> kSolverStatus[] = {
     Member<&V::snaps>("snaps"),
     Member<&V::dropped_poses>("dropped_poses"),
     Member<&V::rejected_messages>("rejected_messages"),
+    Member<&V::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&V::auth_seq>("auth_seq"),
+    Member<&V::mac>("mac"),
 };
 
 using T = device_status_t;
@@ -136,6 +149,9 @@ const Field<T> kDeviceStatus[] = {
     Member<&T::slew_limits>("slew_limits"),
     Member<&T::fades>("fades"),
     Member<&T::snaps_felt>("snaps_felt"),
+    Member<&T::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&T::auth_seq>("auth_seq"),
+    Member<&T::mac>("mac"),
 };
 
 using C = command_t;
@@ -143,6 +159,9 @@ const Field<C> kCommand[] = {
     Member<&C::utime>("utime"),
     Member<&C::command>("command", C::RESET, C::SET_METHOD),
     Member<&C::argument>("argument"),
+    Member<&C::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&C::auth_seq>("auth_seq"),
+    Member<&C::mac>("mac"),
 };
 
 std::span<const Field<D>> TableOf(const D*) { return kDeviceState; }

@@ -37,7 +37,8 @@ bool Validate(const device_status_t& msg, std::string* why);
 bool Validate(const command_t& msg, std::string* why);
 
 // Checks an encoded buffer before handing it to the generated decoder: every string
-// length and array count of T against the bytes there (field_table.h: CheckWire).
+// length and array count of T against the bytes there, and that T's fields fill the
+// buffer exactly (field_table.h: CheckWire).
 // Defined for the six message types above.
 template <class T>
 bool PreDecodeCheck(const void* data, int size, std::string* why);
