@@ -50,14 +50,8 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# lcm-logger closes its log on SIGINT; never wait for it forever.
-stop_logger() {
-  kill -INT "$1" 2>/dev/null
-  for _ in $(seq 50); do kill -0 "$1" 2>/dev/null || break; sleep 0.1; done
-  kill -KILL "$1" 2>/dev/null
-  wait "$1" 2>/dev/null
-}
-fail() { echo "FAIL: $*"; echo "--- outputs in $work"; for f in "$work"/*.txt; do echo "== $f"; tail -n 15 "$f"; done; exit 1; }
+# stop_logger, fail, json
+source "$(dirname "$0")/../../tests/support/script_support.sh"
 
 # Namespaces left by an earlier run of this script that was killed before its trap ran
 # (their names end in the pid of that run, which is gone).
@@ -122,7 +116,6 @@ stop_logger "$logger_pid"
 
 [ $device_rc -eq 0 ] || fail "device exited $device_rc"
 [ $server_rc -eq 0 ] || fail "server exited $server_rc"
-json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))$2)" "$1"; }
 models=$(json "$work/device.json" "['models_received']") || fail "no models_received in device.json"
 [ "$models" -gt 0 ] || fail "device received no force models across namespaces"
 echo "device ($ns_dev) received $models force models from the server ($ns_srv)"
