@@ -71,5 +71,7 @@ int main(int argc, char** argv) {
     }
     return 0;
   };
-  return RunTool("snapthread-sweep", app, argc, argv, run, {.scene_error_is_bad_input = true});
+  ToolExitCodes codes;
+  codes.scene_error_is_bad_input = true;
+  return RunTool("snapthread-sweep", app, argc, argv, run, codes);
 }

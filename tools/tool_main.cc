@@ -22,7 +22,7 @@ int RunTool(const std::string& tool, CLI::App& app, int argc, char** argv, const
     return codes.scene_error_is_bad_input ? 2 : 1;
   } catch (const std::invalid_argument& e) {
     std::cerr << tool << ": " << e.what() << '\n';
-    return 2;
+    return codes.invalid_argument_is_bad_input ? 2 : 1;
   } catch (const std::exception& e) {
     std::cerr << tool << ": " << e.what() << '\n';
     return 1;

@@ -16,6 +16,8 @@ struct ToolExitCodes {
   // A SceneError (a scene file that does not load) is bad input (2) rather than a
   // failure (1).
   bool scene_error_is_bad_input = false;
+  // std::invalid_argument is bad input (2); false: a failure (1) like any other.
+  bool invalid_argument_is_bad_input = true;
 };
 
 // Parses argv with `app` (--help exits 0, a bad argument 2) and runs `body`, whose

@@ -50,7 +50,7 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# stop_logger, fail, json
+# stop_logger, fail, json, run_session
 source "$(dirname "$0")/../../tests/support/script_support.sh"
 
 # Namespaces left by an earlier run of this script that was killed before its trap ran
@@ -102,13 +102,7 @@ ip netns exec "$ns_obs" xvfb-run -a -n $((100 + tag % 800)) -s "-screen 0 640x48
     --timeout-s $((duration + 10)) --width 640 --height 480 > "$work/observer_viewer.txt" 2>&1 &
 viewer_pid=$!
 sleep 0.5
-ip netns exec "$ns_srv" "$bin/snapthread-server" --scene "$scene" --session "$session" --lcm-url "$url" \
-    --duration $((duration + 2)) --summary "$work/server.json" > "$work/server.txt" 2>&1 &
-server_pid=$!
-sleep 0.5
-ip netns exec "$ns_dev" "$bin/snapthread-device" --backend virtual-hand --scene "$scene" --session "$session" \
-    --lcm-url "$url" --duration "$duration" --no-rt --summary "$work/device.json" > "$work/device.txt" 2>&1
-device_rc=$?
+run_session "ip netns exec $ns_srv" "ip netns exec $ns_dev"
 wait "$server_pid"; server_rc=$?
 wait "$viewer_pid"; viewer_rc=$?
 wait "$rates_pid"; rates_rc=$?

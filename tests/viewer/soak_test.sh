@@ -38,7 +38,7 @@ if [ "$(id -u)" -ne 0 ]; then prio=""; logger_prio=""; fi
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
 trap cleanup EXIT
-# stop_logger, fail, json
+# stop_logger, fail, json, run_session
 source "$(dirname "$0")/../support/script_support.sh"
 
 $logger_prio lcm-logger -q -c "${session}_.*" --lcm-url="$url" -f "$work/session.lcmlog" > "$work/logger.txt" 2>&1 &
@@ -51,13 +51,7 @@ for v in 1 2; do
   eval "viewer${v}_pid=$!"
 done
 sleep 0.5
-$prio "$bin/snapthread-server" --scene "$scene" --session "$session" --lcm-url "$url" \
-    --duration $((duration + 2)) --summary "$work/server.json" > "$work/server.txt" 2>&1 &
-server_pid=$!; pids+=("$server_pid")
-sleep 0.5
-$prio "$bin/snapthread-device" --backend virtual-hand --scene "$scene" --session "$session" --lcm-url "$url" \
-    --duration "$duration" --no-rt --summary "$work/device.json" > "$work/device.txt" 2>&1
-device_rc=$?
+run_session "$prio" "$prio"
 wait "$server_pid"; server_rc=$?
 wait "$viewer1_pid"; v1_rc=$?
 wait "$viewer2_pid"; v2_rc=$?
