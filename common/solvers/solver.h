@@ -13,43 +13,9 @@
 #include "linalg/linear_solver.h"
 #include "models/model.h"
 #include "solvers/options.h"
+#include "solvers/summary.h"
 
 namespace snapthread {
-
-enum class Termination {
-  kConverged,           // ||E_x|| < cutoff
-  kBudgetSpent,         // iteration or time budget spent first
-  kLinearSolverFailed,  // factorisation failed and no fallback could proceed
-  kNonFinite,           // a NaN/Inf appeared; the state was restored
-};
-const char* ToString(Termination t);
-
-// What the equilibrium looks like to a user of the force: regular, near a fold
-// (E_xx nearly singular: stiffness from the reduction), or the state just snapped.
-enum class EquilibriumStatus { kRegular = 0, kNearFold = 1, kSnapped = 2 };
-const char* ToString(EquilibriumStatus s);
-
-struct SolverSummary {
-  Termination termination = Termination::kBudgetSpent;
-  EquilibriumStatus status = EquilibriumStatus::kRegular;
-  int iterations = 0;
-  int gradient_evaluations = 0;
-  int hessian_evaluations = 0;
-  int factorizations = 0;
-  double residual = 0.0;     // ||E_x||_2 at the returned state
-  double energy = 0.0;
-  double lambda_min = 0.0;   // smallest eigenvalue estimate of E_xx at the returned state
-  int negative_pivots = 0;   // inertia of E_xx at the returned state
-  // higher-order: the reduction found that the followed minimum had vanished and the
-  // snap minimiser ran (whether the state really changed branch is the tracker's call).
-  bool snapped = false;
-  bool used_reduction = false;  // higher-order: the one-direction reduction was used
-  double solve_us = 0.0;
-  std::string message;
-
-  bool IsConverged() const { return termination == Termination::kConverged; }
-  std::string BriefReport() const;
-};
 
 class EquilibriumSolver {
  public:
