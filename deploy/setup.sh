@@ -11,7 +11,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libspdlog-dev libgtest-dev libgmock-dev
   libyaml-cpp-dev libcli11-dev
   libglfw3-dev libepoxy-dev xvfb xauth libstb-dev libpng-dev libgl1-mesa-dri xdotool
-  gnuplot-nox
+  gnuplot-nox graphviz python3 ccache
   iproute2 procps
 )
 
