@@ -15,6 +15,7 @@
 #include "realtime/clock.h"
 #include "messages/lcm_url.h"
 #include "messages/validate.h"
+#include "solvers/registry.h"
 
 namespace snapthread::server {
 namespace {
@@ -72,7 +73,7 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
   // touching the network.
   Scene scene = LoadScene(params_.scene_path);
   session_ = MakeSession(scene);
-  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), nullptr);
+  SetInfo(session_->scene.name, session_->tracker->options().method, nullptr);
 
   if (lcm != nullptr) {
     lcm_ = lcm;
@@ -95,11 +96,10 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
   session->scene = scene;
   SolverOptions options = scene.solver;
   if (!method_override_.empty()) {
-    Method m;
-    if (!ParseMethod(method_override_, &m)) {
+    if (SolverRegistry::Global().Find(method_override_) == nullptr) {
       throw std::invalid_argument("unknown method '" + method_override_ + "'");
     }
-    options.method = m;
+    options.method = method_override_;
   }
   session->scene.solver = options;
   // MakeModel / the tracker throw std::invalid_argument for invalid parameters.
@@ -133,7 +133,7 @@ void Server::Start() {
   receive_thread_ = std::thread([this] { ReceiveLoop(); });
   spdlog::info("server: session {} on {}, scene '{}' ({}), method {}", channels_.session,
                lcm_url_, session_->scene.name, session_->scene.file,
-               ToString(session_->tracker->options().method));
+               session_->tracker->options().method);
 }
 
 void Server::Stop() {
@@ -326,20 +326,19 @@ void Server::ApplyCommand(const command_t& command) {
       break;
     }
     case command_t::SET_METHOD: {
-      Method m;
-      if (!ParseMethod(command.argument, &m)) {
+      if (SolverRegistry::Global().Find(command.argument) == nullptr) {
         ok = false;
-        message = "SET_METHOD refused: unknown method '" + command.argument +
-                  "' (expected newton, newton-ls or higher-order)";
+        message = "SET_METHOD refused: unknown method '" + command.argument + "' (expected " +
+                  SolverRegistry::Global().NamesText(", ", " or ") + ")";
         break;
       }
       try {
         SolverOptions options = session_->tracker->options();
-        options.method = m;
+        options.method = command.argument;
         session_->tracker->SetOptions(options);
         session_->scene.solver = options;
         method_override_ = command.argument;
-        message = std::string("SET_METHOD: now ") + ToString(m);
+        message = "SET_METHOD: now " + command.argument;
       } catch (const std::exception& e) {
         ok = false;
         message = std::string("SET_METHOD failed: ") + e.what();
@@ -352,7 +351,7 @@ void Server::ApplyCommand(const command_t& command) {
   }
   // The message first, then the counters: a caller that waits on a counter reads the
   // message of that command.
-  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), &message);
+  SetInfo(session_->scene.name, session_->tracker->options().method, &message);
   if (ok) {
     // A new start: the shape's snap count is "since the session (re)started".
     if (command.command != command_t::SET_METHOD) {
@@ -402,7 +401,7 @@ void Server::PublishStatus() {
   const transport::PercentileSummary window = status_window_.Compute();
   StatusInputs in;
   in.scene = session_->scene.name;
-  in.method = ToString(session_->tracker->options().method);
+  in.method = session_->tracker->options().method;
   in.summary = &session_->tracker->last().summary;
   in.status = last_status_;
   in.update_rate_hz = dt > 0.0 ? static_cast<double>(updates - updates_at_last_status_) / dt : 0.0;

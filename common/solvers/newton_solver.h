@@ -19,7 +19,7 @@ namespace snapthread {
 class SolverBase : public EquilibriumSolver {
  public:
   SolverBase(const Model& model, const SolverOptions& options);
-  Method method() const override { return options_.method; }
+  const std::string& method() const override { return options_.method; }
   void Reset() override;
   const SymmetricLinearSolver* Factorization() const override;
   const Vec& LowestEigenvector() const override { return ws_.eig.vector(); }

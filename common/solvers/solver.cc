@@ -2,8 +2,7 @@
 
 #include <stdexcept>
 
-#include "solvers/higher_order_solver.h"
-#include "solvers/newton_solver.h"
+#include "solvers/registry.h"
 
 namespace snapthread {
 
@@ -16,15 +15,13 @@ std::unique_ptr<EquilibriumSolver> MakeSolver(const Model& model, const SolverOp
     throw std::invalid_argument("solver.linear_solver: expected one of " + names + ", got '" +
                                 options.linear_solver + "'");
   }
-  switch (options.method) {
-    case Method::kNewton:
-      return std::make_unique<NewtonSolver>(model, options, false);
-    case Method::kNewtonLineSearch:
-      return std::make_unique<NewtonSolver>(model, options, true);
-    case Method::kHigherOrder:
-      return std::make_unique<HigherOrderSolver>(model, options);
+  const SolverRegistry& registry = SolverRegistry::Global();
+  const SolverEntry* entry = registry.Find(options.method);
+  if (entry == nullptr) {
+    throw std::invalid_argument("solver.method: expected one of " + registry.NamesText(", ", ", ") +
+                                ", got '" + options.method + "'");
   }
-  throw std::invalid_argument("solver.method: unknown method");
+  return entry->make(model, options);
 }
 
 }  // namespace snapthread

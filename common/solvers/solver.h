@@ -20,7 +20,8 @@ namespace snapthread {
 class EquilibriumSolver {
  public:
   virtual ~EquilibriumSolver() = default;
-  virtual Method method() const = 0;
+  // The registered name (SolverOptions::method) this solver was made under.
+  virtual const std::string& method() const = 0;
   // Moves *x (the warm start) to an equilibrium of E(., u). x keeps the last accepted
   // state on failure; it never holds NaN on return.
   virtual SolverSummary Solve(const Vec& u, Vec* x) = 0;
@@ -34,7 +35,9 @@ class EquilibriumSolver {
   virtual const Vec& LowestEigenvector() const = 0;
 };
 
-// Throws std::invalid_argument if !options.IsValid().
+// Makes the registered solver options.method (solvers/registry.h). Throws
+// std::invalid_argument naming the field if !options.IsValid(), or if the method or the
+// linear solver is not registered (listing the registered names).
 std::unique_ptr<EquilibriumSolver> MakeSolver(const Model& model, const SolverOptions& options);
 
 }  // namespace snapthread

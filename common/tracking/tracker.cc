@@ -41,7 +41,7 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   SolverOptions strict = options_;
   strict.max_iterations = 0;
   strict.max_time_us = 0.0;
-  strict.method = Method::kNewtonLineSearch;
+  strict.method = "newton-ls";
   auto start_solver = MakeSolver(*model_, strict);
   result_.summary = start_solver->Solve(u, &x_);
   // The globalised solve can still stop on a saddle when the start is symmetric (a

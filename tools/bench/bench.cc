@@ -36,15 +36,6 @@ double RelativeRmsForceError(const std::vector<SweepRow>& trace, const std::vect
 
 double ForceScaleOf(const Scene& scene) { return MakeModel(scene.params)->ForceScale(); }
 
-const char* MethodColor(Method m) {
-  switch (m) {
-    case Method::kNewton: return "#1f77b4";
-    case Method::kNewtonLineSearch: return "#ff7f0e";
-    case Method::kHigherOrder: return "#2ca02c";
-  }
-  return "#000000";
-}
-
 // ---------------------------------------------------------------- statistics
 
 Spread Summarize(std::vector<double> v) {

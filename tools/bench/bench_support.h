@@ -24,7 +24,5 @@ double RelativeRmsForceError(const std::vector<SweepRow>& trace, const std::vect
 
 double ForceScaleOf(const Scene& scene);
 
-// Line colour of a method in the gnuplot charts.
-const char* MethodColor(Method m);
 
 }  // namespace snapthread
