@@ -36,6 +36,14 @@ double RelativeRmsForceError(const std::vector<SweepRow>& trace, const std::vect
 
 double ForceScaleOf(const Scene& scene) { return MakeModel(scene.params)->ForceScale(); }
 
+Scene WithSolver(const Scene& scene, const std::string& method, double cutoff, int budget) {
+  Scene s = scene;
+  s.solver.method = method;
+  s.solver.cutoff = cutoff;
+  s.solver.max_iterations = budget;
+  return s;
+}
+
 // ---------------------------------------------------------------- statistics
 
 Spread Summarize(std::vector<double> v) {

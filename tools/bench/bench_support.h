@@ -24,5 +24,7 @@ double RelativeRmsForceError(const std::vector<SweepRow>& trace, const std::vect
 
 double ForceScaleOf(const Scene& scene);
 
+// The scene solved with `method`, `cutoff` and an iteration budget (0 = unlimited).
+Scene WithSolver(const Scene& scene, const std::string& method, double cutoff, int budget);
 
 }  // namespace snapthread
