@@ -7,6 +7,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "auth/message_mac.h"
 #include "messages/validate.h"
 #include "realtime/clock.h"
 
@@ -50,7 +51,11 @@ DeviceClient::DeviceClient(HapticDevice* device, DeviceTransport* transport,
       trace_ring_(std::make_unique<TraceRing>()),
       lateness_(std::make_unique<LatenessRing>()),
       trace_file_(OpenTrace(config_.trace_file), &CloseFile),
-      receiver_(config_.limits, models_.get()),
+      channels_(config_.session),
+      sent_poses_(std::make_unique<auth::PoseEchoWindow>()),
+      receiver_(config_.limits, models_.get(),
+                ModelAuth{config_.key, channels_.force_model, channels_.solver_status,
+                                    sent_poses_.get()}),
       tick_(device_, &safety_, models_.get(), poses_.get(),
             trace_file_ ? trace_ring_.get() : nullptr, lateness_.get(), config_.tick),
       loop_(&tick_, config_.loop) {
@@ -104,9 +109,31 @@ void DeviceClient::Stop() {
 void DeviceClient::Tick(int64_t now_us, int64_t lateness_us) { tick_.Tick(now_us, lateness_us); }
 
 int DeviceClient::Receive(int wait_ms) {
-  return transport_->PollForceModels(wait_ms, [this](const void* data, int size) {
+  const int n = transport_->PollForceModels(wait_ms, [this](const void* data, int size) {
     receiver_.Receive(data, size, Now());
   });
+  transport_->PollSolverStatus(
+      [this](const void* data, int size) { receiver_.ReceiveStatus(data, size); });
+  return n;
+}
+
+bool DeviceClient::SignPose() {
+  if (config_.key == nullptr) return true;
+  // Epoch 0 until an authenticated status was heard: the server refuses such poses and
+  // no model can answer them, so the device stays in its fade.
+  const int64_t epoch = receiver_.epoch();
+  if (!auth::Sign(&state_msg_, channels_.device_state, epoch, auth_seq_.Next(), *config_.key)) {
+    return false;
+  }
+  // Before it leaves: a model answering it may arrive before Publish returns.
+  sent_poses_->Record(epoch, state_msg_.seq, state_msg_.utime);
+  return true;
+}
+
+bool DeviceClient::SignStatus(device_status_t* st) {
+  if (config_.key == nullptr) return true;
+  return auth::Sign(st, channels_.device_status, receiver_.epoch(), auth_seq_.Next(),
+                    *config_.key);
 }
 
 void DeviceClient::Drain() {
@@ -119,7 +146,7 @@ void DeviceClient::Drain() {
     state_msg_.buttons = p.buttons;
     // The servo already refused bad positions; this also catches a backend's bad
     // orientation, so the server never receives a pose it would have to reject.
-    if (!transport::Validate(state_msg_, nullptr)) {
+    if (!transport::Validate(state_msg_, nullptr) || !SignPose()) {
       invalid_poses_unpublished_.fetch_add(1);
     } else if (transport_->PublishDeviceState(state_msg_)) {
       poses_published_.fetch_add(1);
@@ -149,8 +176,8 @@ void DeviceClient::MaybeReport(int64_t now_us) {
   const uint64_t ticks = tick_.counters().ticks.load();
   const double rate =
       static_cast<double>(ticks - last_status_ticks_) / Seconds(now_us - last_status_us_);
-  const device_status_t st = BuildStatus(now_us, rate, status_seq_++);
-  if (transport::Validate(st, nullptr) && !transport_->PublishDeviceStatus(st)) {
+  device_status_t st = BuildStatus(now_us, rate, status_seq_++);
+  if (transport::Validate(st, nullptr) && SignStatus(&st) && !transport_->PublishDeviceStatus(st)) {
     publish_failures_.fetch_add(1);
   }
   last_status_ticks_ = ticks;

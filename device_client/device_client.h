@@ -17,7 +17,11 @@
 #include <string>
 #include <thread>
 
+#include "auth/pose_echo_window.h"
+#include "auth/session_epoch.h"
+#include "auth/session_key.h"
 #include "haptic_device.h"
+#include "messages/channels.h"
 #include "model_receiver.h"
 #include "realtime/percentiles.h"
 #include "safety.h"
@@ -40,6 +44,11 @@ struct DeviceClientConfig {
   int64_t log_period_us = 5000000;   // a summary line every 5 s (0 = never)
   int receive_wait_ms = 20;          // receive thread: longest wait per poll
   MicrosClock clock = nullptr;       // CLOCK_MONOTONIC when null; tests use a fake clock
+  // The session key (must outlive the client): poses and statuses are signed, force
+  // models and solver statuses checked (docs/security.md). snapthread-device always
+  // sets it; nullptr (no authentication) is for in-process tests of other concerns.
+  const auth::SessionKey* key = nullptr;
+  std::string session = transport::kDefaultSession;  // channel prefix (for the MACs)
 };
 
 // Statistics of the run so far (the --summary JSON and the last log line).
@@ -96,6 +105,10 @@ class DeviceClient {
  private:
   int64_t Now() const;
   void Drain();
+  // io thread: sign state_msg_ / a status (no-ops without a key); false when it cannot
+  // be signed (then it is not sent).
+  bool SignPose();
+  bool SignStatus(device_status_t* st);
   void MaybeReport(int64_t now_us);
 
   HapticDevice* device_;
@@ -107,11 +120,14 @@ class DeviceClient {
   std::unique_ptr<TraceRing> trace_ring_;
   std::unique_ptr<LatenessRing> lateness_;
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> trace_file_;
+  transport::Channels channels_;
+  std::unique_ptr<auth::PoseEchoWindow> sent_poses_;  // written by the io thread
   ModelReceiver receiver_;
   ServoTick tick_;
   ServoLoop loop_;
 
   // io-thread state.
+  auth::AuthSequence auth_seq_;
   device_state_t state_msg_{};
   transport::SampleWindow lateness_window_{1000};  // last second, for DEVICE_STATUS
   transport::SampleWindow lateness_run_{600000};   // last 10 min at 1 kHz, for the summary

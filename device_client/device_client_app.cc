@@ -13,6 +13,8 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "auth/key_file.h"
+#include "auth/session_key.h"
 #include "device_client.h"
 #include "device_factory.h"
 #include "lcm_transport.h"
@@ -123,6 +125,9 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   app.add_option("--summary", o->summary_file, "write a JSON summary at exit");
+  app.add_option("--key", o->key_path,
+                 "session key file (default: $SNAPTHREAD_KEY_FILE, else "
+                 "$XDG_CONFIG_HOME/snapthread/session.key)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -149,6 +154,17 @@ int RunDeviceClient(const DeviceClientOptions& o) {
       o.trace_divisor < 1 || !(o.model_timeout_ms > 0.0) || !(o.fade_ms > 0.0) ||
       !(o.speed_m_per_s > 0.0) || !(o.duration_s >= 0.0)) {
     std::fprintf(stderr, "snapthread-device: options out of range (see --help)\n");
+    return kExitBadArguments;
+  }
+
+  // ---- the session key: without it nothing the server sends can be trusted -------------
+  std::optional<auth::SessionKey> key;
+  try {
+    const auth::KeyLocation where = auth::ResolveKeyPath(o.key_path);
+    key.emplace(auth::LoadKey(where));
+    spdlog::info("device: session key {} ({}), key id {}", where.path, where.origin, key->Id());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-device: --key: %s\n", e.what());
     return kExitBadArguments;
   }
 
@@ -220,6 +236,8 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   cc.loop.rate_hz = o.rate_hz;
   cc.loop.realtime = o.realtime;
   cc.trace_file = o.trace_file;
+  cc.key = &*key;
+  cc.session = o.session;
   spdlog::info("device: {} session {} on {}; limits |F| <= {} N, stiffness <= {} N/m, "
                "slew {} N/s, timeout {} ms, fade {} ms, workspace {} m",
                cc.device_id, o.session, url, limits.max_force_n, limits.max_stiffness_n_per_m,

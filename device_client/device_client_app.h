@@ -24,6 +24,7 @@ struct DeviceClientOptions {
   std::string trace_file;                // CSV, empty = none
   int trace_divisor = 1;
   std::string summary_file;              // JSON at exit, empty = none
+  std::string key_path;                  // --key; "" = $SNAPTHREAD_KEY_FILE or the XDG default
 };
 
 // Exit codes of snapthread-device.

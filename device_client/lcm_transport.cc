@@ -6,11 +6,39 @@ LcmDeviceTransport::LcmDeviceTransport(const std::string& url, const std::string
     : lcm_(url), channels_(session) {
   if (lcm_.good()) {
     subscription_ = lcm_.subscribe(channels_.force_model, &LcmDeviceTransport::Handle, this);
+    status_subscription_ =
+        lcm_.subscribe(channels_.solver_status, &LcmDeviceTransport::HandleStatus, this);
   }
 }
 
 LcmDeviceTransport::~LcmDeviceTransport() {
   if (subscription_ != nullptr) lcm_.unsubscribe(subscription_);
+  if (status_subscription_ != nullptr) lcm_.unsubscribe(status_subscription_);
+}
+
+void LcmDeviceTransport::HandleStatus(const lcm::ReceiveBuffer* rbuf,
+                                      const std::string& /*channel*/) {
+  if (rbuf == nullptr || rbuf->data_size > (1u << 20)) return;  // a status is < 1 kB
+  try {
+    if (statuses_.size() >= kMaxPendingStatuses) statuses_.pop_front();
+    const auto* bytes = static_cast<const uint8_t*>(rbuf->data);
+    statuses_.emplace_back(bytes, bytes + rbuf->data_size);
+  } catch (...) {
+  }
+}
+
+int LcmDeviceTransport::PollSolverStatus(const StatusSink& sink) {
+  int n = 0;
+  while (!statuses_.empty()) {
+    const std::vector<uint8_t> bytes = std::move(statuses_.front());
+    statuses_.pop_front();
+    ++n;
+    try {
+      sink(bytes.data(), static_cast<int>(bytes.size()));
+    } catch (...) {
+    }
+  }
+  return n;
 }
 
 bool LcmDeviceTransport::PublishDeviceState(const device_state_t& msg) {

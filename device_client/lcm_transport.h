@@ -1,7 +1,10 @@
 // The production DeviceTransport: LCM on the session's channels (messages/channels.h).
 #pragma once
 
+#include <cstdint>
+#include <deque>
 #include <memory>
+#include <vector>
 #include <string>
 
 #include <lcm/lcm-cpp.hpp>
@@ -26,15 +29,23 @@ class LcmDeviceTransport final : public DeviceTransport {
   bool PublishDeviceStatus(const device_status_t& msg) override;
   // handleTimeout(wait_ms) until nothing more is waiting. One thread only.
   int PollForceModels(int wait_ms, const ForceModelSink& sink) override;
+  // The statuses that arrived during the last PollForceModels calls (at most
+  // kMaxPendingStatuses kept: the server sends ~10 Hz).
+  int PollSolverStatus(const StatusSink& sink) override;
 
  private:
   static constexpr int kMaxPerPoll = 1000;
 
+  static constexpr size_t kMaxPendingStatuses = 64;
+
   void Handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void HandleStatus(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
 
   lcm::LCM lcm_;
   transport::Channels channels_;
   lcm::Subscription* subscription_ = nullptr;
+  lcm::Subscription* status_subscription_ = nullptr;
+  std::deque<std::vector<uint8_t>> statuses_;  // received, not yet polled
   const ForceModelSink* sink_ = nullptr;  // set during PollForceModels only
   int delivered_ = 0;
 };

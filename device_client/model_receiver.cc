@@ -2,13 +2,45 @@
 
 #include <spdlog/spdlog.h>
 
+#include <utility>
+
+#include "auth/message_gate.h"
 #include "messages/validate.h"
+#include "realtime/clock.h"
 #include "snapthread/force_model_t.hpp"
+#include "snapthread/solver_status_t.hpp"
 
 namespace snapthread::device {
 
-ModelReceiver::ModelReceiver(const SafetyLimits& limits, ModelSlot* slot)
-    : limits_(limits), slot_(slot) {}
+ModelReceiver::ModelReceiver(const SafetyLimits& limits, ModelSlot* slot, ModelAuth auth)
+    : limits_(limits), slot_(slot), auth_(std::move(auth)) {}
+
+void ModelReceiver::LogAuth(auth::FreshnessFilter* filter, int64_t now_us) {
+  std::string line;
+  if (filter->TakeLogLine(now_us, &line)) spdlog::warn("device: refused {}", line);
+}
+
+bool ModelReceiver::ReceiveStatus(const void* data, int size) {
+  if (auth_.key == nullptr) return false;
+  try {
+    solver_status_t msg;
+    std::string why;
+    if (!transport::DecodeAndValidate(data, size, &msg, &why)) return false;
+    const int64_t before = status_filter_.epoch();
+    if (auth::Admit(data, static_cast<size_t>(size), msg, auth_.status_channel, *auth_.key,
+                    &status_filter_) != auth::Reason::kAccepted) {
+      LogAuth(&status_filter_, transport::MonotonicMicros());
+      return false;
+    }
+    if (status_filter_.epoch() != before) {
+      spdlog::info("device: server session epoch {:016x} (from an authenticated status)",
+                   static_cast<uint64_t>(status_filter_.epoch()));
+    }
+    return true;
+  } catch (...) {
+    return false;
+  }
+}
 
 bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
   try {
@@ -17,6 +49,18 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
     if (!transport::DecodeAndValidate(data, size, &msg, &why)) {
       Reject(why);
       return false;
+    }
+    if (auth_.key != nullptr) {
+      // Models must carry the epoch learned from the server's status (0: none yet, so
+      // everything is refused and the device stays in its fade).
+      const int64_t epoch = status_filter_.epoch();
+      if (epoch != model_filter_.epoch()) model_filter_.SetEpoch(epoch);
+      if (auth::AdmitForceModel(data, static_cast<size_t>(size), msg, auth_.force_model_channel,
+                                *auth_.key, *auth_.sent, &model_filter_) !=
+          auth::Reason::kAccepted) {
+        LogAuth(&model_filter_, now_us);
+        return false;
+      }
     }
     LocalModel model;
     const ModelVerdict verdict = PrepareModel(msg, now_us, limits_, &model, &why);

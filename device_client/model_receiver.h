@@ -10,16 +10,35 @@
 #include <mutex>
 #include <string>
 
+#include "auth/freshness_filter.h"
+#include "auth/pose_echo_window.h"
+#include "auth/session_key.h"
 #include "realtime/percentiles.h"
 #include "safety.h"
 #include "servo_loop.h"
 
 namespace snapthread::device {
 
+// What the receiver checks when the session is authenticated (docs/security.md).
+struct ModelAuth {
+  const auth::SessionKey* key = nullptr;  // nullptr: no checks (in-process tests only)
+  std::string force_model_channel;        // <SESSION>_FORCE_MODEL
+  std::string status_channel;             // <SESSION>_SOLVER_STATUS
+  const auth::PoseEchoWindow* sent = nullptr;  // the poses this device sent
+};
+
 class ModelReceiver {
  public:
-  // slot must outlive the receiver.
-  ModelReceiver(const SafetyLimits& limits, ModelSlot* slot);
+  // slot (and auth's key and window) must outlive the receiver.
+  ModelReceiver(const SafetyLimits& limits, ModelSlot* slot, ModelAuth auth = {});
+
+  // One encoded solver_status_t: with a valid MAC and a fresh (epoch, auth_seq) its
+  // epoch becomes the one force models must carry (FreshnessFilter kAdopt). Same thread
+  // as Receive. Never throws.
+  bool ReceiveStatus(const void* data, int size);
+  // The server epoch learned from an authenticated status; 0 until one was heard.
+  int64_t epoch() const { return status_filter_.epoch(); }
+  uint64_t statuses_rejected() const { return status_filter_.rejected(); }
 
   // One encoded force_model_t received at now_us (device CLOCK_MONOTONIC). True when it
   // reached the servo (possibly as a zero-force model for STATUS_INVALID). Never throws.
@@ -29,16 +48,23 @@ class ModelReceiver {
   transport::PercentileSummary RoundTrip(bool whole_run) const;
 
   uint64_t received() const { return received_.load(); }
-  uint64_t rejected() const { return rejected_.load(); }
+  // Malformed or unsafe models plus those refused by authentication.
+  uint64_t rejected() const { return rejected_.load() + model_filter_.rejected(); }
+  uint64_t auth_rejected() const { return model_filter_.rejected(); }
   uint64_t stiffness_clamps() const { return stiffness_clamps_.load(); }
   uint64_t invalid_models() const { return invalid_models_.load(); }
   uint64_t snaps_felt() const { return snaps_felt_.load(); }
 
  private:
   void Reject(const std::string& why);
+  void LogAuth(auth::FreshnessFilter* filter, int64_t now_us);
 
   SafetyLimits limits_;
   ModelSlot* slot_;
+  ModelAuth auth_;
+  auth::FreshnessFilter status_filter_{"SOLVER_STATUS",
+                                       auth::FreshnessFilter::EpochPolicy::kAdopt};
+  auth::FreshnessFilter model_filter_{"FORCE_MODEL"};
   std::atomic<uint64_t> received_{0}, rejected_{0}, stiffness_clamps_{0}, invalid_models_{0},
       snaps_felt_{0};
   mutable std::mutex mutex_;  // the round-trip windows (receiver and status threads)

@@ -32,6 +32,13 @@ class DeviceTransport {
   // when the transport failed (the caller backs off; the watchdog fades the force
   // meanwhile). Never throws, even when sink does.
   virtual int PollForceModels(int wait_ms, const ForceModelSink& sink) = 0;
+
+  // Hands every solver_status_t received since the last call (undecoded, as for force
+  // models) to sink without waiting; the device learns the server's epoch from them.
+  // Call from the thread that calls PollForceModels. Returns the number handed over.
+  // Never throws.
+  using StatusSink = std::function<void(const void* data, int size)>;
+  virtual int PollSolverStatus(const StatusSink& sink) = 0;
 };
 
 }  // namespace snapthread::device

@@ -10,6 +10,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "auth/message_gate.h"
+#include "auth/message_mac.h"
 #include "messages/pose_mapping.h"
 #include "server_messages.h"
 #include "server_session.h"
@@ -55,10 +57,20 @@ SteadyClock::duration Period(double rate_hz) {
       std::chrono::duration<double>(1.0 / rate_hz));
 }
 
+auth::SessionKey LoadServerKey(const auth::KeyLocation& where, bool* created) {
+  auth::LoadedKey loaded = auth::LoadOrCreateKey(where);
+  *created = loaded.created;
+  return std::move(loaded.key);
+}
+
 }  // namespace
 
 Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
-    : params_(params), hooks_(std::move(hooks)) {
+    : params_(params),
+      key_location_(auth::ResolveKeyPath(params.key_path)),
+      key_(LoadServerKey(key_location_, &key_created_)),
+      epoch_(auth::NewEpoch()),
+      hooks_(std::move(hooks)) {
   std::string error;
   if (!params_.IsValid(&error)) throw std::invalid_argument(error);
   channels_ = transport::Channels(params_.session);
@@ -135,6 +147,13 @@ void Server::Start() {
   spdlog::info("server: session {} on {}, scene '{}' ({}), method {}", channels_.session,
                lcm_url_, session_->scene.name, session_->scene.file,
                session_->tracker->options().method);
+  spdlog::info("server: {} session key {} ({}), key id {}, epoch {:016x}",
+               key_created_ ? "created a new" : "using the", key_location_.path,
+               key_location_.origin, key_.Id(), static_cast<uint64_t>(epoch_));
+  if (key_created_) {
+    spdlog::info("server: copy {} to every machine of the session (scp -p; mode 0600) and "
+                 "pass it with --key or SNAPTHREAD_KEY_FILE", key_location_.path);
+  }
 }
 
 void Server::Stop() {
@@ -167,12 +186,42 @@ void Server::Reject(const std::string& channel, const std::string& why) {
   }
 }
 
+void Server::RejectAuth(auth::FreshnessFilter* filter) {
+  rejected_messages_.fetch_add(1);
+  std::string line;
+  if (filter->TakeLogLine(SteadyMicros(), &line)) spdlog::warn("server: refused {}", line);
+}
+
+auth::FreshnessFilter* Server::DeviceFilter(const std::string& device_id) {
+  auto it = device_filters_.find(device_id);
+  if (it != device_filters_.end()) return it->second.get();
+  if (device_filters_.size() >= kMaxDevices) return nullptr;
+  auto filter = std::make_unique<auth::FreshnessFilter>(
+      "DEVICE_STATE of " + device_id, auth::FreshnessFilter::EpochPolicy::kFixed, epoch_);
+  return device_filters_.emplace(device_id, std::move(filter)).first->second.get();
+}
+
 void Server::HandleDeviceState(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   try {
     PoseSample sample;
     std::string why;
     if (!transport::DecodeAndValidate(rbuf, &sample.state, &why)) {
       Reject(channel, why);
+      return;
+    }
+    // The MAC first: only a key holder's pose may create a per-device filter.
+    if (!auth::VerifyEncoded(rbuf->data, rbuf->data_size, channel, key_)) {
+      pose_mac_filter_.Reject(auth::Reason::kBadMac);
+      RejectAuth(&pose_mac_filter_);
+      return;
+    }
+    auth::FreshnessFilter* filter = DeviceFilter(sample.state.device_id);
+    if (filter == nullptr) {
+      Reject(channel, "more than " + std::to_string(kMaxDevices) + " devices");
+      return;
+    }
+    if (filter->Admit(sample.state.epoch, sample.state.auth_seq) != auth::Reason::kAccepted) {
+      RejectAuth(filter);
       return;
     }
     sample.receive_utime = transport::RealtimeMicros();
@@ -192,6 +241,11 @@ void Server::HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& ch
       Reject(channel, why);
       return;
     }
+    if (auth::Admit(rbuf->data, rbuf->data_size, command, channel, key_, &command_filter_) !=
+        auth::Reason::kAccepted) {
+      RejectAuth(&command_filter_);
+      return;
+    }
     if (!inbox_.PushCommand(command)) {
       commands_refused_.fetch_add(1);
       if (ShouldLog(&last_reject_log_us_)) {
@@ -204,6 +258,16 @@ void Server::HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& ch
 }
 
 // ---------------------------------------------------------------- solve thread
+
+template <class Msg>
+bool Server::SignForChannel(Msg* msg, const std::string& channel) {
+  if (auth::Sign(msg, channel, epoch_, auth_seq_.Next(), key_)) return true;
+  publish_failures_.fetch_add(1);
+  if (ShouldLog(&last_solve_error_log_us_)) {
+    spdlog::error("server: could not sign a message for {}; not sent", channel);
+  }
+  return false;
+}
 
 void Server::SolveLoop() {
   const auto shape_period = Period(params_.shape_rate_hz);
@@ -299,6 +363,7 @@ void Server::SolveAndPublish(const PoseSample& pose) {
     if (first_update_us_ == 0) first_update_us_ = now_us;
     last_update_us_ = now_us;
   }
+  if (!SignForChannel(&msg, channels_.force_model)) return;
   if (lcm_->publish(channels_.force_model, &msg) != 0) publish_failures_.fetch_add(1);
 }
 
@@ -316,12 +381,13 @@ void Server::PublishShape() {
   in.snaps = snaps_since_reset_;
   in.seq = shape_seq_++;
   in.utime = transport::RealtimeMicros();
-  const thread_shape_t msg = BuildShape(in);
+  thread_shape_t msg = BuildShape(in);
   std::string why;
   if (!transport::Validate(msg, &why)) {
     if (ShouldLog(&last_solve_error_log_us_)) spdlog::error("server: bad shape not sent: {}", why);
     return;
   }
+  if (!SignForChannel(&msg, channels_.shape)) return;
   if (lcm_->publish(channels_.shape, &msg) != 0) {
     publish_failures_.fetch_add(1);
     return;
@@ -348,10 +414,11 @@ void Server::PublishStatus() {
   in.rejected_messages = rejected_messages_.load();
   in.seq = status_seq_++;
   in.utime = transport::RealtimeMicros();
-  const solver_status_t msg = BuildSolverStatus(in);
+  solver_status_t msg = BuildSolverStatus(in);
   status_window_.Clear();
   updates_at_last_status_ = updates;
   last_status_time_ = now;
+  if (!SignForChannel(&msg, channels_.solver_status)) return;
   if (lcm_->publish(channels_.solver_status, &msg) != 0) {
     publish_failures_.fetch_add(1);
     return;

@@ -18,6 +18,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -25,6 +26,11 @@
 #include <thread>
 
 #include <lcm/lcm-cpp.hpp>
+
+#include "auth/freshness_filter.h"
+#include "auth/key_file.h"
+#include "auth/session_epoch.h"
+#include "auth/session_key.h"
 
 #include "server_inbox.h"
 #include "server_params.h"
@@ -73,7 +79,8 @@ class Server {
  public:
   static constexpr size_t kSolveWindow = 100000;
 
-  // Validates params (std::invalid_argument naming the flag), loads the scene
+  // Validates params (std::invalid_argument naming the flag), loads or creates the
+  // session key (auth::KeyFileError naming the file and the fix), loads the scene
   // (SceneError) and resets the tracker at the scene's grasp_start. With lcm == nullptr
   // the server creates its own LCM on ResolveLcmUrl(params.lcm_url) (LcmInitError when
   // it does not start); otherwise it uses *lcm, which must outlive the server.
@@ -98,6 +105,11 @@ class Server {
   const transport::Channels& channels() const { return channels_; }
   const std::string& lcm_url() const { return lcm_url_; }
   const ServerParams& params() const { return params_; }
+  // This start's session epoch (new at each construction) and the key in use.
+  int64_t epoch() const { return epoch_; }
+  const auth::SessionKey& key() const { return key_; }
+  const auth::KeyLocation& key_location() const { return key_location_; }
+  bool key_created() const { return key_created_; }
 
  private:
   struct Session;  // scene + tracker, owned by the solve thread
@@ -106,6 +118,16 @@ class Server {
   void HandleDeviceState(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void Reject(const std::string& channel, const std::string& why);
+  // An authentication refusal counted by `filter`: rejected_messages + a rate-limited
+  // log line with the reason.
+  void RejectAuth(auth::FreshnessFilter* filter);
+  // The freshness filter of one device_id, created on its first authenticated pose;
+  // nullptr when kMaxDevices are known already (the pose is refused).
+  auth::FreshnessFilter* DeviceFilter(const std::string& device_id);
+  // Signs msg for channel with this session's epoch and the next auth_seq; false (and
+  // a publish failure counted) when it cannot be signed.
+  template <class Msg>
+  bool SignForChannel(Msg* msg, const std::string& channel);
 
   void ReceiveLoop();
   void SolveLoop();
@@ -117,8 +139,22 @@ class Server {
   std::unique_ptr<Session> MakeSession(const Scene& scene) const;
   void SetInfo(const std::string& scene, const std::string& method, const std::string* command);
 
+  // Devices whose freshness the server tracks; poses of further device_ids are refused
+  // (a forger cannot grow the map: filters exist only after a valid MAC).
+  static constexpr size_t kMaxDevices = 64;
+
   ServerParams params_;
   transport::Channels channels_;
+  auth::KeyLocation key_location_;
+  bool key_created_ = false;
+  auth::SessionKey key_;
+  int64_t epoch_ = 0;
+  auth::AuthSequence auth_seq_;
+  // Receive thread: refusals before a device is known (bad MAC), per-device pose
+  // freshness, commands.
+  auth::FreshnessFilter pose_mac_filter_{"DEVICE_STATE"};
+  std::map<std::string, std::unique_ptr<auth::FreshnessFilter>> device_filters_;
+  auth::FreshnessFilter command_filter_{"COMMAND"};
   std::string lcm_url_;
   std::unique_ptr<lcm::LCM> owned_lcm_;
   lcm::LCM* lcm_ = nullptr;

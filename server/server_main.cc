@@ -83,6 +83,9 @@ int main(int argc, char** argv) {
   app.add_option("--summary", params.summary_path,
                  "Write a JSON summary (updates, update_rate_hz, solve_us_p50/p99, snaps, "
                  "dropped_poses, rejected_messages) here at exit");
+  app.add_option("--key", params.key_path,
+                 "Session key file (default: $SNAPTHREAD_KEY_FILE, else "
+                 "$XDG_CONFIG_HOME/snapthread/session.key); created (mode 0600) when missing");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -112,6 +115,8 @@ int main(int argc, char** argv) {
   std::unique_ptr<snapthread::server::Server> server;
   try {
     server = std::make_unique<snapthread::server::Server>(params);
+  } catch (const snapthread::auth::KeyFileError& e) {
+    return Usage(std::string("--key: ") + e.what());
   } catch (const snapthread::server::LcmInitError& e) {
     std::fprintf(stderr, "snapthread-server: %s\n", e.what());
     return kExitLcm;

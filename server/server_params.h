@@ -36,6 +36,9 @@ struct ServerParams {
   double duration_s = 0.0;
   // Where to write the end-of-run JSON summary; empty = none.
   std::string summary_path;
+  // The session key file (--key): "" = $SNAPTHREAD_KEY_FILE, else the XDG default
+  // (auth/key_file.h). The server creates it when it does not exist.
+  std::string key_path;
 
   // False with a message naming the offending field (as a command-line flag) when
   // invalid. Does not touch the file system (the scene is checked when loaded).

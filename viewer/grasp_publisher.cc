@@ -1,5 +1,8 @@
 #include "grasp_publisher.h"
 
+#include <utility>
+
+#include "auth/message_mac.h"
 #include "snapthread/device_state_t.hpp"
 #include "messages/channels.h"
 #include "messages/pose_mapping.h"
@@ -9,8 +12,13 @@
 namespace snapthread::viewer {
 
 GraspPublisher::GraspPublisher(lcm::LCM* lcm, const std::string& session,
-                               const DeviceMapping& mapping)
-    : lcm_(lcm), channel_(transport::Channels(session).device_state), mapping_(mapping) {}
+                               const DeviceMapping& mapping, const auth::SessionKey* key,
+                               std::function<int64_t()> epoch)
+    : lcm_(lcm),
+      channel_(transport::Channels(session).device_state),
+      mapping_(mapping),
+      key_(key),
+      epoch_(std::move(epoch)) {}
 
 bool GraspPublisher::Publish(const Eigen::Vector3d& model_position, bool held) {
   device_state_t msg;
@@ -23,6 +31,10 @@ bool GraspPublisher::Publish(const Eigen::Vector3d& model_position, bool held) {
   msg.orientation[1] = msg.orientation[2] = msg.orientation[3] = 0.0;
   msg.buttons = held ? 1 : 0;
   if (!transport::Validate(msg, nullptr)) return false;  // e.g. a non-finite drag target
+  if (key_ != nullptr &&
+      !auth::Sign(&msg, channel_, epoch_ ? epoch_() : 0, auth_seq_.Next(), *key_)) {
+    return false;
+  }
   return lcm_->publish(channel_, &msg) == 0;
 }
 

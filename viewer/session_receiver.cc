@@ -1,14 +1,19 @@
 #include "session_receiver.h"
 
 #include <cmath>
+#include <cstdio>
+
+#include "auth/message_gate.h"
 
 #include "shape_check.h"
 #include "messages/channels.h"
 
 namespace snapthread::viewer {
 
-SessionReceiver::SessionReceiver(lcm::LCM* lcm, const std::string& session)
+SessionReceiver::SessionReceiver(lcm::LCM* lcm, const std::string& session,
+                                 const auth::SessionKey* key)
     : lcm_(lcm),
+      key_(key),
       shape_channel_(transport::Channels(session).shape),
       status_channel_(transport::Channels(session).solver_status) {
   subscriptions_.push_back(lcm_->subscribe(shape_channel_, &SessionReceiver::OnShape, this));
@@ -51,6 +56,27 @@ double SessionReceiver::NowS() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
+template <class Msg>
+bool SessionReceiver::Authentic(const lcm::ReceiveBuffer* rbuf, const Msg& msg,
+                                const std::string& channel, auth::FreshnessFilter* filter) {
+  if (key_ == nullptr) return true;
+  if (filter == &shape_filter_ && shape_filter_.epoch() != status_filter_.epoch()) {
+    shape_filter_.SetEpoch(status_filter_.epoch());
+  }
+  if (auth::Admit(rbuf->data, rbuf->data_size, msg, channel, *key_, filter) ==
+      auth::Reason::kAccepted) {
+    return true;
+  }
+  std::string line;
+  const int64_t now_us = static_cast<int64_t>(1e6 * NowS());
+  if (filter->TakeLogLine(now_us, &line)) {
+    std::fprintf(stderr, "snapthread-viewer: refused %s\n", line.c_str());
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_error_ = line;
+  }
+  return false;
+}
+
 void SessionReceiver::OnShape(const lcm::ReceiveBuffer* rbuf, const std::string&) {
   thread_shape_t shape;
   std::string why;
@@ -61,6 +87,7 @@ void SessionReceiver::OnShape(const lcm::ReceiveBuffer* rbuf, const std::string&
     last_error_ = shape_channel_ + ": " + why;
     return;
   }
+  if (!Authentic(rbuf, shape, shape_channel_, &shape_filter_)) return;
   const double now = NowS();
   const double f = std::sqrt(shape.force_newtons[0] * shape.force_newtons[0] +
                              shape.force_newtons[1] * shape.force_newtons[1] +
@@ -87,6 +114,7 @@ void SessionReceiver::OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string
     last_error_ = status_channel_ + ": " + why;
     return;
   }
+  if (!Authentic(rbuf, status, status_channel_, &status_filter_)) return;
   std::lock_guard<std::mutex> lock(mutex_);
   latest_.status = std::move(status);
   latest_.has_status = true;
@@ -98,6 +126,7 @@ SessionSnapshot SessionReceiver::Snapshot(bool with_history) const {
   std::lock_guard<std::mutex> lock(mutex_);
   SessionSnapshot s = latest_;
   s.bad_messages = bad_messages_.load();
+  s.auth_rejected = auth_rejected();
   s.now_s = now;
   int recent = 0;
   for (double t : shape_times_s_) recent += (t >= now - 1.0);

@@ -15,6 +15,8 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/freshness_filter.h"
+#include "auth/session_key.h"
 #include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
 
@@ -33,6 +35,7 @@ struct SessionSnapshot {
   int64_t shapes_received = 0;   // valid shapes since start
   int64_t statuses_received = 0;
   int64_t bad_messages = 0;      // malformed messages dropped (both channels)
+  int64_t auth_rejected = 0;     // refused by authentication (bad MAC, epoch, sequence)
   double shape_rate_hz = 0.0;    // valid shapes over the last second
   std::vector<ForceSample> force_history;  // last kHistorySeconds
   double now_s = 0.0;            // seconds since the receiver started
@@ -44,7 +47,11 @@ class SessionReceiver {
 
   // Subscribes on `lcm` (which must be good()). Call Start() to begin handling.
   // `session` must be a valid session name (transport::Channels throws otherwise).
-  SessionReceiver(lcm::LCM* lcm, const std::string& session);
+  // With a key (which must outlive the receiver) statuses are taken only with a valid
+  // MAC and fresh sequence (their epoch adopted) and shapes only with a valid MAC, that
+  // epoch and a fresh sequence (docs/security.md); nullptr checks nothing (tests).
+  SessionReceiver(lcm::LCM* lcm, const std::string& session,
+                  const auth::SessionKey* key = nullptr);
   ~SessionReceiver();
   SessionReceiver(const SessionReceiver&) = delete;
   SessionReceiver& operator=(const SessionReceiver&) = delete;
@@ -55,6 +62,11 @@ class SessionReceiver {
   SessionSnapshot Snapshot(bool with_history = true) const;
   int64_t shapes_received() const { return shapes_received_.load(); }
   int64_t bad_messages() const { return bad_messages_.load(); }
+  // The server epoch learned from an authenticated status (0: none yet).
+  int64_t epoch() const { return status_filter_.epoch(); }
+  int64_t auth_rejected() const {
+    return static_cast<int64_t>(status_filter_.rejected() + shape_filter_.rejected());
+  }
   std::string last_error() const;
   const std::string& shape_channel() const { return shape_channel_; }
 
@@ -63,8 +75,16 @@ class SessionReceiver {
   void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void Loop();
   double NowS() const;
+  // Authentication of one received message; false (counted, logged rate-limited) when
+  // refused. LCM thread.
+  template <class Msg>
+  bool Authentic(const lcm::ReceiveBuffer* rbuf, const Msg& msg, const std::string& channel,
+                 auth::FreshnessFilter* filter);
 
   lcm::LCM* lcm_;
+  const auth::SessionKey* key_;
+  auth::FreshnessFilter status_filter_{"SOLVER_STATUS", auth::FreshnessFilter::EpochPolicy::kAdopt};
+  auth::FreshnessFilter shape_filter_{"SHAPE"};
   std::string shape_channel_;
   std::string status_channel_;
   std::vector<lcm::Subscription*> subscriptions_;

@@ -12,6 +12,7 @@
 #include <GLFW/glfw3.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/key_file.h"
 #include "channel_rates.h"
 #include "grasp_publisher.h"
 #include "png_writer.h"
@@ -148,9 +149,21 @@ bool SaveScreenshot(const std::string& path, int width, int height, std::string*
   return WritePngRgb(path, width, height, flipped, error);
 }
 
+// The session key, or nullopt after printing why it cannot be used (file and fix).
+std::optional<auth::SessionKey> LoadViewerKey(const ViewerOptions& options) {
+  try {
+    return auth::LoadKey(auth::ResolveKeyPath(options.key_path));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-viewer: --key: %s\n", e.what());
+    return std::nullopt;
+  }
+}
+
 }  // namespace
 
 int RunPrintRates(const ViewerOptions& options) {
+  const std::optional<auth::SessionKey> key = LoadViewerKey(options);
+  if (!key) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "snapthread-viewer: cannot open LCM at %s. %s\n", options.lcm_url.c_str(),
@@ -158,6 +171,8 @@ int RunPrintRates(const ViewerOptions& options) {
     return kExitSetupFailed;
   }
   ChannelRateMonitor monitor(&lcm, options.session + "_.*");
+  // Checks shapes and statuses on the same LCM (handled by this loop) to count refusals.
+  SessionReceiver checked(&lcm, options.session, &*key);
   const auto start = Clock::now();
   auto last_report = start;
   std::printf("channel rates of session %s on %s (once per second)\n", options.session.c_str(),
@@ -168,7 +183,9 @@ int RunPrintRates(const ViewerOptions& options) {
     const double since = Seconds(last_report);
     if (since >= 1.0) {
       last_report = Clock::now();
-      std::printf("--- t=%.0f s\n%s", Seconds(start), monitor.RateReport(since).c_str());
+      std::printf("--- t=%.0f s\n%sauthentication refused %lld (shape/status)\n",
+                  Seconds(start), monitor.RateReport(since).c_str(),
+                  static_cast<long long>(checked.auth_rejected()));
       std::fflush(stdout);
     }
   }
@@ -176,6 +193,7 @@ int RunPrintRates(const ViewerOptions& options) {
   for (const auto& [channel, count] : monitor.Totals()) {
     std::printf("TOTAL %s %lld\n", channel.c_str(), static_cast<long long>(count.messages));
   }
+  std::printf("REJECTED %lld\n", static_cast<long long>(checked.auth_rejected()));
   std::fflush(stdout);
   return kExitOk;
 }
@@ -190,15 +208,20 @@ int RunViewer(const ViewerOptions& options) {
       return kExitSetupFailed;
     }
   }
+  const std::optional<auth::SessionKey> key = LoadViewerKey(options);
+  if (!key) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
   if (!lcm.good()) {
     std::fprintf(stderr, "snapthread-viewer: cannot open LCM at %s. %s\n", options.lcm_url.c_str(),
                  transport::LcmStartHint(options.lcm_url).c_str());
     return kExitSetupFailed;
   }
-  SessionReceiver receiver(&lcm, options.session);
+  SessionReceiver receiver(&lcm, options.session, &*key);
   std::unique_ptr<GraspPublisher> grasp;
-  if (scene) grasp = std::make_unique<GraspPublisher>(&lcm, options.session, scene->device);
+  if (scene) {
+    grasp = std::make_unique<GraspPublisher>(&lcm, options.session, scene->device, &*key,
+                                             [&receiver] { return receiver.epoch(); });
+  }
 
   glfwSetErrorCallback(&OnGlfwError);
   if (!glfwInit()) {

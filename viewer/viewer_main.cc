@@ -32,6 +32,9 @@ int main(int argc, char** argv) {
   app.add_option("--timeout-s", o.timeout_s,
                  "screenshot: fail (exit 2) if the shapes have not arrived by then")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--key", o.key_path,
+                 "session key file (default: $SNAPTHREAD_KEY_FILE, else "
+                 "$XDG_CONFIG_HOME/snapthread/session.key)");
   app.add_flag("--print-rates", o.print_rates,
                "print live rates of every <SESSION>_* channel once per second (no window)");
   app.add_option("--duration-s", o.duration_s, "exit after this many seconds (0 = never)")

@@ -18,6 +18,7 @@ struct ViewerOptions {
   double max_fps = 60.0;        // render at most this often (the machine may be shared)
   bool grasp_mode = false;      // mouse drag of the grasp publishes device_state_t
   std::string scene_path;       // needed by grasp mode (device mapping)
+  std::string key_path;         // --key; "" = $SNAPTHREAD_KEY_FILE or the XDG default
 };
 
 }  // namespace snapthread::viewer

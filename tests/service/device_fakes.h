@@ -30,6 +30,15 @@ class InMemoryTransport final : public DeviceTransport {
     return n;
   }
 
+  int PollSolverStatus(const StatusSink& sink) override {
+    const int n = static_cast<int>(status_inbox_.size());
+    for (const auto& bytes : status_inbox_) sink(bytes.data(), static_cast<int>(bytes.size()));
+    status_inbox_.clear();
+    return n;
+  }
+  // A solver_status_t as it would come off the wire.
+  void DeliverStatus(std::vector<uint8_t> bytes) { status_inbox_.push_back(std::move(bytes)); }
+
   // The server side: queue bytes (a force model as it would come off the wire).
   void Deliver(std::vector<uint8_t> bytes) { inbox_.push_back(std::move(bytes)); }
   void Deliver(const force_model_t& msg) {
@@ -43,6 +52,7 @@ class InMemoryTransport final : public DeviceTransport {
 
  private:
   std::vector<std::vector<uint8_t>> inbox_;
+  std::vector<std::vector<uint8_t>> status_inbox_;
 };
 
 // F(p) = -k (p - anchor), newtons, p in metres: f0 = F(u0), K = -k I, so the model is
