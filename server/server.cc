@@ -73,6 +73,7 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
       hooks_(std::move(hooks)) {
   std::string error;
   if (!params_.IsValid(&error)) throw std::invalid_argument(error);
+  command_filter_.SetEpoch(epoch_);  // commands must carry this start's epoch
   channels_ = transport::Channels(params_.session);
   method_override_ = params_.method;
 

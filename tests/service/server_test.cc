@@ -26,7 +26,10 @@
 #include "scene/scene.h"
 #include "tracking/tracker.h"
 #include "messages/validate.h"
+#include "auth/message_mac.h"
+#include "auth/session_epoch.h"
 #include "environment.h"
+#include "session_key_file.h"
 
 namespace snapthread::server {
 namespace {
@@ -163,6 +166,7 @@ class ServerTest : public ::testing::Test {
     params.session = "MEMQ";
     params.scene_path = ScenePath(scene_file);
     params.log_level = "warn";
+    params.key_path = key_file_.path();
     server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
     probe_ = std::make_unique<Probe>(&lcm_, server_->channels());
     server_->Start();
@@ -180,17 +184,25 @@ class ServerTest : public ::testing::Test {
     server_.reset();
   }
 
+  // Signed with the session key and the server's epoch, as a genuine device does.
   void Publish(const device_state_t& s) {
-    ASSERT_EQ(lcm_.publish(server_->channels().device_state, &s), 0);
+    device_state_t signed_state = s;
+    ASSERT_TRUE(auth::Sign(&signed_state, server_->channels().device_state, server_->epoch(),
+                           auth_seq_.Next(), key_file_.key()));
+    ASSERT_EQ(lcm_.publish(server_->channels().device_state, &signed_state), 0);
   }
   void Command(int8_t command, const std::string& argument) {
-    const command_t c = MakeCommand(command, argument);
+    command_t c = MakeCommand(command, argument);
+    ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
+                           key_file_.key()));
     ASSERT_EQ(lcm_.publish(server_->channels().command, &c), 0);
   }
   void PublishRaw(const std::string& channel, const std::vector<uint8_t>& bytes) {
     ASSERT_EQ(lcm_.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size())), 0);
   }
 
+  test_support::SessionKeyFile key_file_;
+  auth::AuthSequence auth_seq_;
   lcm::LCM lcm_{"memq://"};
   std::unique_ptr<Server> server_;
   std::unique_ptr<Probe> probe_;

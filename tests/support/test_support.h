@@ -4,4 +4,5 @@
 
 #include "child_process.h"
 #include "environment.h"
+#include "session_key_file.h"
 #include "temp_dir.h"
