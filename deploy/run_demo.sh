@@ -8,7 +8,8 @@
 # $SNAPTHREAD_BIN_DIR, or --bin-dir).
 #
 # usage: deploy/run_demo.sh [--scene scenes/curve2d_snap.yaml] [--duration 10]
-#                           [--bin-dir DIR] [--out DIR]
+#                           [--bin-dir DIR] [--out DIR] [--key FILE]
+# Session key: --key FILE, else $SNAPTHREAD_KEY_FILE, else a new one in the output dir.
 # exit: 0 ok, 1 a process failed / multicast route missing, 2 bad arguments
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -17,6 +18,7 @@ scene="$here/scenes/curve2d_snap.yaml"
 duration=10
 bin="${SNAPTHREAD_BIN_DIR:-$here/build/bin}"
 out=""
+key=""
 url="udpm://239.255.76.67:7667?ttl=0"   # loopback only: the demo never leaves the host
 usage() { sed -n '2,12p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
 while (($#)); do
@@ -24,6 +26,7 @@ while (($#)); do
     --scene) [ $# -ge 2 ] || { echo "run_demo: --scene needs a file" >&2; exit 2; }; scene=$2; shift 2 ;;
     --duration) [ $# -ge 2 ] || { echo "run_demo: --duration needs seconds" >&2; exit 2; }; duration=$2; shift 2 ;;
     --bin-dir) [ $# -ge 2 ] || { echo "run_demo: --bin-dir needs a directory" >&2; exit 2; }; bin=$2; shift 2 ;;
+    --key) [ $# -ge 2 ] || { echo "run_demo: --key needs a file" >&2; exit 2; }; key=$2; shift 2 ;;
     --out) [ $# -ge 2 ] || { echo "run_demo: --out needs a directory" >&2; exit 2; }; out=$2; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "run_demo: unknown argument '$1'" >&2; usage >&2; exit 2 ;;
@@ -32,7 +35,7 @@ done
 [[ "$duration" =~ ^[0-9]+([.][0-9]+)?$ ]] && awk -v d="$duration" 'BEGIN { exit !(d > 0) }' ||
   { echo "run_demo: --duration must be a positive number of seconds, got '$duration'" >&2; exit 2; }
 [ -f "$scene" ] || { echo "run_demo: --scene: no such file '$scene'" >&2; exit 2; }
-for b in snapthread-server snapthread-device; do
+for b in snapthread-server snapthread-device snapthread-keygen; do
   [ -x "$bin/$b" ] || { echo "run_demo: $bin/$b missing (build first: deploy/setup.sh)" >&2; exit 1; }
 done
 command -v python3 >/dev/null || { echo "run_demo: python3 missing (prints the summary)" >&2; exit 1; }
@@ -47,6 +50,12 @@ fi
 session="DEMO_$$_${RANDOM}"
 [ -n "$out" ] || out=$(mktemp -d "${TMPDIR:-/tmp}/snapthread-demo.XXXXXX")
 mkdir -p "$out"
+key="${key:-${SNAPTHREAD_KEY_FILE:-}}"
+if [ -z "$key" ]; then
+  key="$out/session.key"
+  "$bin/snapthread-keygen" --key "$key" > "$out/keygen.log" 2>&1 ||
+    { echo "run_demo: could not make a session key:" >&2; cat "$out/keygen.log" >&2; exit 1; }
+fi
 server_pid=""
 device_pid=""
 cleanup() {
@@ -60,7 +69,7 @@ trap 'echo "run_demo: interrupted" >&2; exit 1' INT TERM
 echo "run_demo: scene $(basename "$scene"), session $session on $url, ${duration} s; logs in $out"
 # The server's own --duration is only a safety net (stopped with SIGTERM after the
 # device finishes): it never outlives the demo by more than a minute.
-"$bin/snapthread-server" --scene "$scene" --session "$session" --lcm-url "$url" \
+"$bin/snapthread-server" --key "$key" --scene "$scene" --session "$session" --lcm-url "$url" \
   --duration "$(awk -v d="$duration" 'BEGIN { print d + 60 }')" \
   --summary "$out/server.json" > "$out/server.log" 2>&1 &
 server_pid=$!
@@ -76,7 +85,7 @@ if ! grep -q "server: session" "$out/server.log" 2>/dev/null; then
   exit 1
 fi
 
-"$bin/snapthread-device" --backend virtual-hand --scene "$scene" --session "$session" \
+"$bin/snapthread-device" --key "$key" --backend virtual-hand --scene "$scene" --session "$session" \
   --lcm-url "$url" --duration "$duration" --rate-hz 1000 --publish-divisor 1 \
   --model-timeout-ms 50 --no-rt --trace "$out/device_trace.csv" \
   --summary "$out/device.json" > "$out/device.log" 2>&1 &

@@ -3,9 +3,11 @@
 # (virtual-hand backend) and a viewer (a window when $DISPLAY is set, otherwise under
 # xvfb-run taking a screenshot), for ~10 s; then snapthread-report on the log.
 # Outputs: out/session-<UTC time>/ (log, report/, summaries, viewer.png, process logs).
+# Session key (docs/security.md): --key FILE, else $SNAPTHREAD_KEY_FILE, else a new key
+# for this run in the outputs folder (snapthread-keygen).
 #
 # usage: deploy/run_session.sh [--duration S] [--scene FILE] [--session NAME]
-#                              [--lcm-url URL] [--bin-dir DIR] [--out-root DIR]
+#                              [--lcm-url URL] [--bin-dir DIR] [--out-root DIR] [--key FILE]
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
@@ -15,6 +17,7 @@ session="RUN_$(date -u +%Y%m%d_%H%M%S)_$$"
 url="udpm://239.255.76.67:7667?ttl=0"   # loopback only: a local session never leaves the host
 bin="${SNAPTHREAD_BIN_DIR:-$here/build/bin}"
 out_root="$here/out"
+key="${SNAPTHREAD_KEY_FILE:-}"
 while (($#)); do
   case "$1" in
     --duration) duration=$2; shift 2 ;;
@@ -23,11 +26,12 @@ while (($#)); do
     --lcm-url) url=$2; shift 2 ;;
     --bin-dir) bin=$2; shift 2 ;;
     --out-root) out_root=$2; shift 2 ;;
-    -h|--help) sed -n '2,9p' "${BASH_SOURCE[0]}"; exit 0 ;;
+    --key) key=$2; shift 2 ;;
+    -h|--help) sed -n '2,11p' "${BASH_SOURCE[0]}"; exit 0 ;;
     *) echo "run_session: unknown argument $1" >&2; exit 2 ;;
   esac
 done
-for b in snapthread-server snapthread-device snapthread-viewer snapthread-report; do
+for b in snapthread-server snapthread-device snapthread-viewer snapthread-report snapthread-keygen; do
   [ -x "$bin/$b" ] || { echo "run_session: $bin/$b missing (build first: deploy/setup.sh)" >&2; exit 1; }
 done
 command -v lcm-logger >/dev/null || { echo "run_session: lcm-logger missing (liblcm-bin)" >&2; exit 1; }
@@ -36,6 +40,11 @@ command -v lcm-logger >/dev/null || { echo "run_session: lcm-logger missing (lib
 out="$out_root/session-$(date -u +%Y%m%d-%H%M%S)"
 mkdir -p "$out"
 log="$out/session.lcmlog"
+if [ -z "$key" ]; then
+  key="$out/session.key"
+  "$bin/snapthread-keygen" --key "$key" > "$out/keygen.txt" 2>&1 ||
+    { echo "run_session: could not make a session key:" >&2; cat "$out/keygen.txt" >&2; exit 1; }
+fi
 pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
@@ -51,19 +60,19 @@ logger_prio=()
 logger_pid=$!
 pids+=("$logger_pid")
 sleep 0.3
-"$bin/snapthread-server" --scene "$scene" --session "$session" --lcm-url "$url" \
+"$bin/snapthread-server" --key "$key" --scene "$scene" --session "$session" --lcm-url "$url" \
     --duration $((duration + 3)) --summary "$out/server.json" > "$out/server.txt" 2>&1 &
 server_pid=$!
 pids+=("$server_pid")
 sleep 0.5
 
 if [ -n "${DISPLAY:-}" ]; then
-  "$bin/snapthread-viewer" --session "$session" --lcm-url "$url" --duration-s "$((duration + 2))" \
+  "$bin/snapthread-viewer" --key "$key" --session "$session" --lcm-url "$url" --duration-s "$((duration + 2))" \
       > "$out/viewer.txt" 2>&1 &
   viewer_mode="window on $DISPLAY"
 else
   # Headless: a screenshot about a third of the way in (shapes come at ~60 Hz).
-  xvfb-run -a -s "-screen 0 1280x720x24" "$bin/snapthread-viewer" --session "$session" \
+  xvfb-run -a -s "-screen 0 1280x720x24" "$bin/snapthread-viewer" --key "$key" --session "$session" \
       --lcm-url "$url" --screenshot "$out/viewer.png" --after-shapes $((20 * duration)) \
       --timeout-s $((duration + 5)) > "$out/viewer.txt" 2>&1 &
   viewer_mode="xvfb screenshot"
@@ -72,7 +81,7 @@ viewer_pid=$!
 pids+=("$viewer_pid")
 
 device_rc=0
-"$bin/snapthread-device" --backend virtual-hand --scene "$scene" --session "$session" \
+"$bin/snapthread-device" --key "$key" --backend virtual-hand --scene "$scene" --session "$session" \
     --lcm-url "$url" --duration "$duration" --summary "$out/device.json" \
     --trace "$out/device_trace.csv" > "$out/device.txt" 2>&1 || device_rc=$?
 server_rc=0

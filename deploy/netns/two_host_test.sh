@@ -50,8 +50,9 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# stop_logger, fail, json, run_session
+# stop_logger, fail, json, make_key, run_session
 source "$(dirname "$0")/../../tests/support/script_support.sh"
+make_key
 
 # Namespaces left by an earlier run of this script that was killed before its trap ran
 # (their names end in the pid of that run, which is gone).
@@ -94,10 +95,10 @@ echo "namespaces: server $ns_srv ($subnet.1), device $ns_dev ($subnet.2), observ
 # SCHED_FIFO for the logger, as in the soak test: a stalled logger drops messages.
 ip netns exec "$ns_obs" chrt -f 10 lcm-logger -q -c "${session}_.*" --lcm-url="$url" -f "$work/session.lcmlog" > "$work/logger.txt" 2>&1 &
 logger_pid=$!
-ip netns exec "$ns_obs" "$bin/snapthread-viewer" --print-rates --session "$session" --lcm-url "$url" \
+ip netns exec "$ns_obs" "$bin/snapthread-viewer" --key "$key" --print-rates --session "$session" --lcm-url "$url" \
     --duration-s $((duration + 3)) > "$work/observer_rates.txt" 2>&1 &
 rates_pid=$!
-ip netns exec "$ns_obs" xvfb-run -a -n $((100 + tag % 800)) -s "-screen 0 640x480x24" "$bin/snapthread-viewer" \
+ip netns exec "$ns_obs" xvfb-run -a -n $((100 + tag % 800)) -s "-screen 0 640x480x24" "$bin/snapthread-viewer" --key "$key" \
     --session "$session" --lcm-url "$url" --screenshot "$work/observer.png" --after-shapes 30 \
     --timeout-s $((duration + 10)) --width 640 --height 480 > "$work/observer_viewer.txt" 2>&1 &
 viewer_pid=$!

@@ -29,6 +29,8 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/message_mac.h"
+#include "auth/session_epoch.h"
 #include "messages/channels.h"
 #include "messages/validate.h"
 #include "test_support.h"
@@ -87,14 +89,24 @@ std::vector<TraceSample> ReadTrace(const std::string& path, std::string* header)
   return rows;
 }
 
-// The fake server: answers each device pose with the spring's local model.
+// The fake server: answers each device pose with the spring's local model, signed with
+// the session key and its own epoch, which it announces in a signed solver status every
+// 50 ms (the device learns the epoch from it, as from the real server).
 class FakeServer {
  public:
-  explicit FakeServer(const std::string& session) : channels_(session), lcm_(kUrl) {
+  FakeServer(const std::string& session, const auth::SessionKey* key)
+      : channels_(session), lcm_(kUrl), key_(key), epoch_(auth::NewEpoch()) {
     if (!lcm_.good()) return;
     lcm_.subscribe(channels_.device_state, &FakeServer::OnPose, this);
     thread_ = std::thread([this] {
-      while (!stop_.load()) lcm_.handleTimeout(10);
+      auto next_status = std::chrono::steady_clock::now();
+      while (!stop_.load()) {
+        lcm_.handleTimeout(10);
+        if (std::chrono::steady_clock::now() >= next_status) {
+          PublishStatus();
+          next_status += std::chrono::milliseconds(50);
+        }
+      }
     });
   }
   ~FakeServer() { Stop(); }
@@ -125,11 +137,25 @@ class FakeServer {
     // A negative stiffness along z (dF_z/dz > 0), which the device must clamp to zero in
     // every model. The sim-path stays at z = 0, so the spring law is unaffected.
     m.K[2][2] = +kNegativeStiffnessNPerM;
+    if (!auth::Sign(&m, channels_.force_model, epoch_, auth_seq_.Next(), *key_)) return;
     lcm_.publish(channels_.force_model, &m);
+  }
+
+  void PublishStatus() {
+    solver_status_t st{};
+    st.seq = ++status_seq_;
+    st.scene = "fake";
+    st.method = "spring";
+    if (!auth::Sign(&st, channels_.solver_status, epoch_, auth_seq_.Next(), *key_)) return;
+    lcm_.publish(channels_.solver_status, &st);
   }
 
   transport::Channels channels_;
   lcm::LCM lcm_;
+  const auth::SessionKey* key_;
+  int64_t epoch_;
+  auth::AuthSequence auth_seq_;
+  int64_t status_seq_ = 0;
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<int> poses_{0};
@@ -152,6 +178,7 @@ void SleepUntil(std::chrono::steady_clock::time_point t0, double s) {
 }
 
 TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
+  const test_support::SessionKeyFile key_file;  // SNAPTHREAD_KEY_FILE for the device
   const std::string bin = DeviceBinary();
   ASSERT_FALSE(bin.empty()) << "SNAPTHREAD_BIN_DIR not set (run through ctest)";
   const test_support::ScopedTempDir scoped("device_test");
@@ -160,7 +187,7 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   const std::string scene = WriteScene(dir);
   const transport::Channels channels(session);
 
-  auto server = std::make_unique<FakeServer>(session);
+  auto server = std::make_unique<FakeServer>(session, &key_file.key());
   ASSERT_TRUE(server->good()) << "udpm on loopback unavailable: " << kUrl;
 
   const double duration_s = 5.0;
@@ -177,7 +204,7 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   const int poses_first = server->poses();
   server.reset();
   SleepUntil(t0, 3.0);
-  server = std::make_unique<FakeServer>(session);
+  server = std::make_unique<FakeServer>(session, &key_file.key());
   ASSERT_TRUE(server->good());
   SleepUntil(t0, 3.6);
 
@@ -256,11 +283,13 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   EXPECT_GT(rt50, 0.0) << summary;
   EXPECT_LT(rt50, 1e6) << summary;
   EXPECT_GE(JsonNumber(summary, "round_trip_us_p99"), rt50) << summary;
-  // Bad packets: counted and dropped (udpm on loopback may lose a few), nothing else is
-  // rejected, and the device never output a non-finite force.
+  // Bad packets: counted and dropped (udpm on loopback may lose a few), and the device
+  // never output a non-finite force. Besides them only the few models that answer poses
+  // sent before the device heard a (re)started server's signed status are refused
+  // (another epoch than the pose's): at most a status period's worth at each start.
   const double rejected = JsonNumber(summary, "models_rejected");
   EXPECT_GE(rejected, 0.8 * injected) << summary;
-  EXPECT_LE(rejected, injected) << summary;
+  EXPECT_LE(rejected, injected + 2 * 50) << summary;
   EXPECT_EQ(JsonNumber(summary, "nonfinite_outputs"), 0.0) << summary;
   EXPECT_GT(JsonNumber(summary, "fade_ticks"), 200) << summary;
   // Every accepted model had its negative z stiffness clamped; about 1 in 100 snapped.
@@ -382,6 +411,7 @@ class Listener {
 };
 
 TEST(DeviceProcessTest, SigtermStopsCleanlyAndPublishesPosesAndStatus) {
+  const test_support::SessionKeyFile key_file;  // SNAPTHREAD_KEY_FILE for the device
   const std::string bin = DeviceBinary();
   ASSERT_FALSE(bin.empty());
   const test_support::ScopedTempDir scoped("device_test");
@@ -421,6 +451,7 @@ TEST(DeviceProcessTest, SigtermStopsCleanlyAndPublishesPosesAndStatus) {
 }
 
 TEST(DeviceProcessTest, BadArgumentsExitTwoNamingTheArgument) {
+  const test_support::SessionKeyFile key_file;  // SNAPTHREAD_KEY_FILE for the device
   const std::string bin = DeviceBinary();
   ASSERT_FALSE(bin.empty());
   const test_support::ScopedTempDir scoped("device_test");
@@ -452,6 +483,7 @@ TEST(DeviceProcessTest, BadArgumentsExitTwoNamingTheArgument) {
 }
 
 TEST(DeviceProcessTest, LcmFailureExitsOneWithUrlAndHint) {
+  const test_support::SessionKeyFile key_file;  // SNAPTHREAD_KEY_FILE for the device
   const std::string bin = DeviceBinary();
   ASSERT_FALSE(bin.empty());
   const test_support::ScopedTempDir scoped("device_test");

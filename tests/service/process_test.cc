@@ -98,6 +98,9 @@ double Percentile(std::vector<double> v, double q) {
 
 class ProcessTest : public ::testing::Test {
  protected:
+  // The session key every binary of the test uses (SNAPTHREAD_KEY_FILE, inherited).
+  const test_support::SessionKeyFile key_file_;
+
   void SetUp() override {
     bin_ = test_support::BinDir();
     source_ = test_support::SourceDir();

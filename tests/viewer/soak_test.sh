@@ -38,13 +38,14 @@ if [ "$(id -u)" -ne 0 ]; then prio=""; logger_prio=""; fi
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
 trap cleanup EXIT
-# stop_logger, fail, json, run_session
+# stop_logger, fail, json, make_key, run_session
 source "$(dirname "$0")/../support/script_support.sh"
+make_key
 
 $logger_prio lcm-logger -q -c "${session}_.*" --lcm-url="$url" -f "$work/session.lcmlog" > "$work/logger.txt" 2>&1 &
 logger_pid=$!; pids+=("$logger_pid")
 for v in 1 2; do
-  xvfb-run -a -n $((100 + ($$ + 37 * v) % 800)) -s "-screen 0 640x480x24" "$bin/snapthread-viewer" \
+  xvfb-run -a -n $((100 + ($$ + 37 * v) % 800)) -s "-screen 0 640x480x24" "$bin/snapthread-viewer" --key "$key" \
       --session "$session" --lcm-url "$url" --duration-s $((duration + 3)) --width 320 --height 240 --max-fps 15 \
       > "$work/viewer$v.txt" 2>&1 &
   pids+=("$!")

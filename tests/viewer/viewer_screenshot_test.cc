@@ -17,6 +17,9 @@
 #include "snapthread/device_state_t.hpp"
 #include "scene/scene.h"
 #include "orbit_camera.h"
+#include "auth/message_mac.h"
+#include "auth/session_epoch.h"
+#include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
 #include "messages/channels.h"
 #include "spline.h"
@@ -68,11 +71,16 @@ thread_shape_t ArcShape(int64_t seq, int8_t status = 0) {
   return s;
 }
 
-// Publishes the arc every 20 ms (plus malformed packets when asked) until stopped.
+// Publishes the arc every 20 ms (plus malformed packets when asked) until stopped, signed
+// like the server's (a per-test key in SNAPTHREAD_KEY_FILE for the viewer, an epoch
+// announced in a signed solver status before each shape).
 class ShapePublisher {
  public:
   ShapePublisher(const std::string& session, bool with_garbage, int8_t status = 0)
-      : channel_(transport::Channels(session).shape), garbage_(with_garbage), status_(status) {}
+      : channel_(transport::Channels(session).shape),
+        status_channel_(transport::Channels(session).solver_status),
+        garbage_(with_garbage),
+        status_(status) {}
   ~ShapePublisher() { Stop(); }
   bool Start() {
     if (!lcm_.good()) return false;
@@ -84,6 +92,7 @@ class ShapePublisher {
     if (thread_.joinable()) thread_.join();
   }
   int64_t garbage_sent() const { return garbage_sent_; }
+  int64_t epoch() const { return epoch_; }
 
  private:
   void Loop() {
@@ -91,8 +100,18 @@ class ShapePublisher {
     int64_t seq = 0;
     while (running_) {
       if (garbage_) PublishGarbage(seq, &rng);
+      solver_status_t st{};
+      st.seq = seq;
+      st.scene = "test-arc";
+      st.method = "newton";
+      st.status = status_;
+      if (auth::Sign(&st, status_channel_, epoch_, auth_seq_.Next(), key_file_.key())) {
+        lcm_.publish(status_channel_, &st);
+      }
       thread_shape_t s = ArcShape(++seq, status_);
-      lcm_.publish(channel_, &s);
+      if (auth::Sign(&s, channel_, epoch_, auth_seq_.Next(), key_file_.key())) {
+        lcm_.publish(channel_, &s);
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
@@ -135,8 +154,12 @@ class ShapePublisher {
     garbage_sent_++;
   }
 
+  const SessionKeyFile key_file_;
+  const int64_t epoch_ = auth::NewEpoch();
+  auth::AuthSequence auth_seq_;
   lcm::LCM lcm_{kLoopbackUrl};
   std::string channel_;
+  std::string status_channel_;
   bool garbage_;
   int8_t status_;
   std::atomic<bool> running_{true};
@@ -330,12 +353,30 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
   const std::string session = UniqueSession("VIEWREPLAY");
   const std::string dir = FreshTempDir("viewer-replay");
   const std::string log_path = dir + "/session.lcmlog";
+  const SessionKeyFile key_file;  // the logged session's key, for the viewer too
   {
     lcm::LogFile log(log_path, "w");
     ASSERT_TRUE(log.good());
     const std::string channel = transport::Channels(session).shape;
-    for (int k = 0; k < 400; ++k) {  // 8 s of shapes at 50 Hz
+    const int64_t epoch = auth::NewEpoch();
+    auth::AuthSequence auth_seq;
+    for (int k = 0; k < 400; ++k) {  // 8 s of shapes at 50 Hz, a signed status before each
+      solver_status_t st{};
+      st.seq = k;
+      st.scene = "test-arc";
+      st.method = "newton";
+      ASSERT_TRUE(auth::Sign(&st, transport::Channels(session).solver_status, epoch,
+                             auth_seq.Next(), key_file.key()));
+      std::vector<uint8_t> status_buf(st.getEncodedSize());
+      st.encode(status_buf.data(), 0, int(status_buf.size()));
+      lcm::LogEvent se;
+      se.timestamp = 1700000000000000 + k * 20000 - 1;
+      se.channel = transport::Channels(session).solver_status;
+      se.datalen = int32_t(status_buf.size());
+      se.data = status_buf.data();
+      ASSERT_EQ(log.writeEvent(&se), 0);
       thread_shape_t s = ArcShape(k);
+      ASSERT_TRUE(auth::Sign(&s, channel, epoch, auth_seq.Next(), key_file.key()));
       std::vector<uint8_t> buf(s.getEncodedSize());
       s.encode(buf.data(), 0, int(buf.size()));
       lcm::LogEvent e;
@@ -449,6 +490,9 @@ TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
   for (const auto& p : poses) {
     EXPECT_EQ(p.buttons, 1);  // published only while the button is held
     EXPECT_EQ(p.device_id, "viewer-mouse");
+    // Signed with the epoch the viewer learned from the publisher's signed status.
+    EXPECT_EQ(p.epoch, publisher.epoch());
+    EXPECT_GT(p.auth_seq, 0);
   }
   // The pose while held at the target: the model point under the cursor, in device metres
   // (one pixel is ~0.007 model units = 0.14 mm here).
@@ -464,6 +508,7 @@ TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
 TEST(ViewerScreenshotTest, TimesOutWithAClearMessageWhenNothingArrives) {
   const std::string session = UniqueSession("VIEWNONE");
   const std::string dir = FreshTempDir("viewer-none");
+  const SessionKeyFile key_file;
   const ViewerRun run = RunViewerScreenshot(session, dir, 1, 1.5);
   ASSERT_TRUE(run.result.exited) << run.result.err;
   EXPECT_EQ(run.result.exit_code, 2);
