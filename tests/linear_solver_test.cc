@@ -297,11 +297,11 @@ TEST_P(LinearSolverTest, Thread3dHessians) {
       for (double compression : {1.0, 0.9, 0.6}) {
         ModelParams p;
         p.model = "thread3d";
-        p.n = segments;
-        p.grip_direction = grip;
+        p.Set("n", segments);
+        p.Set("grip_direction", grip);
         const auto model = MakeModel(p);
         Vec u = Vec::Zero(model->NumControls());
-        u[0] = compression * segments * p.segment_length;
+        u[0] = compression * segments * p.Number("segment_length");
         if (grip) u[3] = 1.0;
         Vec x = model->InitialState(u);
         for (int i = 0; i < x.size(); ++i) x[i] += noise(rng);
