@@ -6,7 +6,9 @@
 #include <CLI/CLI.hpp>
 
 #include "models/registry.h"
+#include "solvers/registry.h"
 #include "sweep.h"
+#include "tool_main.h"
 
 int main(int argc, char** argv) {
   using namespace snapthread;
@@ -26,25 +28,23 @@ int main(int argc, char** argv) {
   path_opt->excludes(from_opt)->excludes(to_opt);
   app.add_option("--steps", steps, "number of equal steps N (rows 0..N), or per leg with --path");
   app.add_flag("--back", back, "continue N more steps back to --from (2N+1 rows)");
-  app.add_option("--method", method, "newton | newton-ls | higher-order (default: the scene's)");
+  app.add_option("--method", method, SolverRegistry::Global().NamesText(" | ", " | ") + " (default: the scene's)");
   app.add_option("--cutoff", cutoff, "stop when |E_x| < cutoff (default: the scene's)");
   app.add_option("--max-iterations", max_iterations, "iteration budget per step, 0 = unlimited");
   app.add_option("--set", sets, "override a scene key, e.g. --set params.n=20 (repeatable)");
   app.add_option("--out", out_file, "CSV output file (default: standard output)");
   // The models a scene may name, with their parameters (--set params.<name>=...).
   app.footer("Models (scene key `model:`):\n" + ModelHelp());
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
-  try {
+  const auto run = [&]() -> int {
     std::vector<SceneOverride> overrides;
     for (const auto& s : sets) overrides.push_back(ParseOverride(s));
     Scene scene = LoadScene(scene_file, overrides);
-    if (!method.empty() && !ParseMethod(method, &scene.solver.method))
-      throw std::invalid_argument("--method: expected newton, newton-ls or higher-order, got '" + method + "'");
+    if (!method.empty()) {
+      if (SolverRegistry::Global().Find(method) == nullptr)
+        throw std::invalid_argument("--method: expected " + SolverRegistry::Global().NamesText(", ", " or ") +
+                                    ", got '" + method + "'");
+      scene.solver.method = method;
+    }
     if (app.count("--cutoff")) {
       if (!(cutoff > 0.0)) throw std::invalid_argument("--cutoff: expected a number > 0");
       scene.solver.cutoff = cutoff;
@@ -77,15 +77,9 @@ int main(int argc, char** argv) {
       if (!out) throw std::runtime_error("--out: cannot write '" + out_file + "'");
       WriteSweepCsv(rows, scene.solver.method, out);
     }
-  } catch (const SceneError& e) {
-    std::cerr << "snapthread-sweep: " << e.what() << '\n';
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "snapthread-sweep: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "snapthread-sweep: " << e.what() << '\n';
-    return 1;
-  }
-  return 0;
+    return 0;
+  };
+  ToolExitCodes codes;
+  codes.scene_error_is_bad_input = true;
+  return RunTool("snapthread-sweep", app, argc, argv, run, codes);
 }

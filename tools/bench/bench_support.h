@@ -24,7 +24,7 @@ double RelativeRmsForceError(const std::vector<SweepRow>& trace, const std::vect
 
 double ForceScaleOf(const Scene& scene);
 
-// Line colour of a method in the gnuplot charts.
-const char* MethodColor(Method m);
+// The scene solved with `method`, `cutoff` and an iteration budget (0 = unlimited).
+Scene WithSolver(const Scene& scene, const std::string& method, double cutoff, int budget);
 
 }  // namespace snapthread
