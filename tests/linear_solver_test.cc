@@ -521,7 +521,7 @@ TEST_P(LinearSolverTest, EquilibriumSolvesAfterTheFirstDoNotAllocate) {
     o.linear_solver = GetParam();
     auto solver = MakeSolver(*model, o);
     Vec u = Vec::Zero(model->NumControls());
-    u[0] = 0.8 * p.n;
+    u[0] = 0.8 * p.Integer("n");
     u[1] = 0.5;
     Vec x = model->InitialState(u);
     SolverOptions strict = o;
