@@ -37,7 +37,7 @@ class Model {
  public:
   virtual ~Model() = default;
 
-  // "zeeman", "cusp", "curve2d", "thread3d".
+  // The name the model is registered under (models/registry.h).
   virtual std::string_view Name() const = 0;
   virtual int NumStates() const = 0;
   virtual int NumControls() const = 0;
