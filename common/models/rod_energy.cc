@@ -5,8 +5,9 @@
 //   d²p = -p dφ dφ + dφ (m2·dκb) + (m2·dκb) dφ + q B + (κb·de)(m1·de)/|e|² + m1·d²κb,
 // where B = ∂(Â/|e|)/∂e = (dÂ/dt)(I - t tᵀ)/|e|² - Â tᵀ/|e|² is the derivative of the
 // twist-rate term of dφ. (The B and (κb·de)(m·de) terms are not symmetric one by one;
-// their sum is, because the curl of Â is the area form of the sphere.) The d²κb terms of
-// all four directors are gathered into one contraction W·d²κb, W·κb = 2 W·(e0×e1)/χ,
+// their sum is, because the curl of Â is the area form of the sphere.) With
+// E_bend = ¼ Σ_j [B1 (q_j - κ̄1)² + B2 (-p_j - κ̄2)²] / ℓ̄ the d²κb terms of all four
+// directors are gathered into one contraction W·d²κb, W·κb = 2 W·(e0×e1)/χ,
 // χ = |e0||e1| + e0·e1, differentiated as a quotient.
 #include "models/rod_energy.h"
 
@@ -67,15 +68,21 @@ double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
   }
   const double chi = l[0] * l[1] + e0.dot(e1);
   const V3 kb = (2.0 / chi) * e0.cross(e1);  // [DER (1)]
-  const double kappa1 = 0.5 * (m2[0] + m2[1]).dot(kb);
-  const double kappa2 = -0.5 * (m1[0] + m1[1]).dot(kb);
+  // Material curvatures of each edge [DER §4.2]: κ^j = (κb·m2_j, -κb·m1_j).
+  double r1[2], r2[2];
+  double bend = 0.0;
+  for (int j = 0; j < 2; ++j) {
+    r1[j] = kb.dot(m2[j]) - k.kappa1_bar;
+    r2[j] = -kb.dot(m1[j]) - k.kappa2_bar;
+    bend += k.c1 * r1[j] * r1[j] + k.c2 * r2[j] * r2[j];
+  }
   V3 a0, b0, a1, b1;
   ReferenceFrame(s0, t[0], &a0, &b0);
   ReferenceFrame(s1, t[1], &a1, &b1);
   const double mref = AngleAbout(t[1], Transport(t[0], t[1], a0), a1, twist_near);
   const double tau = theta1 - theta0 + mref;
-  const double r1 = kappa1 - k.kappa1_bar, r2 = kappa2 - k.kappa2_bar;
-  const double energy = 0.5 * (k.c1 * r1 * r1 + k.c2 * r2 * r2 + k.ct * tau * tau);
+  // Bending: the mean of the two edges' energies [DER (4)]; twist [DVT (4)].
+  const double energy = 0.25 * bend + 0.5 * k.ct * tau * tau;
   if (g == nullptr && h == nullptr) return energy;
 
   // ∂κb/∂e0, ∂κb/∂e1 [DER §6]: (±2[e]× - κb ∇χᵀ)/χ.
@@ -97,20 +104,23 @@ double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
     gq[j] = -p[j] * dphi[j] + jm2[j];
     gp[j] = q[j] * dphi[j] + jm1[j];
   }
-  const Vec8 gk1 = 0.5 * (gq[0] + gq[1]);
-  const Vec8 gk2 = -0.5 * (gp[0] + gp[1]);
   Vec8 gtau;
   gtau << kb / (2.0 * l[0]) - alpha[0], kb / (2.0 * l[1]) + alpha[1], -1.0, 1.0;
-  if (g != nullptr) *g = k.c1 * r1 * gk1 + k.c2 * r2 * gk2 + k.ct * tau * gtau;
+  if (g != nullptr) {
+    *g = k.ct * tau * gtau;
+    for (int j = 0; j < 2; ++j) *g += 0.5 * (k.c1 * r1[j] * gq[j] - k.c2 * r2[j] * gp[j]);
+  }
   if (h == nullptr) return energy;
 
   Mat8& hh = *h;
-  hh = k.c1 * gk1 * gk1.transpose() + k.c2 * gk2 * gk2.transpose() +
-       k.ct * gtau * gtau.transpose();
-  const double wq = 0.5 * k.c1 * r1;   // weight of each d²q_j in E
-  const double wp = -0.5 * k.c2 * r2;  // weight of each d²p_j in E
+  hh = k.ct * gtau * gtau.transpose();
   M3 balpha[2];
+  V3 w = V3::Zero();
   for (int j = 0; j < 2; ++j) {
+    hh.noalias() += 0.5 * k.c1 * gq[j] * gq[j].transpose() + 0.5 * k.c2 * gp[j] * gp[j].transpose();
+    const double wq = 0.5 * k.c1 * r1[j];   // weight of d²q_j in E
+    const double wp = -0.5 * k.c2 * r2[j];  // weight of d²p_j in E
+    w += wq * m2[j] + wp * m1[j];
     const double inv_l2 = 1.0 / (l[j] * l[j]);
     const M3 proj = M3::Identity() - t[j] * t[j].transpose();
     balpha[j] = (TwistRateJacobian(src[j]->t, t[j]) * proj - TwistRate(src[j]->t, t[j]) *
@@ -121,7 +131,6 @@ double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
     hh.block<3, 3>(3 * j, 3 * j) += (wp * q[j] - wq * p[j]) * balpha[j] +
                                     inv_l2 * kb * (wq * m2[j] + wp * m1[j]).transpose();
   }
-  const V3 w = wq * (m2[0] + m2[1]) + wp * (m1[0] + m1[1]);
   hh.topLeftCorner<6, 6>() += ContractedCurvatureHessian(e0, e1, l[0], l[1], t[0], t[1], chi, w);
   // Twist: ct τ ∇²m, from dm above.
   const double ct = k.ct * tau;

@@ -9,7 +9,7 @@
 // y = m1, z = m2.
 //
 // State x (4n - 11 entries), ordered for a narrow band:
-//   [θ_1, x_2, θ_2, x_3, θ_3, ..., x_{n-2}, θ_{n-2}]   (half-bandwidth 7)
+//   [θ_1, x_2, θ_2, x_3, θ_3, ..., x_{n-2}, θ_{n-2}]   (half-bandwidth 10: a vertex couples three nodes)
 //
 // Controls and torque. E_u = (E_p, E_φ). F = -E_p is the force of the rod on the hand
 // (world frame). -E_φ is the torque conjugate to the rotation vector φ; at φ = 0 (and
