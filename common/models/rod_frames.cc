@@ -12,19 +12,22 @@ Coefficients RodriguesCoefficients(double s) {
   Coefficients c{};
   if (s < 0.1) {
     // A = Σ (-s)^k / (2k+1)!, B = Σ (-s)^k / (2k+2)!; nine terms leave < 1e-20.
+    // Term k contributes f s^k, f k s^(k-1), f k (k-1) s^(k-2) to the value and the
+    // two derivatives (powers carried along, no pow calls).
     double fa = 1.0, fb = 0.5;  // (-1)^k / (2k+1)!, (-1)^k / (2k+2)!
+    double pk = 1.0, pk1 = 0.0, pk2 = 0.0;  // s^k, s^(k-1), s^(k-2) (0 when k is too small)
     for (int k = 0; k < 9; ++k) {
-      const double p0 = std::pow(s, k);
-      const double p1 = k >= 1 ? k * std::pow(s, k - 1) : 0.0;
-      const double p2 = k >= 2 ? k * (k - 1.0) * std::pow(s, k - 2) : 0.0;
-      c.a += fa * p0;
-      c.a1 += fa * p1;
-      c.a2 += fa * p2;
-      c.b += fb * p0;
-      c.b1 += fb * p1;
-      c.b2 += fb * p2;
+      c.a += fa * pk;
+      c.a1 += fa * k * pk1;
+      c.a2 += fa * k * (k - 1.0) * pk2;
+      c.b += fb * pk;
+      c.b1 += fb * k * pk1;
+      c.b2 += fb * k * (k - 1.0) * pk2;
       fa /= -(2.0 * k + 2.0) * (2.0 * k + 3.0);
       fb /= -(2.0 * k + 3.0) * (2.0 * k + 4.0);
+      pk2 = pk1;
+      pk1 = pk;
+      pk *= s;
     }
     return c;
   }

@@ -141,6 +141,17 @@ RodModel::GraspMap RodModel::Grasp(const Vec& u, bool derivatives) const {
   GraspMap gm;
   const V3 pos = u.head<3>();
   const V3 phi = u.segment<3>(3);
+  if (!derivatives) {
+    // Values only (Energy, line searches): the rotation and one angle.
+    const M3 r = rod::ExpMap(phi) * p_.grasp_rotation;
+    const V3 t = r.col(0);
+    gm.xn = pos;
+    gm.xn1 = pos - rest_ * t;
+    V3 a, b;
+    rod::ReferenceFrame(sources_[n_ - 1], t, &a, &b);
+    gm.theta = rod::AngleAbout(t, a, r.col(1), grasp_theta_near_);
+    return gm;
+  }
   const JetVec t = rod::RotateJet(phi, p_.grasp_rotation.col(0));
   const JetVec m1 = rod::RotateJet(phi, p_.grasp_rotation.col(1));
   gm.xn = pos;
@@ -154,7 +165,6 @@ RodModel::GraspMap RodModel::Grasp(const Vec& u, bool derivatives) const {
   const Jet theta = rod::Atan2(Dot(b, m1), Dot(a, m1));
   gm.theta = grasp_theta_near_ +
              std::remainder(theta.v - grasp_theta_near_, 2.0 * std::numbers::pi);
-  if (!derivatives) return gm;
   gm.jac.setZero();
   for (int c = 0; c < 3; ++c) {
     gm.jac(c, c) = 1.0;
@@ -214,17 +224,28 @@ void RodModel::Local(int t, const Vec& x, const GraspMap& gm, bool want_h, F&& f
     gy.segment<3>(6) = g8.segment<3>(3);
     gy.segment<2>(9) = g8.tail<2>();
     if (want_h) {
-      static const Eigen::Matrix<double, 8, kMaxLocal> kLift = [] {
-        Eigen::Matrix<double, 8, kMaxLocal> l = Eigen::Matrix<double, 8, kMaxLocal>::Zero();
-        l.block<3, 3>(0, 0) = -M3::Identity();
-        l.block<3, 3>(0, 3) = M3::Identity();
-        l.block<3, 3>(3, 3) = -M3::Identity();
-        l.block<3, 3>(3, 6) = M3::Identity();
-        l(6, 9) = 1.0;
-        l(7, 10) = 1.0;
-        return l;
-      }();
-      hy.noalias() = kLift.transpose() * h8 * kLift;
+      // Hy = Lᵀ H8 L with node a's edge coefficients D(a, ·) = (-1, 0), (1, -1), (0, 1),
+      // block by block (the dense product would cost several times more).
+      static constexpr double kD[3][2] = {{-1.0, 0.0}, {1.0, -1.0}, {0.0, 1.0}};
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) {
+          M3 blk = M3::Zero();
+          for (int e = 0; e < 2; ++e) {
+            if (kD[a][e] == 0.0) continue;
+            for (int f = 0; f < 2; ++f) {
+              if (kD[b][f] != 0.0) blk += (kD[a][e] * kD[b][f]) * h8.block<3, 3>(3 * e, 3 * f);
+            }
+          }
+          hy.block<3, 3>(3 * a, 3 * b) = blk;
+        }
+        Eigen::Matrix<double, 3, 2> side = Eigen::Matrix<double, 3, 2>::Zero();
+        for (int e = 0; e < 2; ++e) {
+          if (kD[a][e] != 0.0) side += kD[a][e] * h8.block<3, 2>(3 * e, 6);
+        }
+        hy.block<3, 2>(3 * a, 9) = side;
+        hy.block<2, 3>(9, 3 * a) = side.transpose();
+      }
+      hy.block<2, 2>(9, 9) = h8.block<2, 2>(6, 6);
     }
   }
   const int nloc = term.nloc;
