@@ -28,7 +28,8 @@ endfunction()
 if(NOT TARGET snapthread_warnings)
   add_library(snapthread_warnings INTERFACE)
   add_library(snapthread::warnings ALIAS snapthread_warnings)
-  target_compile_options(snapthread_warnings INTERFACE -Wall -Wextra -Wpedantic -Werror)
+  target_compile_options(snapthread_warnings INTERFACE -Wall -Wextra -Wpedantic
+                         $<$<BOOL:${SNAPTHREAD_WERROR}>:-Werror>)
 endif()
 
 # snapthread_project_code(TARGET): a library or program of this project (warnings, PIC).

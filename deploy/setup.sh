@@ -9,9 +9,9 @@ packages=(
   build-essential cmake pkg-config git
   liblcm-dev liblcm-bin liblcm-java libglib2.0-dev default-jdk-headless libjchart2d-java
   libeigen3-dev libsuitesparse-dev libspdlog-dev libgtest-dev libgmock-dev
-  libyaml-cpp-dev libcli11-dev
+  libyaml-cpp-dev libcli11-dev libsodium-dev
   libglfw3-dev libepoxy-dev xvfb xauth libstb-dev libpng-dev libgl1-mesa-dri xdotool
-  gnuplot-nox
+  gnuplot-nox graphviz python3 ccache
   iproute2 procps
 )
 

@@ -1,5 +1,5 @@
 // snapthread-bench: speed against accuracy, scaling with n, service latency and the
-// "model no more than a scene needs" advisor. See tools/bench.h and docs/benchmarks.md.
+// "model no more than a scene needs" advisor. See tools/bench/bench.h and docs/benchmarks.md.
 #include <unistd.h>
 
 #include <chrono>

@@ -1,0 +1,55 @@
+// What a receiver does with each signed message (docs/security.md): the MAC over the
+// received bytes first, then the freshness of the decoded epoch and auth_seq, and for a
+// force model on the device the echo of a pose it sent. Each refusal is counted in the
+// filter; the caller adds filter.rejected() to its status counter (models_rejected,
+// rejected_messages), logs filter.TakeLogLine() and never uses a refused message.
+//
+// `data`/`size` are the received LCM buffer (rbuf->data, rbuf->data_size) and `decoded`
+// its exact decoding (no trailing bytes; transport::DecodeAndValidate). Allocation-free
+// after the first message of each size; never throws.
+#pragma once
+
+#include <cstddef>
+#include <string_view>
+
+#include "auth/freshness_filter.h"
+#include "auth/message_mac.h"
+#include "auth/pose_echo_window.h"
+#include "auth/session_key.h"
+#include "snapthread/force_model_t.hpp"
+
+namespace snapthread::auth {
+
+template <class Msg>
+Reason Admit(const void* data, std::size_t size, const Msg& decoded, std::string_view channel,
+             const SessionKey& key, FreshnessFilter* filter) {
+  if (!VerifyEncoded(data, size, channel, key)) {
+    filter->Reject(Reason::kBadMac);
+    return Reason::kBadMac;
+  }
+  return filter->Admit(decoded.epoch, decoded.auth_seq);
+}
+
+// The device's check of a force model: Admit, plus the model must echo the
+// (epoch, device_seq, device_utime) of a pose in `sent`. A model refused for its echo
+// does not raise the sequence floor.
+inline Reason AdmitForceModel(const void* data, std::size_t size, const force_model_t& decoded,
+                              std::string_view channel, const SessionKey& key,
+                              const PoseEchoWindow& sent, FreshnessFilter* filter) {
+  if (!VerifyEncoded(data, size, channel, key)) {
+    filter->Reject(Reason::kBadMac);
+    return Reason::kBadMac;
+  }
+  const Reason fresh = filter->Check(decoded.epoch, decoded.auth_seq);
+  if (fresh != Reason::kAccepted) {
+    filter->Reject(fresh);
+    return fresh;
+  }
+  if (!sent.Contains(decoded.epoch, decoded.device_seq, decoded.device_utime)) {
+    filter->Reject(Reason::kUnsentPoseEcho);
+    return Reason::kUnsentPoseEcho;
+  }
+  return filter->Admit(decoded.epoch, decoded.auth_seq);
+}
+
+}  // namespace snapthread::auth

@@ -1,0 +1,243 @@
+// The whole exchange over LCM memq://, with the auth room only: the device learns the
+// epoch from the server's signed status, its signed poses are answered by signed force
+// models, and a key-less attacker's forged, replayed and re-keyed messages are all
+// refused and counted (never handed on), while the genuine exchange keeps working.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "auth/freshness_filter.h"
+#include "auth/message_gate.h"
+#include "auth/message_mac.h"
+#include "auth/pose_echo_window.h"
+#include "auth/session_epoch.h"
+#include "messages/validate.h"
+#include "sample_messages.h"
+
+namespace snapthread::auth {
+namespace {
+
+const std::string kStatus = "T_SOLVER_STATUS";
+const std::string kPose = "T_DEVICE_STATE";
+const std::string kModel = "T_FORCE_MODEL";
+
+using Bytes = std::vector<uint8_t>;
+
+Bytes Copy(const lcm::ReceiveBuffer* rbuf) {
+  const auto* p = static_cast<const uint8_t*>(rbuf->data);
+  return Bytes(p, p + rbuf->data_size);
+}
+
+// The device's receive side, as the device client will do it.
+class Device {
+ public:
+  Device(lcm::LCM* lcm, const SessionKey* key) : lcm_(lcm), key_(key) {
+    lcm->subscribe(kStatus, &Device::OnStatus, this);
+    lcm->subscribe(kModel, &Device::OnModel, this);
+  }
+
+  void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    solver_status_t msg;
+    if (!transport::DecodeAndValidate(rbuf, &msg, nullptr)) return;
+    if (Admit(rbuf->data, rbuf->data_size, msg, channel, *key_, &status_filter_) == Reason::kAccepted) {
+      model_filter_.SetEpoch(status_filter_.epoch());
+    }
+  }
+
+  void OnModel(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    force_model_t msg;
+    if (!transport::DecodeAndValidate(rbuf, &msg, nullptr)) {
+      ++malformed_;
+      return;
+    }
+    if (AdmitForceModel(rbuf->data, rbuf->data_size, msg, channel, *key_, *sent_, &model_filter_) ==
+        Reason::kAccepted) {
+      rendered_.push_back(msg.device_seq);
+    }
+  }
+
+  void SendPose() {
+    device_state_t pose = testing::Sample<device_state_t>();
+    pose.seq = ++pose_seq_;
+    pose.utime = 1000 * pose.seq + 7;
+    const int64_t epoch = status_filter_.epoch();
+    ASSERT_TRUE(Sign(&pose, kPose, epoch, seq_.Next(), *key_));
+    sent_->Record(epoch, pose.seq, pose.utime);
+    lcm_->publish(kPose, &pose);
+  }
+
+  // What goes into device_status_t.models_rejected.
+  uint64_t models_rejected() const { return malformed_ + model_filter_.rejected(); }
+
+  FreshnessFilter status_filter_{kStatus, FreshnessFilter::EpochPolicy::kAdopt};
+  FreshnessFilter model_filter_{kModel};
+  std::unique_ptr<PoseEchoWindow> sent_ = std::make_unique<PoseEchoWindow>();
+  std::vector<int64_t> rendered_;  // device_seq of every model accepted
+  uint64_t malformed_ = 0;
+  int64_t pose_seq_ = 0;
+
+ private:
+  lcm::LCM* lcm_;
+  const SessionKey* key_;
+  AuthSequence seq_;
+};
+
+// The server's side: answers every admitted pose with a signed model echoing it.
+class Server {
+ public:
+  Server(lcm::LCM* lcm, const SessionKey* key)
+      : lcm_(lcm), key_(key), subscription_(lcm->subscribe(kPose, &Server::OnPose, this)) {}
+  ~Server() { lcm_->unsubscribe(subscription_); }
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    device_state_t pose;
+    if (!transport::DecodeAndValidate(rbuf, &pose, nullptr)) return;
+    if (Admit(rbuf->data, rbuf->data_size, pose, channel, *key_, &pose_filter_) != Reason::kAccepted) {
+      return;
+    }
+    force_model_t m = testing::Sample<force_model_t>();
+    m.device_seq = pose.seq;
+    m.device_utime = pose.utime;
+    ASSERT_TRUE(Sign(&m, kModel, epoch_, seq_.Next(), *key_));
+    lcm_->publish(kModel, &m);
+    ++answered_;
+  }
+
+  void SendStatus() {
+    solver_status_t s = testing::Sample<solver_status_t>();
+    ASSERT_TRUE(Sign(&s, kStatus, epoch_, seq_.Next(), *key_));
+    lcm_->publish(kStatus, &s);
+  }
+
+  const int64_t epoch_ = NewEpoch();
+  FreshnessFilter pose_filter_{kPose, FreshnessFilter::EpochPolicy::kFixed, epoch_};
+  int answered_ = 0;
+
+ private:
+  lcm::LCM* lcm_;
+  const SessionKey* key_;
+  lcm::Subscription* subscription_;
+  AuthSequence seq_;
+};
+
+// Everything on the models and status channels, as lcm-logger would keep it.
+struct Recorder {
+  void OnAny(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    (channel == kModel ? models : statuses).push_back(Copy(rbuf));
+  }
+  std::vector<Bytes> models, statuses;
+};
+
+void Drain(lcm::LCM* lcm) {
+  while (lcm->handleTimeout(0) > 0) {
+  }
+}
+
+TEST(AuthOverMemqTest, ForgedReplayedAndRekeyedMessagesAreRefusedAndCounted) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  const SessionKey key = SessionKey::Generate();
+  Recorder log;
+  lcm.subscribe(kModel, &Recorder::OnAny, &log);
+  lcm.subscribe(kStatus, &Recorder::OnAny, &log);
+  Device device(&lcm, &key);
+  auto server = std::make_unique<Server>(&lcm, &key);
+
+  // Before any status the device has no epoch: the server refuses its poses.
+  device.SendPose();
+  Drain(&lcm);
+  EXPECT_EQ(server->answered_, 0);
+  EXPECT_EQ(server->pose_filter_.rejected(Reason::kForeignEpoch), 1u);
+
+  // Genuine session: status, then 20 poses answered by 20 accepted models.
+  server->SendStatus();
+  Drain(&lcm);
+  ASSERT_EQ(device.status_filter_.epoch(), server->epoch_);
+  for (int i = 0; i < 20; ++i) device.SendPose();
+  Drain(&lcm);
+  EXPECT_EQ(server->answered_, 20);
+  ASSERT_EQ(device.rendered_.size(), 20u);
+  EXPECT_EQ(device.models_rejected(), 0u);
+
+  // 1. Forged models answering the device's last pose, with the sniffed epoch and a high
+  //    sequence number, valid LCM encoding, but no key (tag left zero).
+  for (int i = 0; i < 50; ++i) {
+    force_model_t forged = testing::Sample<force_model_t>();
+    forged.f0[0] = 2.9;
+    forged.device_seq = device.pose_seq_;
+    forged.device_utime = 1000 * device.pose_seq_ + 7;
+    forged.epoch = server->epoch_;
+    forged.auth_seq = INT64_MAX - i;
+    lcm.publish(kModel, &forged);
+  }
+  // 2. The same, signed with a key of the attacker's own.
+  const SessionKey rogue = SessionKey::Generate();
+  for (int i = 0; i < 10; ++i) {
+    force_model_t forged = testing::Sample<force_model_t>();
+    forged.device_seq = device.pose_seq_;
+    forged.device_utime = 1000 * device.pose_seq_ + 7;
+    ASSERT_TRUE(Sign(&forged, kModel, server->epoch_, INT64_MAX - i, rogue));
+    lcm.publish(kModel, &forged);
+  }
+  Drain(&lcm);
+  // 3. The log of the models channel played back (lcm-logplayer): genuine and forged.
+  const std::vector<Bytes> logged = log.models;
+  ASSERT_EQ(logged.size(), 80u);  // 20 genuine + 60 forged
+  for (const Bytes& b : logged) lcm.publish(kModel, b.data(), static_cast<unsigned>(b.size()));
+  // 4. Forged poses to the server (no key): never answered.
+  for (int i = 0; i < 30; ++i) {
+    device_state_t pose = testing::Sample<device_state_t>();
+    pose.epoch = server->epoch_;
+    pose.auth_seq = INT64_MAX - i;
+    lcm.publish(kPose, &pose);
+  }
+  Drain(&lcm);
+
+  EXPECT_EQ(device.rendered_.size(), 20u);  // nothing forged or replayed was accepted
+  EXPECT_EQ(device.model_filter_.rejected(Reason::kBadMac), 60u + 60u);  // + the replayed forgeries
+  EXPECT_EQ(device.model_filter_.rejected(Reason::kStaleSequence), 20u);
+  EXPECT_EQ(device.models_rejected(), 140u);
+  EXPECT_EQ(server->answered_, 20);
+  EXPECT_EQ(server->pose_filter_.rejected(Reason::kBadMac), 30u);
+  std::string line;
+  ASSERT_TRUE(device.model_filter_.TakeLogLine(0, &line));
+  EXPECT_NE(line.find("T_FORCE_MODEL: 140 rejected (bad MAC 120, replayed or old sequence number 20)"),
+            std::string::npos)
+      << line;
+
+  // The genuine exchange goes on.
+  for (int i = 0; i < 5; ++i) device.SendPose();
+  Drain(&lcm);
+  EXPECT_EQ(device.rendered_.size(), 25u);
+
+  // The server restarts (new epoch). Its first status moves the device over; the old
+  // session's status and models played back afterwards move nothing.
+  const std::vector<Bytes> old_statuses = log.statuses;
+  const std::vector<Bytes> old_models = log.models;
+  server.reset();
+  server = std::make_unique<Server>(&lcm, &key);
+  server->SendStatus();
+  Drain(&lcm);
+  ASSERT_EQ(device.status_filter_.epoch(), server->epoch_);
+  for (const Bytes& b : old_statuses) lcm.publish(kStatus, b.data(), static_cast<unsigned>(b.size()));
+  for (const Bytes& b : old_models) lcm.publish(kModel, b.data(), static_cast<unsigned>(b.size()));
+  Drain(&lcm);
+  EXPECT_EQ(device.status_filter_.epoch(), server->epoch_);
+  EXPECT_EQ(device.status_filter_.rejected(Reason::kStaleSequence), old_statuses.size());
+  EXPECT_EQ(device.rendered_.size(), 25u);
+  // The 45 genuine models of the old session (20 + 20 replayed + 5) and its status.
+  EXPECT_EQ(device.model_filter_.rejected(Reason::kForeignEpoch), 45u);
+  EXPECT_EQ(old_statuses.size(), 1u);
+  for (int i = 0; i < 5; ++i) device.SendPose();
+  Drain(&lcm);
+  EXPECT_EQ(device.rendered_.size(), 30u);
+}
+
+}  // namespace
+}  // namespace snapthread::auth

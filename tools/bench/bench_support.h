@@ -1,0 +1,30 @@
+// Helpers shared by the bench's charts (internal to tools/bench/).
+#pragma once
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "bench.h"
+
+namespace snapthread {
+
+using Clock = std::chrono::steady_clock;
+
+inline double Seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+inline std::string BudgetText(int budget) { return budget == 0 ? "inf" : std::to_string(budget); }
+
+std::string Sci(double v, int digits = 2);
+
+// Relative rms force error of a trace against a reference of the same rows.
+double RelativeRmsForceError(const std::vector<SweepRow>& trace, const std::vector<SweepRow>& ref, double scale);
+
+double ForceScaleOf(const Scene& scene);
+
+// Line colour of a method in the gnuplot charts.
+const char* MethodColor(Method m);
+
+}  // namespace snapthread

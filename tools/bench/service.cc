@@ -1,0 +1,227 @@
+// Service chart: pose -> force-model round trip of a real server + device pair.
+#include "bench_support.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "models/models.h"
+
+extern char** environ;
+
+namespace snapthread {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------- service
+
+bool JsonNumber(const std::string& json, const std::string& key, double* value) {
+  const std::string quoted = "\"" + key + "\"";
+  size_t p = json.find(quoted);
+  if (p == std::string::npos) return false;
+  p = json.find(':', p + quoted.size());
+  if (p == std::string::npos) return false;
+  const char* begin = json.c_str() + p + 1;
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  if (end == begin || !std::isfinite(v)) return false;
+  *value = v;
+  return true;
+}
+
+namespace {
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Starts argv[0] with stdout and stderr into `log`; returns the pid or -1.
+pid_t Spawn(const std::vector<std::string>& args, const std::string& log) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  return rc == 0 ? pid : -1;
+}
+
+// Waits for pid up to `timeout_s`; returns its exit status, or -1 after killing it.
+int WaitFor(pid_t pid, double timeout_s) {
+  const auto t0 = Clock::now();
+  while (true) {
+    int status = 0;
+    const pid_t r = waitpid(pid, &status, WNOHANG);
+    if (r == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    if (r < 0) return -1;
+    if (Seconds(t0, Clock::now()) > timeout_s) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+}  // namespace
+
+ServiceRun RunServiceOnce(const ServiceOptions& o, const std::string& scene, int index) {
+  ServiceRun run;
+  run.scene = scene;
+  const std::string server_bin = o.bin_dir + "/snapthread-server";
+  const std::string device_bin = o.bin_dir + "/snapthread-device";
+  for (const auto& b : {server_bin, device_bin})
+    if (access(b.c_str(), X_OK) != 0) {
+      run.error = b + " missing (build snapthread-server and snapthread-device)";
+      return run;
+    }
+  const std::string scene_file = o.scenes_dir + "/" + scene + ".yaml";
+  const std::string session = "BENCH_" + std::to_string(getpid()) + "_" + std::to_string(index);
+  fs::create_directories(o.work_dir);
+  const std::string base = o.work_dir + "/" + session;
+  char duration[32], safety[32];
+  std::snprintf(duration, sizeof duration, "%g", o.duration_s);
+  std::snprintf(safety, sizeof safety, "%g", o.duration_s + 60.0);  // a safety net only
+  const pid_t server =
+      Spawn({server_bin, "--scene", scene_file, "--session", session, "--lcm-url", o.lcm_url, "--duration", safety,
+             "--log-level", "info", "--summary", base + "_server.json"},
+            base + "_server.log");
+  if (server < 0) {
+    run.error = "cannot start the server";
+    return run;
+  }
+  // The server logs its session line once it has loaded the scene and subscribed.
+  bool up = false;
+  for (int k = 0; k < 300 && !up; ++k) {
+    up = ReadFile(base + "_server.log").find("server: session") != std::string::npos;
+    int status = 0;
+    if (!up && waitpid(server, &status, WNOHANG) == server) {
+      run.error = "the server exited at start (see " + base + "_server.log)";
+      return run;
+    }
+    if (!up) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (!up) {
+    kill(server, SIGTERM);
+    WaitFor(server, 10);
+    run.error = "the server did not start within 15 s (see " + base + "_server.log)";
+    return run;
+  }
+  const pid_t device =
+      Spawn({device_bin, "--backend", "virtual-hand", "--scene", scene_file, "--session", session, "--lcm-url",
+             o.lcm_url, "--duration", duration, "--rate-hz", "1000", "--publish-divisor", "1", "--no-rt",
+             "--summary", base + "_device.json"},
+            base + "_device.log");
+  int device_rc = device < 0 ? -1 : WaitFor(device, o.duration_s + 30.0);
+  kill(server, SIGTERM);
+  const int server_rc = WaitFor(server, 20.0);
+  if (device_rc != 0 || server_rc != 0) {
+    run.error = "device exit " + std::to_string(device_rc) + ", server exit " + std::to_string(server_rc) + " (logs " +
+                base + "_*.log)";
+    return run;
+  }
+  const std::string dev = ReadFile(base + "_device.json");
+  const std::string srv = ReadFile(base + "_server.json");
+  const bool ok = JsonNumber(dev, "round_trip_us_p50", &run.round_trip_us_p50) &&
+                  JsonNumber(dev, "round_trip_us_p99", &run.round_trip_us_p99) &&
+                  JsonNumber(dev, "lateness_us_p50", &run.lateness_us_p50) &&
+                  JsonNumber(dev, "lateness_us_p99", &run.lateness_us_p99) &&
+                  JsonNumber(dev, "tick_rate_hz", &run.tick_rate_hz);
+  if (!ok) {
+    run.error = "the device summary lacks round_trip_us_* / lateness_us_* (" + base + "_device.json)";
+    return run;
+  }
+  JsonNumber(srv, "update_rate_hz", &run.server_update_rate_hz);
+  JsonNumber(srv, "solve_us_p50", &run.server_solve_us_p50);
+  JsonNumber(srv, "solve_us_p99", &run.server_solve_us_p99);
+  run.ok = true;
+  return run;
+}
+
+std::vector<ServiceRun> RunServiceBench(const ServiceOptions& o, std::ostream* progress) {
+  std::vector<ServiceRun> runs;
+  int index = 0;
+  for (const auto& scene : o.scenes)
+    for (int rep = 0; rep < std::max(1, o.repetitions); ++rep) {
+      if (progress)
+        *progress << "bench service: " << scene << " run " << rep + 1 << "/" << o.repetitions << " (" << o.duration_s
+                  << " s)\n"
+                  << std::flush;
+      runs.push_back(RunServiceOnce(o, scene, index++));
+      if (progress && !runs.back().ok) *progress << "bench service: failed: " << runs.back().error << '\n';
+    }
+  return runs;
+}
+
+void WriteServiceCsv(const std::vector<ServiceRun>& runs, std::ostream& out) {
+  out << "scene,ok,round_trip_us_p50,round_trip_us_p99,lateness_us_p50,lateness_us_p99,tick_rate_hz,"
+         "server_update_rate_hz,server_solve_us_p50,server_solve_us_p99,error\n";
+  for (const auto& r : runs)
+    out << r.scene << ',' << (r.ok ? 1 : 0) << ',' << r.round_trip_us_p50 << ',' << r.round_trip_us_p99 << ','
+        << r.lateness_us_p50 << ',' << r.lateness_us_p99 << ',' << r.tick_rate_hz << ',' << r.server_update_rate_hz
+        << ',' << r.server_solve_us_p50 << ',' << r.server_solve_us_p99 << ",\"" << r.error << "\"\n";
+}
+
+void PrintServiceTable(const std::vector<ServiceRun>& runs, std::ostream& out) {
+  std::map<std::string, std::vector<const ServiceRun*>> by;
+  std::vector<std::string> order;
+  for (const auto& r : runs) {
+    if (!by.count(r.scene)) order.push_back(r.scene);
+    by[r.scene].push_back(&r);
+  }
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%-14s %5s %22s %22s %22s %22s %18s %18s %18s\n", "scene", "runs",
+                "round trip p50 us", "round trip p99 us", "lateness p50 us", "lateness p99 us", "tick Hz",
+                "server updates/s", "server solve p99 us");
+  out << buf << "  (median [min..max] over the runs)\n";
+  for (const auto& s : order) {
+    std::vector<double> a, b, c, d, e, f, g;
+    int ok = 0;
+    for (const ServiceRun* r : by[s]) {
+      if (!r->ok) continue;
+      ++ok;
+      a.push_back(r->round_trip_us_p50);
+      b.push_back(r->round_trip_us_p99);
+      c.push_back(r->lateness_us_p50);
+      d.push_back(r->lateness_us_p99);
+      e.push_back(r->tick_rate_hz);
+      f.push_back(r->server_update_rate_hz);
+      g.push_back(r->server_solve_us_p99);
+    }
+    auto cell = [](const std::vector<double>& v) {
+      const Spread sp = Summarize(v);
+      char t[64];
+      std::snprintf(t, sizeof t, "%.0f [%.0f..%.0f]", sp.median, sp.min, sp.max);
+      return std::string(t);
+    };
+    std::snprintf(buf, sizeof buf, "%-14s %2d/%-2zu %22s %22s %22s %22s %18s %18s %18s\n", s.c_str(), ok,
+                  by[s].size(), cell(a).c_str(), cell(b).c_str(), cell(c).c_str(), cell(d).c_str(), cell(e).c_str(),
+                  cell(f).c_str(), cell(g).c_str());
+    out << buf;
+  }
+}
+
+
+}  // namespace snapthread

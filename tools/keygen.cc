@@ -1,0 +1,49 @@
+// snapthread-keygen: makes the session key (32 random bytes, mode 0600) and says how to
+// copy it to the second machine (docs/security.md). Refuses to replace a key without
+// --force: every machine of the session holds a copy and would stop being trusted.
+#include <cstdio>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "auth/key_file.h"
+
+int main(int argc, char** argv) {
+  using namespace snapthread::auth;
+  CLI::App app{"snapthread-keygen: make the session key shared by the server, device and viewers"};
+  std::string key_path, host = "LAB_PC";
+  bool force = false, show_id = false;
+  app.add_option("--key", key_path,
+                 "key file (default: $SNAPTHREAD_KEY_FILE, else "
+                 "$XDG_CONFIG_HOME/snapthread/session.key or ~/.config/snapthread/session.key)");
+  app.add_flag("--force", force, "replace an existing key (copy the new one to every machine)");
+  app.add_flag("--id", show_id, "check the existing key and print its id (compare on both machines)");
+  app.add_option("--host", host, "ssh name of the other machine, for the printed scp command");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  try {
+    const KeyLocation where = ResolveKeyPath(key_path);
+    if (show_id) {
+      std::printf("%s: key id %s (%s)\n", where.path.c_str(), LoadKey(where).Id().c_str(),
+                  where.origin.c_str());
+      return 0;
+    }
+    WriteNewKey(where, force);
+    const std::string id = LoadKey(where).Id();  // reads it back: mode and size as checked
+    std::printf("snapthread-keygen: wrote a new session key to %s (mode 0600, key id %s)\n",
+                where.path.c_str(), id.c_str());
+    std::printf("Copy it to the other machine (scp -p keeps mode 0600):\n");
+    std::printf("  ssh %s 'mkdir -p -m 700 ~/.config/snapthread'\n", host.c_str());
+    std::printf("  scp -p %s %s:.config/snapthread/session.key\n", where.path.c_str(), host.c_str());
+    std::printf("Check the copy: ssh %s snapthread-keygen --id   (must print key id %s)\n",
+                host.c_str(), id.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-keygen: %s\n", e.what());
+    return 1;
+  }
+}
