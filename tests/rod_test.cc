@@ -337,6 +337,37 @@ TEST(RodModel, EnergyIsInvariantUnderRigidMotion) {
   }
 }
 
+
+// The torque convention of rod_model.h: the world torque on the hand, -dE/dδ for a small
+// rotation exp([δ]×) applied to the grasp orientation, is -J_l(φ)^{-T} E_φ (and -E_φ at φ = 0).
+TEST(RodModel, TorqueIsTheConvertedRotationGradient) {
+  std::mt19937 rng(11);
+  RodModel model(BentParams(6));
+  const RandomState s = RandomBentState(&model, &rng);
+  Vec eu;
+  model.ControlGradient(s.x, s.u, &eu);
+  const V3 phi = s.u.segment<3>(3);
+  const double a = phi.norm();
+  const M3 k = rod::Cross(phi);
+  const M3 jl = M3::Identity() + (1.0 - std::cos(a)) / (a * a) * k +
+                (a - std::sin(a)) / (a * a * a) * k * k;
+  const V3 torque = -jl.transpose().inverse() * eu.segment<3>(3);
+  const M3 r = rod::ExpMap(phi);
+  const double h = 1e-6;
+  for (int c = 0; c < 3; ++c) {
+    double e[2];
+    for (int side = 0; side < 2; ++side) {
+      const V3 delta = (side == 0 ? h : -h) * V3::Unit(c);
+      const Eigen::AngleAxisd rotated(rod::ExpMap(delta) * r);
+      Vec u = s.u;
+      u.segment<3>(3) = rotated.angle() * rotated.axis();
+      e[side] = model.Energy(s.x, u);
+    }
+    EXPECT_NEAR(torque[c], -(e[0] - e[1]) / (2 * h), 1e-6 * std::max(1.0, torque.norm()));
+  }
+  EXPECT_GT(torque.norm(), 1e-2);
+}
+
 // Accepting a state moves the reference frames without changing the energy there, and an
 // equilibrium stays one (the energy of the physical rod does not depend on the frames).
 TEST(RodModel, AcceptStateKeepsEnergyAndEquilibria) {
