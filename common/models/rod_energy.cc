@@ -56,15 +56,15 @@ double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
   const FrameSource* src[2] = {&s0, &s1};
   const double th[2] = {theta0, theta1};
   double l[2];
-  V3 t[2], m1[2], m2[2];
+  V3 t[2], a[2], m1[2], m2[2];
   for (int j = 0; j < 2; ++j) {
     l[j] = e[j].norm();
     t[j] = e[j] / l[j];
-    V3 a, b;
-    ReferenceFrame(*src[j], t[j], &a, &b);
+    V3 b;
+    ReferenceFrame(*src[j], t[j], &a[j], &b);
     const double c = std::cos(th[j]), s = std::sin(th[j]);
-    m1[j] = c * a + s * b;
-    m2[j] = -s * a + c * b;
+    m1[j] = c * a[j] + s * b;
+    m2[j] = -s * a[j] + c * b;
   }
   const double chi = l[0] * l[1] + e0.dot(e1);
   const V3 kb = (2.0 / chi) * e0.cross(e1);  // [DER (1)]
@@ -76,10 +76,7 @@ double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
     r2[j] = -kb.dot(m1[j]) - k.kappa2_bar;
     bend += k.c1 * r1[j] * r1[j] + k.c2 * r2[j] * r2[j];
   }
-  V3 a0, b0, a1, b1;
-  ReferenceFrame(s0, t[0], &a0, &b0);
-  ReferenceFrame(s1, t[1], &a1, &b1);
-  const double mref = AngleAbout(t[1], Transport(t[0], t[1], a0), a1, twist_near);
+  const double mref = AngleAbout(t[1], Transport(t[0], t[1], a[0]), a[1], twist_near);
   const double tau = theta1 - theta0 + mref;
   // Bending: the mean of the two edges' energies [DER (4)]; twist [DVT (4)].
   const double energy = 0.25 * bend + 0.5 * k.ct * tau * tau;
