@@ -40,3 +40,20 @@ function(snapthread_project_code target)
     set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   endif()
 endfunction()
+
+# snapthread_library(NAME SOURCES a.cc ... [PUBLIC libs...] [PRIVATE libs...]): a static
+# library of this project, snapthread_NAME with the alias snapthread::NAME, whose folder
+# is its public include directory, built with the project's warnings.
+function(snapthread_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC;PRIVATE" ${ARGN})
+  add_library(snapthread_${name} STATIC ${ARG_SOURCES})
+  add_library(snapthread::${name} ALIAS snapthread_${name})
+  target_include_directories(snapthread_${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
+  if(ARG_PUBLIC)
+    target_link_libraries(snapthread_${name} PUBLIC ${ARG_PUBLIC})
+  endif()
+  if(ARG_PRIVATE)
+    target_link_libraries(snapthread_${name} PRIVATE ${ARG_PRIVATE})
+  endif()
+  snapthread_project_code(snapthread_${name})
+endfunction()

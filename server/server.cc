@@ -6,11 +6,13 @@
 #include <cstdio>
 #include <exception>
 #include <utility>
+#include <vector>
 
 #include <spdlog/spdlog.h>
 
 #include "messages/pose_mapping.h"
 #include "server_messages.h"
+#include "server_session.h"
 #include "models/models.h"
 #include "realtime/clock.h"
 #include "messages/lcm_url.h"
@@ -53,13 +55,6 @@ SteadyClock::duration Period(double rate_hz) {
 }
 
 }  // namespace
-
-struct Server::Session {
-  Scene scene;
-  std::unique_ptr<EquilibriumTracker> tracker;
-  // The grip direction of a device at rest (pose_mapping.h).
-  Eigen::Vector3d rest_direction = Eigen::Vector3d::UnitX();
-};
 
 Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
     : params_(params), hooks_(std::move(hooks)) {
@@ -300,74 +295,6 @@ void Server::SolveAndPublish(const PoseSample& pose) {
   if (lcm_->publish(channels_.force_model, &msg) != 0) publish_failures_.fetch_add(1);
 }
 
-void Server::ApplyCommand(const command_t& command) {
-  std::string message;
-  bool ok = true;
-  switch (command.command) {
-    case command_t::RESET: {
-      try {
-        session_->tracker->Reset(session_->scene.grasp_start);
-        message = "RESET: back to the start of scene '" + session_->scene.name + "'";
-      } catch (const std::exception& e) {
-        ok = false;
-        message = std::string("RESET failed: ") + e.what();
-      }
-      break;
-    }
-    case command_t::LOAD_SCENE: {
-      try {
-        std::unique_ptr<Session> next = MakeSession(LoadScene(command.argument));
-        session_ = std::move(next);
-        message = "LOAD_SCENE: now scene '" + session_->scene.name + "' (" + command.argument + ")";
-      } catch (const std::exception& e) {
-        ok = false;
-        message = "LOAD_SCENE refused, keeping scene '" + session_->scene.name + "': " + e.what();
-      }
-      break;
-    }
-    case command_t::SET_METHOD: {
-      Method m;
-      if (!ParseMethod(command.argument, &m)) {
-        ok = false;
-        message = "SET_METHOD refused: unknown method '" + command.argument +
-                  "' (expected newton, newton-ls or higher-order)";
-        break;
-      }
-      try {
-        SolverOptions options = session_->tracker->options();
-        options.method = m;
-        session_->tracker->SetOptions(options);
-        session_->scene.solver = options;
-        method_override_ = command.argument;
-        message = std::string("SET_METHOD: now ") + ToString(m);
-      } catch (const std::exception& e) {
-        ok = false;
-        message = std::string("SET_METHOD failed: ") + e.what();
-      }
-      break;
-    }
-    default:
-      ok = false;
-      message = "unknown command " + std::to_string(command.command);
-  }
-  // The message first, then the counters: a caller that waits on a counter reads the
-  // message of that command.
-  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), &message);
-  if (ok) {
-    // A new start: the shape's snap count is "since the session (re)started".
-    if (command.command != command_t::SET_METHOD) {
-      snaps_since_reset_ = 0;
-      last_status_ = force_model_t::STATUS_REGULAR;
-      for (double& f : last_force_n_) f = 0.0;
-    }
-    spdlog::info("server: {}", message);
-    commands_applied_.fetch_add(1);
-  } else {
-    spdlog::warn("server: {}", message);
-    commands_refused_.fetch_add(1);
-  }
-}
-
 void Server::PublishShape() {
   const EquilibriumTracker& tracker = *session_->tracker;
   ShapeInputs in;
@@ -454,42 +381,60 @@ ServerStats Server::Stats() const {
   return s;
 }
 
-std::string Server::SummaryJson() const {
-  const ServerStats s = Stats();
-  char buf[1024];
-  std::snprintf(buf, sizeof(buf),
-                "{\n  \"updates\": %lld,\n  \"update_rate_hz\": %.3f,\n  \"solve_us_p50\": %.3f,\n"
-                "  \"solve_us_p99\": %.3f,\n  \"snaps\": %lld,\n  \"dropped_poses\": %lld,\n"
-                "  \"rejected_messages\": %lld,\n  \"poses_received\": %lld,\n"
-                "  \"invalid_models\": %lld,\n  \"commands_applied\": %lld,\n"
-                "  \"commands_refused\": %lld,\n  \"shapes_published\": %lld,\n"
-                "  \"statuses_published\": %lld,\n  \"publish_failures\": %lld\n}\n",
-                static_cast<long long>(s.updates), s.update_rate_hz, s.solve_us_p50,
-                s.solve_us_p99, static_cast<long long>(s.snaps),
-                static_cast<long long>(s.dropped_poses),
-                static_cast<long long>(s.rejected_messages),
-                static_cast<long long>(s.poses_received),
-                static_cast<long long>(s.invalid_models),
-                static_cast<long long>(s.commands_applied),
-                static_cast<long long>(s.commands_refused),
-                static_cast<long long>(s.shapes_published),
-                static_cast<long long>(s.statuses_published),
-                static_cast<long long>(s.publish_failures));
+namespace {
+
+// One figure of the end-of-run summary; counts print as integers.
+struct Figure {
+  const char* key;
+  double value;
+  bool count;
+  bool in_final_line;  // also on the final log line
+};
+
+std::vector<Figure> Figures(const ServerStats& s) {
+  auto n = [](int64_t v) { return static_cast<double>(v); };
+  return {{"updates", n(s.updates), true, true},
+          {"update_rate_hz", s.update_rate_hz, false, true},
+          {"solve_us_p50", s.solve_us_p50, false, true},
+          {"solve_us_p99", s.solve_us_p99, false, true},
+          {"snaps", n(s.snaps), true, true},
+          {"dropped_poses", n(s.dropped_poses), true, true},
+          {"rejected_messages", n(s.rejected_messages), true, true},
+          {"poses_received", n(s.poses_received), true, false},
+          {"invalid_models", n(s.invalid_models), true, true},
+          {"commands_applied", n(s.commands_applied), true, false},
+          {"commands_refused", n(s.commands_refused), true, false},
+          {"shapes_published", n(s.shapes_published), true, false},
+          {"statuses_published", n(s.statuses_published), true, false},
+          {"publish_failures", n(s.publish_failures), true, false}};
+}
+
+std::string FigureText(const Figure& f, int decimals) {
+  char buf[64];
+  if (f.count)
+    std::snprintf(buf, sizeof(buf), "%lld", static_cast<long long>(f.value));
+  else
+    std::snprintf(buf, sizeof(buf), "%.*f", decimals, f.value);
   return buf;
 }
 
+}  // namespace
+
+std::string Server::SummaryJson() const {
+  std::string json = "{\n";
+  const std::vector<Figure> figures = Figures(Stats());
+  for (size_t i = 0; i < figures.size(); ++i) {
+    json += std::string("  \"") + figures[i].key + "\": " + FigureText(figures[i], 3);
+    json += i + 1 < figures.size() ? ",\n" : "\n";
+  }
+  return json + "}\n";
+}
+
 std::string Server::FinalReport() const {
-  const ServerStats s = Stats();
-  char buf[512];
-  std::snprintf(buf, sizeof(buf),
-                "final: updates=%lld update_rate_hz=%.1f solve_us_p50=%.1f solve_us_p99=%.1f "
-                "snaps=%lld dropped_poses=%lld rejected_messages=%lld invalid_models=%lld",
-                static_cast<long long>(s.updates), s.update_rate_hz, s.solve_us_p50,
-                s.solve_us_p99, static_cast<long long>(s.snaps),
-                static_cast<long long>(s.dropped_poses),
-                static_cast<long long>(s.rejected_messages),
-                static_cast<long long>(s.invalid_models));
-  return buf;
+  std::string line = "final:";
+  for (const Figure& f : Figures(Stats()))
+    if (f.in_final_line) line += std::string(" ") + f.key + "=" + FigureText(f, 1);
+  return line;
 }
 
 }  // namespace snapthread::server

@@ -16,9 +16,10 @@
 namespace snapthread {
 namespace {
 
-ModelParams Curve2dParams(int n, double l, double beta, double gamma) {
+// A chain model of n segments of length l, bending beta and stretching gamma.
+ModelParams ChainParams(const std::string& model, int n, double l, double beta, double gamma) {
   ModelParams p;
-  p.model = "curve2d";
+  p.model = model;
   p.n = n;
   p.segment_length = l;
   p.bending = beta;
@@ -26,14 +27,10 @@ ModelParams Curve2dParams(int n, double l, double beta, double gamma) {
   return p;
 }
 
+ModelParams Curve2dParams(int n, double l, double beta, double gamma) { return ChainParams("curve2d", n, l, beta, gamma); }
+
 ModelParams Thread3dParams(int n, double l, double beta, double gamma) {
-  ModelParams p;
-  p.model = "thread3d";
-  p.n = n;
-  p.segment_length = l;
-  p.bending = beta;
-  p.stretching = gamma;
-  return p;
+  return ChainParams("thread3d", n, l, beta, gamma);
 }
 
 // Index of coordinate k of node i (2 <= i <= n-1) in each model's state vector.

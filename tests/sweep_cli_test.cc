@@ -1,11 +1,9 @@
 // snapthread-sweep as a user runs it: CSV contract, --back, bad arguments.
-#include <cstdio>
-#include <fstream>
 #include <sstream>
-#include <sys/wait.h>
 
 #include <gtest/gtest.h>
 
+#include "test_support.h"
 #include "test_util.h"
 
 namespace snapthread {
@@ -16,14 +14,14 @@ struct CliRun {
   std::string out;
 };
 
+// Runs snapthread-sweep through the shell (stdout and stderr together), with a deadline.
 CliRun Sweep(const std::string& args) {
-  const std::string cmd = testing::BinDir() + "/snapthread-sweep " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+  const test_support::ScopedTempDir dir("sweep_cli");
+  test_support::ChildProcess sweep({"/bin/sh", "-c", testing::BinDir() + "/snapthread-sweep " + args},
+                                   test_support::OneLog(dir.path() + "/out.txt"));
+  int code = -1;
+  sweep.WaitOrKill(120.0, &code);
+  return {code, sweep.Out()};
 }
 
 std::string Scene(const std::string& f) { return testing::SourceDir() + "/scenes/" + f; }

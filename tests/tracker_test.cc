@@ -35,23 +35,24 @@ std::vector<Case> RegularCases() {
   return cases;
 }
 
-// Equilibrium force at u, solved tightly from the warm start x.
-Vec ForceAt(const Model& model, const Vec& u, Vec x) {
+// Newton with line search to ||E_x|| < 1e-12, no iteration cap.
+SolverOptions TightOptions() {
   SolverOptions o;
   o.method = Method::kNewtonLineSearch;
   o.cutoff = 1e-12;
   o.max_iterations = 0;
-  MakeSolver(model, o)->Solve(u, &x);
+  return o;
+}
+
+// Equilibrium force at u, solved tightly from the warm start x.
+Vec ForceAt(const Model& model, const Vec& u, Vec x) {
+  MakeSolver(model, TightOptions())->Solve(u, &x);
   Vec eu;
   model.ControlGradient(x, u, &eu);
   return -eu;
 }
 double EnergyAt(const Model& model, const Vec& u, Vec x) {
-  SolverOptions o;
-  o.method = Method::kNewtonLineSearch;
-  o.cutoff = 1e-12;
-  o.max_iterations = 0;
-  MakeSolver(model, o)->Solve(u, &x);
+  MakeSolver(model, TightOptions())->Solve(u, &x);
   return model.Energy(x, u);
 }
 

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "auth/key_file.h"
+#include "tool_main.h"
 
 int main(int argc, char** argv) {
   using namespace snapthread::auth;
@@ -19,13 +20,7 @@ int main(int argc, char** argv) {
   app.add_flag("--force", force, "replace an existing key (copy the new one to every machine)");
   app.add_flag("--id", show_id, "check the existing key and print its id (compare on both machines)");
   app.add_option("--host", host, "ssh name of the other machine, for the printed scp command");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
-  try {
+  const auto run = [&]() -> int {
     const KeyLocation where = ResolveKeyPath(key_path);
     if (show_id) {
       std::printf("%s: key id %s (%s)\n", where.path.c_str(), LoadKey(where).Id().c_str(),
@@ -42,8 +37,9 @@ int main(int argc, char** argv) {
     std::printf("Check the copy: ssh %s snapthread-keygen --id   (must print key id %s)\n",
                 host.c_str(), id.c_str());
     return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "snapthread-keygen: %s\n", e.what());
-    return 1;
-  }
+  };
+  // Every error exits 1 (a bad key file is not a bad argument).
+  snapthread::ToolExitCodes codes;
+  codes.invalid_argument_is_bad_input = false;
+  return snapthread::RunTool("snapthread-keygen", app, argc, argv, run, codes);
 }

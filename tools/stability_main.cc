@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "stability.h"
+#include "tool_main.h"
 
 namespace fs = std::filesystem;
 using namespace snapthread;
@@ -147,13 +148,7 @@ int main(int argc, char** argv) {
   app.add_option("--substeps", substeps, "reference: fine steps per row")->check(CLI::Range(1, 1000));
   app.add_option("--plot-budget", plot_budget, "budget whose traces are charted (0 = unlimited)");
   app.add_flag("--no-plot", no_plot, "skip the gnuplot chart");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
-  try {
+  return RunTool("snapthread-stability", app, argc, argv, [&]() -> int {
     const std::vector<int> budgets = ParseInts(budgets_text, "--budgets");
     std::vector<StandardSweep> sweeps = StandardSweeps(scenes_dir);
     if (!only.empty()) {
@@ -217,12 +212,6 @@ int main(int argc, char** argv) {
       }
       std::cerr << "stability: chart " << (fs::path(out_dir) / "stability.png").string() << '\n';
     }
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "snapthread-stability: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "snapthread-stability: " << e.what() << '\n';
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

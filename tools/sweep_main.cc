@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "sweep.h"
+#include "tool_main.h"
 
 int main(int argc, char** argv) {
   using namespace snapthread;
@@ -30,13 +31,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-iterations", max_iterations, "iteration budget per step, 0 = unlimited");
   app.add_option("--set", sets, "override a scene key, e.g. --set params.n=20 (repeatable)");
   app.add_option("--out", out_file, "CSV output file (default: standard output)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
-  try {
+  const auto run = [&]() -> int {
     std::vector<SceneOverride> overrides;
     for (const auto& s : sets) overrides.push_back(ParseOverride(s));
     Scene scene = LoadScene(scene_file, overrides);
@@ -74,15 +69,9 @@ int main(int argc, char** argv) {
       if (!out) throw std::runtime_error("--out: cannot write '" + out_file + "'");
       WriteSweepCsv(rows, scene.solver.method, out);
     }
-  } catch (const SceneError& e) {
-    std::cerr << "snapthread-sweep: " << e.what() << '\n';
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "snapthread-sweep: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "snapthread-sweep: " << e.what() << '\n';
-    return 1;
-  }
-  return 0;
+    return 0;
+  };
+  ToolExitCodes codes;
+  codes.scene_error_is_bad_input = true;
+  return RunTool("snapthread-sweep", app, argc, argv, run, codes);
 }

@@ -45,16 +45,24 @@ void main() {
 constexpr int kSplineSamplesPerSegment = 8;
 constexpr int kTubeSides = 14;
 
+// False with "<what> failed: <info log>" in *error when the object's status is not set;
+// `get_iv` / `get_log` are the GL getters of the object's kind (shader or program).
+template <typename GetIv, typename GetLog>
+bool StatusOk(GLuint object, GLenum status, GetIv get_iv, GetLog get_log, const char* what, std::string* error) {
+  GLint ok = 0;
+  get_iv(object, status, &ok);
+  if (ok) return true;
+  char log[2048] = {0};
+  get_log(object, sizeof log, nullptr, log);
+  *error = std::string(what) + " failed: " + log;
+  return false;
+}
+
 GLuint Compile(GLenum type, const char* source, std::string* error) {
   const GLuint shader = glCreateShader(type);
   glShaderSource(shader, 1, &source, nullptr);
   glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {0};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    *error = std::string("shader compile failed: ") + log;
+  if (!StatusOk(shader, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog, "shader compile", error)) {
     glDeleteShader(shader);
     return 0;
   }
@@ -106,14 +114,7 @@ bool Renderer::Init(std::string* error) {
   glLinkProgram(program_);
   glDeleteShader(vs);
   glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {0};
-    glGetProgramInfoLog(program_, sizeof log, nullptr, log);
-    *error = std::string("shader link failed: ") + log;
-    return false;
-  }
+  if (!StatusOk(program_, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog, "shader link", error)) return false;
   mvp_location_ = glGetUniformLocation(program_, "u_mvp");
   light_location_ = glGetUniformLocation(program_, "u_light_dir");
   glGenVertexArrays(1, &vao_);

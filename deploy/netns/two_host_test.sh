@@ -50,14 +50,8 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# lcm-logger closes its log on SIGINT; never wait for it forever.
-stop_logger() {
-  kill -INT "$1" 2>/dev/null
-  for _ in $(seq 50); do kill -0 "$1" 2>/dev/null || break; sleep 0.1; done
-  kill -KILL "$1" 2>/dev/null
-  wait "$1" 2>/dev/null
-}
-fail() { echo "FAIL: $*"; echo "--- outputs in $work"; for f in "$work"/*.txt; do echo "== $f"; tail -n 15 "$f"; done; exit 1; }
+# stop_logger, fail, json, run_session
+source "$(dirname "$0")/../../tests/support/script_support.sh"
 
 # Namespaces left by an earlier run of this script that was killed before its trap ran
 # (their names end in the pid of that run, which is gone).
@@ -108,13 +102,7 @@ ip netns exec "$ns_obs" xvfb-run -a -n $((100 + tag % 800)) -s "-screen 0 640x48
     --timeout-s $((duration + 10)) --width 640 --height 480 > "$work/observer_viewer.txt" 2>&1 &
 viewer_pid=$!
 sleep 0.5
-ip netns exec "$ns_srv" "$bin/snapthread-server" --scene "$scene" --session "$session" --lcm-url "$url" \
-    --duration $((duration + 2)) --summary "$work/server.json" > "$work/server.txt" 2>&1 &
-server_pid=$!
-sleep 0.5
-ip netns exec "$ns_dev" "$bin/snapthread-device" --backend virtual-hand --scene "$scene" --session "$session" \
-    --lcm-url "$url" --duration "$duration" --no-rt --summary "$work/device.json" > "$work/device.txt" 2>&1
-device_rc=$?
+run_session "ip netns exec $ns_srv" "ip netns exec $ns_dev"
 wait "$server_pid"; server_rc=$?
 wait "$viewer_pid"; viewer_rc=$?
 wait "$rates_pid"; rates_rc=$?
@@ -122,7 +110,6 @@ stop_logger "$logger_pid"
 
 [ $device_rc -eq 0 ] || fail "device exited $device_rc"
 [ $server_rc -eq 0 ] || fail "server exited $server_rc"
-json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))$2)" "$1"; }
 models=$(json "$work/device.json" "['models_received']") || fail "no models_received in device.json"
 [ "$models" -gt 0 ] || fail "device received no force models across namespaces"
 echo "device ($ns_dev) received $models force models from the server ($ns_srv)"

@@ -9,11 +9,7 @@
 // no non-finite output).
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -35,105 +31,30 @@
 
 #include "messages/channels.h"
 #include "messages/validate.h"
-
-extern char** environ;
+#include "test_support.h"
 
 namespace snapthread::device {
 namespace {
 
-constexpr const char* kUrl = "udpm://239.255.76.67:7667?ttl=0";
+constexpr const char* kUrl = test_support::kLoopbackLcmUrl;
 constexpr double kSpringNPerM = 40.0;
 constexpr double kNegativeStiffnessNPerM = 25.0;
 
-std::string UniqueSession(const std::string& tag) {
-  static std::atomic<int> counter{0};
-  return "DEVTEST_" + tag + "_" + std::to_string(getpid()) + "_" + std::to_string(counter++) +
-         "_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count() % 100000);
-}
+using test_support::ReadFile;
+using test_support::UniqueSession;
 
-std::string TempDir() {
-  char tmpl[] = "/tmp/snapthread_device_test_XXXXXX";
-  const char* d = mkdtemp(tmpl);
-  EXPECT_NE(d, nullptr);
-  return d ? d : "/tmp";
-}
+std::string DeviceBinary() { return test_support::BinDir() + "/snapthread-device"; }
 
-// A temporary directory, removed at the end of a passing test (kept for a failing one).
-struct ScopedDir {
-  ScopedDir() : path(TempDir()) {}
-  ~ScopedDir() {
-    if (!::testing::Test::HasFailure() && path.rfind("/tmp/snapthread_device_test_", 0) == 0) {
-      std::error_code ec;
-      std::filesystem::remove_all(path, ec);
-    }
-  }
-  std::string path;
-};
-
-std::string DeviceBinary() {
-  const char* bin = std::getenv("SNAPTHREAD_BIN_DIR");
-  return bin ? std::string(bin) + "/snapthread-device" : std::string();
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// A child process with stdout/stderr in files.
-class Process {
+// A child process with stdout/stderr in <prefix>.out / <prefix>.err.
+class Process : public test_support::ChildProcess {
  public:
-  Process(const std::vector<std::string>& args, const std::string& out_prefix)
-      : out_(out_prefix + ".out"), err_(out_prefix + ".err") {
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&fa, 2, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int rc = posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&fa);
-    if (rc != 0) pid_ = -1;
+  Process(const std::vector<std::string>& args, const std::string& prefix)
+      : ChildProcess(args, test_support::OutputFiles(prefix + ".out", prefix + ".err")) {}
+  // Exit code, or -1 on a timeout (then the process is killed).
+  int ExitCode(double timeout_s) {
+    int code = -1;
+    return WaitOrKill(timeout_s, &code) ? code : -1;
   }
-  ~Process() {
-    if (pid_ > 0 && !exited_) {
-      kill(pid_, SIGKILL);
-      int status;
-      waitpid(pid_, &status, 0);
-    }
-  }
-  bool started() const { return pid_ > 0; }
-  void Signal(int sig) {
-    if (pid_ > 0 && !exited_) kill(pid_, sig);
-  }
-  // Exit code, or -1 on a timeout (then the process is killed) or a signal death.
-  int Wait(double timeout_s) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (std::chrono::steady_clock::now() < deadline) {
-      int status = 0;
-      const pid_t r = waitpid(pid_, &status, WNOHANG);
-      if (r == pid_) {
-        exited_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    kill(pid_, SIGKILL);
-    int status;
-    waitpid(pid_, &status, 0);
-    exited_ = true;
-    return -1;
-  }
-  std::string out() const { return ReadFile(out_); }
-  std::string err() const { return ReadFile(err_); }
-
- private:
-  pid_t pid_ = -1;
-  bool exited_ = false;
-  std::string out_, err_;
 };
 
 // "key": number from the summary JSON (NaN when absent).
@@ -233,9 +154,9 @@ void SleepUntil(std::chrono::steady_clock::time_point t0, double s) {
 TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   const std::string bin = DeviceBinary();
   ASSERT_FALSE(bin.empty()) << "SNAPTHREAD_BIN_DIR not set (run through ctest)";
-  const ScopedDir scoped;
-  const std::string& dir = scoped.path;
-  const std::string session = UniqueSession("SPRING");
+  const test_support::ScopedTempDir scoped("device_test");
+  const std::string& dir = scoped.path();
+  const std::string session = UniqueSession("DEVTEST_SPRING");
   const std::string scene = WriteScene(dir);
   const transport::Channels channels(session);
 
@@ -310,10 +231,10 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
     Pace();
   }
 
-  const int code = device.Wait(duration_s + 20.0);
+  const int code = device.ExitCode(duration_s + 20.0);
   const int poses_second = server->poses();
   server.reset();
-  ASSERT_EQ(code, 0) << device.err();
+  ASSERT_EQ(code, 0) << device.Err();
 
   const std::string summary = ReadFile(dir + "/summary.json");
   ASSERT_FALSE(summary.empty());
@@ -463,9 +384,9 @@ class Listener {
 TEST(DeviceProcessTest, SigtermStopsCleanlyAndPublishesPosesAndStatus) {
   const std::string bin = DeviceBinary();
   ASSERT_FALSE(bin.empty());
-  const ScopedDir scoped;
-  const std::string& dir = scoped.path;
-  const std::string session = UniqueSession("TERM");
+  const test_support::ScopedTempDir scoped("device_test");
+  const std::string& dir = scoped.path();
+  const std::string session = UniqueSession("DEVTEST_TERM");
   Listener listener(session);
   ASSERT_TRUE(listener.good());
   Process device({bin, "--backend", "virtual-hand", "--scene", WriteScene(dir), "--session",
@@ -475,7 +396,7 @@ TEST(DeviceProcessTest, SigtermStopsCleanlyAndPublishesPosesAndStatus) {
   ASSERT_TRUE(device.started());
   std::this_thread::sleep_for(std::chrono::milliseconds(2500));
   device.Signal(SIGTERM);
-  ASSERT_EQ(device.Wait(10.0), 0) << device.err();
+  ASSERT_EQ(device.ExitCode(10.0), 0) << device.Err();
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   listener.Stop();
   const std::string summary = ReadFile(dir + "/summary.json");
@@ -502,8 +423,8 @@ TEST(DeviceProcessTest, SigtermStopsCleanlyAndPublishesPosesAndStatus) {
 TEST(DeviceProcessTest, BadArgumentsExitTwoNamingTheArgument) {
   const std::string bin = DeviceBinary();
   ASSERT_FALSE(bin.empty());
-  const ScopedDir scoped;
-  const std::string& dir = scoped.path;
+  const test_support::ScopedTempDir scoped("device_test");
+  const std::string& dir = scoped.path();
   const std::string scene = WriteScene(dir);
   struct Case {
     std::vector<std::string> args;
@@ -524,8 +445,8 @@ TEST(DeviceProcessTest, BadArgumentsExitTwoNamingTheArgument) {
     args.insert(args.end(), c.args.begin(), c.args.end());
     Process p(args, dir + "/bad");
     ASSERT_TRUE(p.started());
-    EXPECT_EQ(p.Wait(10.0), 2) << c.args[0] << " " << c.args[1];
-    const std::string msg = p.err() + p.out();
+    EXPECT_EQ(p.ExitCode(10.0), 2) << c.args[0] << " " << c.args[1];
+    const std::string msg = p.Err() + p.Out();
     EXPECT_NE(msg.find(c.mention), std::string::npos) << msg;
   }
 }
@@ -533,15 +454,15 @@ TEST(DeviceProcessTest, BadArgumentsExitTwoNamingTheArgument) {
 TEST(DeviceProcessTest, LcmFailureExitsOneWithUrlAndHint) {
   const std::string bin = DeviceBinary();
   ASSERT_FALSE(bin.empty());
-  const ScopedDir scoped;
-  const std::string& dir = scoped.path;
+  const test_support::ScopedTempDir scoped("device_test");
+  const std::string& dir = scoped.path();
   const std::string url = "udpm://239.255.76.67:99999999?ttl=0";
   Process p({bin, "--backend", "sim-path", "--scene", WriteScene(dir), "--lcm-url", url, "--no-rt",
              "--duration", "1"},
             dir + "/lcmfail");
   ASSERT_TRUE(p.started());
-  EXPECT_EQ(p.Wait(10.0), 1);
-  const std::string err = p.err();
+  EXPECT_EQ(p.ExitCode(10.0), 1);
+  const std::string err = p.Err();
   EXPECT_NE(err.find(url), std::string::npos) << err;
   EXPECT_NE(err.find("ip route add 224.0.0.0/4 dev lo"), std::string::npos) << err;
 }

@@ -2,11 +2,7 @@
 // on loopback (ttl=0), one unique session per test. The machine is shared (2 cores, other
 // builds and tests running): timeouts are generous and assertions are on distributions
 // over thousands of servo ticks, never on single timings.
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -30,8 +26,7 @@
 #include "models/models.h"
 #include "scene/scene.h"
 #include "tracking/tracker.h"
-
-extern char** environ;
+#include "test_support.h"
 
 namespace snapthread::server {
 namespace {
@@ -40,82 +35,11 @@ using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-constexpr const char* kUrl = "udpm://239.255.76.67:7667?ttl=0";
+constexpr const char* kUrl = test_support::kLoopbackLcmUrl;
+using test_support::ChildProcess;
 
-std::string Env(const char* name) {
-  const char* v = std::getenv(name);
-  return v != nullptr ? v : "";
-}
-
-// A child process with stdout+stderr in a log file; killed (SIGKILL) if still running
-// when the handle goes away, so a failing test never leaks processes.
-class Child {
- public:
-  Child(const std::vector<std::string>& argv, const std::string& log_path) : log_(log_path) {
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, 1, 2);
-    posix_spawn_file_actions_addclose(&actions, 0);
-    const int rc = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) pid_ = -1;
-  }
-  ~Child() {
-    if (running()) {
-      kill(pid_, SIGKILL);
-      int status;
-      waitpid(pid_, &status, 0);
-    }
-  }
-  bool started() const { return pid_ > 0; }
-  bool running() const { return pid_ > 0 && !exited_; }
-  void Signal(int sig) {
-    if (running()) kill(pid_, sig);
-  }
-  // Waits for the exit; true with *code (exit status, or 128 + signal) when it exited.
-  bool Wait(std::chrono::seconds timeout, int* code) {
-    const auto deadline = Clock::now() + timeout;
-    while (!exited_) {
-      int status = 0;
-      const pid_t r = waitpid(pid_, &status, WNOHANG);
-      if (r == pid_) {
-        exited_ = true;
-        code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        break;
-      }
-      if (Clock::now() > deadline) return false;
-      std::this_thread::sleep_for(10ms);
-    }
-    if (code) *code = code_;
-    return true;
-  }
-  std::string Log() const {
-    std::ifstream in(log_);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  }
-  // Waits until the log contains `text`.
-  bool WaitForLog(const std::string& text, std::chrono::seconds timeout) const {
-    const auto deadline = Clock::now() + timeout;
-    while (Clock::now() < deadline) {
-      if (Log().find(text) != std::string::npos) return true;
-      if (exited_) return false;
-      std::this_thread::sleep_for(20ms);
-    }
-    return false;
-  }
-
- private:
-  std::string log_;
-  pid_t pid_ = -1;
-  bool exited_ = false;
-  int code_ = -1;
-};
+// stdout and stderr in one log, no stdin.
+test_support::ChildOptions LogTo(const std::string& path) { return test_support::OneLog(path, /*close_stdin=*/true); }
 
 struct TraceRow {
   double t_s, x, y, z, fx, fy, fz, model_age_ms;
@@ -175,8 +99,8 @@ double Percentile(std::vector<double> v, double q) {
 class ProcessTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    bin_ = Env("SNAPTHREAD_BIN_DIR");
-    source_ = Env("SNAPTHREAD_SOURCE_DIR");
+    bin_ = test_support::BinDir();
+    source_ = test_support::SourceDir();
     ASSERT_FALSE(bin_.empty() || source_.empty())
         << "SNAPTHREAD_BIN_DIR / SNAPTHREAD_SOURCE_DIR not set (run through ctest)";
     ASSERT_TRUE(fs::exists(bin_ + "/snapthread-server")) << bin_ << "/snapthread-server not built";
@@ -188,22 +112,11 @@ class ProcessTest : public ::testing::Test {
     }
     // Unique per process, test and run: parallel ctest jobs share the multicast group.
     // (LCM channel names are at most 63 bytes: keep it short.)
-    static int counter = 0;
-    std::random_device rd;
-    session_ = "PT" + std::to_string(getpid()) + "_" + std::to_string(rd() % 100000) + "_" +
-               std::to_string(counter++);
-    dir_ = ::testing::TempDir() + "/snapthread_" + session_;
-    fs::create_directories(dir_);
+    session_ = test_support::UniqueSession("PT");
+    tmp_ = std::make_unique<test_support::ScopedTempDir>("process_" + session_);
+    dir_ = tmp_->path();
     scene_path_ = source_ + "/scenes/curve2d_snap.yaml";
     scene_ = LoadScene(scene_path_);
-  }
-
-  // Keep the logs and traces of a failed test for the post-mortem, drop the rest.
-  void TearDown() override {
-    if (!HasFailure() && !dir_.empty()) {
-      std::error_code ec;
-      fs::remove_all(dir_, ec);
-    }
   }
 
   // A path through the strip's snap: from the scene's start (bent up, y = -3) up to
@@ -222,22 +135,22 @@ class ProcessTest : public ::testing::Test {
     return path;
   }
 
-  std::unique_ptr<Child> StartServer(const std::string& tag) {
-    auto child = std::make_unique<Child>(
+  std::unique_ptr<ChildProcess> StartServer(const std::string& tag) {
+    auto child = std::make_unique<ChildProcess>(
         std::vector<std::string>{bin_ + "/snapthread-server", "--scene", scene_path_, "--session",
                                  session_, "--lcm-url", kUrl, "--summary",
                                  dir_ + "/server_" + tag + ".json", "--log-level", "info",
                                  // A safety net should the test die without its cleanup;
                                  // the tests stop it with SIGTERM long before.
                                  "--duration", "300"},
-        dir_ + "/server_" + tag + ".log");
+        LogTo(dir_ + "/server_" + tag + ".log"));
     EXPECT_TRUE(child->started());
     // Up when it has logged its session line (scene loaded, LCM started, subscribed).
-    EXPECT_TRUE(child->WaitForLog("server: session", 30s)) << child->Log();
+    EXPECT_TRUE(child->WaitForOutput("server: session", 30)) << child->Out();
     return child;
   }
 
-  std::unique_ptr<Child> StartDevice(double duration_s, const std::string& path_csv,
+  std::unique_ptr<ChildProcess> StartDevice(double duration_s, const std::string& path_csv,
                                      double speed) {
     std::ostringstream dur, spd;
     dur << duration_s;
@@ -254,7 +167,7 @@ class ProcessTest : public ::testing::Test {
       argv.push_back("--path-csv");
       argv.push_back(path_csv);
     }
-    auto child = std::make_unique<Child>(argv, dir_ + "/device.log");
+    auto child = std::make_unique<ChildProcess>(argv, LogTo(dir_ + "/device.log"));
     EXPECT_TRUE(child->started());
     return child;
   }
@@ -279,6 +192,8 @@ class ProcessTest : public ::testing::Test {
 
   static constexpr int kTimeoutMs = 50;
   static constexpr int kFadeMs = 100;
+  // Logs and traces: kept for the post-mortem of a failed test, dropped otherwise.
+  std::unique_ptr<test_support::ScopedTempDir> tmp_;
   std::string bin_, source_, session_, dir_, scene_path_;
   Scene scene_;
 };
@@ -289,17 +204,17 @@ TEST_F(ProcessTest, DeviceFeelsTheServersForceThroughTheSnap) {
   // 0.136 m up at 0.03 m/s: the snap (y = 3.42) comes at ~4.3 s, then part of the way back.
   auto device = StartDevice(7.0, path, 0.03);
   int code = -1;
-  ASSERT_TRUE(device->Wait(120s, &code)) << "device did not finish";
-  EXPECT_EQ(code, 0) << device->Log();
+  ASSERT_TRUE(device->Wait(120, &code)) << "device did not finish";
+  EXPECT_EQ(code, 0) << device->Out();
   server->Signal(SIGTERM);
-  ASSERT_TRUE(server->Wait(60s, &code)) << "server did not stop on SIGTERM";
-  EXPECT_EQ(code, 0) << server->Log();
-  EXPECT_NE(server->Log().find("final: updates="), std::string::npos) << server->Log();
+  ASSERT_TRUE(server->Wait(60, &code)) << "server did not stop on SIGTERM";
+  EXPECT_EQ(code, 0) << server->Out();
+  EXPECT_NE(server->Out().find("final: updates="), std::string::npos) << server->Out();
 
   auto dev = ReadJsonNumbers(dir_ + "/device.json");
   auto srv = ReadJsonNumbers(dir_ + "/server_a.json");
-  ASSERT_GT(dev.count("ticks"), 0u) << device->Log();
-  ASSERT_GT(srv.count("updates"), 0u) << server->Log();
+  ASSERT_GT(dev.count("ticks"), 0u) << device->Out();
+  ASSERT_GT(srv.count("updates"), 0u) << server->Out();
   // The device got models for the bulk of its ticks (poses are superseded when the
   // server is busy, so not one per tick).
   EXPECT_GT(dev["ticks"], 3000);
@@ -354,15 +269,15 @@ TEST_F(ProcessTest, ServerKilledForceFadesThenRecoversWithANewServer) {
   ASSERT_TRUE(server_a->running());
   server_a->Signal(SIGKILL);
   int code = -1;
-  ASSERT_TRUE(server_a->Wait(30s, &code));
+  ASSERT_TRUE(server_a->Wait(30, &code));
   EXPECT_EQ(code, 128 + SIGKILL);
   std::this_thread::sleep_for(1500ms);
   auto server_b = StartServer("b");
-  ASSERT_TRUE(device->Wait(120s, &code)) << "device did not finish";
-  EXPECT_EQ(code, 0) << device->Log();
+  ASSERT_TRUE(device->Wait(120, &code)) << "device did not finish";
+  EXPECT_EQ(code, 0) << device->Out();
   server_b->Signal(SIGTERM);
-  ASSERT_TRUE(server_b->Wait(60s, &code));
-  EXPECT_EQ(code, 0) << server_b->Log();
+  ASSERT_TRUE(server_b->Wait(60, &code));
+  EXPECT_EQ(code, 0) << server_b->Out();
 
   auto dev = ReadJsonNumbers(dir_ + "/device.json");
   EXPECT_EQ(dev["nonfinite_outputs"], 0);
@@ -454,14 +369,14 @@ TEST_F(ProcessTest, GripSceneFollowsWithoutChatter) {
   auto server = StartServer("a");
   auto device = StartDevice(5.0, "", 0.02);
   int code = -1;
-  ASSERT_TRUE(device->Wait(120s, &code)) << "device did not finish";
-  EXPECT_EQ(code, 0) << device->Log();
+  ASSERT_TRUE(device->Wait(120, &code)) << "device did not finish";
+  EXPECT_EQ(code, 0) << device->Out();
   server->Signal(SIGTERM);
-  ASSERT_TRUE(server->Wait(60s, &code));
-  EXPECT_EQ(code, 0) << server->Log();
+  ASSERT_TRUE(server->Wait(60, &code));
+  EXPECT_EQ(code, 0) << server->Out();
   auto dev = ReadJsonNumbers(dir_ + "/device.json");
   auto srv = ReadJsonNumbers(dir_ + "/server_a.json");
-  ASSERT_GT(dev.count("ticks"), 0u) << device->Log();
+  ASSERT_GT(dev.count("ticks"), 0u) << device->Out();
   EXPECT_GT(dev["models_received"], 0.5 * dev["ticks"]);
   EXPECT_EQ(dev["nonfinite_outputs"], 0);
   EXPECT_EQ(srv["invalid_models"], 0);
@@ -474,9 +389,9 @@ TEST_F(ProcessTest, ServerCommandLine) {
   const std::string server = bin_ + "/snapthread-server";
   auto run = [&](std::vector<std::string> args, int* code) {
     args.insert(args.begin(), server);
-    Child c(args, dir_ + "/cli.log");
-    EXPECT_TRUE(c.Wait(60s, code));
-    return c.Log();
+    ChildProcess c(args, LogTo(dir_ + "/cli.log"));
+    EXPECT_TRUE(c.Wait(60, code));
+    return c.Out();
   };
   int code = -1;
   std::string log = run({"--help"}, &code);
@@ -529,24 +444,24 @@ TEST_F(ProcessTest, ServerCommandLine) {
 
   // --duration 0 runs until SIGINT, then stops cleanly.
   {
-    Child c({server, "--scene", scene_path_, "--session", session_, "--lcm-url", kUrl},
-            dir_ + "/sigint.log");
-    ASSERT_TRUE(c.WaitForLog("server: session", 30s)) << c.Log();
+    ChildProcess c({server, "--scene", scene_path_, "--session", session_, "--lcm-url", kUrl},
+            LogTo(dir_ + "/sigint.log"));
+    ASSERT_TRUE(c.WaitForOutput("server: session", 30)) << c.Out();
     c.Signal(SIGINT);
-    ASSERT_TRUE(c.Wait(30s, &code));
-    EXPECT_EQ(code, 0) << c.Log();
-    EXPECT_NE(c.Log().find("final: updates=0"), std::string::npos) << c.Log();
+    ASSERT_TRUE(c.Wait(30, &code));
+    EXPECT_EQ(code, 0) << c.Out();
+    EXPECT_NE(c.Out().find("final: updates=0"), std::string::npos) << c.Out();
   }
 }
 
 // deploy/run_demo.sh end to end (server + virtual-hand device, summary), short.
 TEST_F(ProcessTest, RunDemoScript) {
-  Child demo({"/bin/bash", source_ + "/deploy/run_demo.sh", "--bin-dir", bin_, "--duration", "3",
+  ChildProcess demo({"/bin/bash", source_ + "/deploy/run_demo.sh", "--bin-dir", bin_, "--duration", "3",
               "--out", dir_ + "/demo"},
-             dir_ + "/demo.log");
+             LogTo(dir_ + "/demo.log"));
   int code = -1;
-  ASSERT_TRUE(demo.Wait(120s, &code)) << demo.Log();
-  const std::string log = demo.Log();
+  ASSERT_TRUE(demo.Wait(120, &code)) << demo.Out();
+  const std::string log = demo.Out();
   EXPECT_EQ(code, 0) << log;
   for (const char* text : {"tick rate", "round trip", "snaps felt", "max force", "clamps",
                            "updates", "solve", "final log line: updates="}) {
@@ -560,11 +475,11 @@ TEST_F(ProcessTest, RunDemoScript) {
   EXPECT_GT(srv.at("updates"), 1000);
 
   // Bad arguments: exit 2 naming the argument.
-  Child bad({"/bin/bash", source_ + "/deploy/run_demo.sh", "--bin-dir", bin_, "--duration", "x"},
-            dir_ + "/demo_bad.log");
-  ASSERT_TRUE(bad.Wait(60s, &code));
+  ChildProcess bad({"/bin/bash", source_ + "/deploy/run_demo.sh", "--bin-dir", bin_, "--duration", "x"},
+            LogTo(dir_ + "/demo_bad.log"));
+  ASSERT_TRUE(bad.Wait(60, &code));
   EXPECT_EQ(code, 2);
-  EXPECT_NE(bad.Log().find("--duration"), std::string::npos) << bad.Log();
+  EXPECT_NE(bad.Out().find("--duration"), std::string::npos) << bad.Out();
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "scene/scene.h"
 #include "tracking/tracker.h"
 #include "messages/validate.h"
+#include "environment.h"
 
 namespace snapthread::server {
 namespace {
@@ -33,12 +34,8 @@ namespace {
 using namespace std::chrono_literals;
 constexpr auto kWait = 20s;  // generous: the machine is shared and noisy
 
-std::string SourceDir() {
-  const char* dir = std::getenv("SNAPTHREAD_SOURCE_DIR");
-  return dir != nullptr ? dir : "";
-}
-
-std::string ScenePath(const std::string& name) { return SourceDir() + "/scenes/" + name; }
+using test_support::ScenePath;
+using test_support::SourceDir;
 
 // Collects what the server publishes on the session's output channels. Its handlers run
 // on the server's receive thread (the server spins the shared LCM instance).
@@ -54,78 +51,24 @@ class Probe {
   }
 
   void OnModel(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    force_model_t m;
-    std::string why;
-    const bool ok = transport::DecodeAndValidate(rbuf, &m, &why);
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!ok || !IsFinite(m)) {
-      ++invalid_;
-      return;
-    }
-    models_.push_back(m);
-    cv_.notify_all();
+    Keep<force_model_t>(rbuf, &models_, IsFinite);
   }
-  void OnShape(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    thread_shape_t s;
-    std::string why;
-    const bool ok = transport::DecodeAndValidate(rbuf, &s, &why);
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!ok) {
-      ++invalid_;
-      return;
-    }
-    shapes_.push_back(s);
-    cv_.notify_all();
-  }
-  void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    solver_status_t s;
-    std::string why;
-    const bool ok = transport::DecodeAndValidate(rbuf, &s, &why);
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!ok) {
-      ++invalid_;
-      return;
-    }
-    statuses_.push_back(s);
-    cv_.notify_all();
-  }
+  void OnShape(const lcm::ReceiveBuffer* rbuf, const std::string&) { Keep<thread_shape_t>(rbuf, &shapes_); }
+  void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string&) { Keep<solver_status_t>(rbuf, &statuses_); }
 
   // Waits for a force model answering device_seq.
   bool WaitModel(int64_t device_seq, force_model_t* out) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    return cv_.wait_for(lock, kWait, [&] {
-      for (const auto& m : models_) {
-        if (m.device_seq == device_seq) {
-          if (out) *out = m;
-          return true;
-        }
-      }
-      return false;
-    });
+    return WaitFirst<force_model_t>(models_, 0, [&](const force_model_t& m) { return m.device_seq == device_seq; },
+                                    out);
   }
   // Waits until pred(shapes or statuses) holds for a message received after `since`
   // messages of that kind.
   bool WaitShape(size_t since, const std::function<bool(const thread_shape_t&)>& pred,
                  thread_shape_t* out = nullptr) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    return cv_.wait_for(lock, kWait, [&] {
-      for (size_t i = since; i < shapes_.size(); ++i) {
-        if (pred(shapes_[i])) {
-          if (out) *out = shapes_[i];
-          return true;
-        }
-      }
-      return false;
-    });
+    return WaitFirst(shapes_, since, pred, out);
   }
   bool WaitStatus(size_t since, const std::function<bool(const solver_status_t&)>& pred) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    return cv_.wait_for(lock, kWait, [&] {
-      for (size_t i = since; i < statuses_.size(); ++i) {
-        if (pred(statuses_[i])) return true;
-      }
-      return false;
-    });
+    return WaitFirst<solver_status_t>(statuses_, since, pred, nullptr);
   }
   std::vector<force_model_t> models() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -145,6 +88,35 @@ class Probe {
   }
 
  private:
+  // Decodes and validates a message into *kept (and `accept` when given); counts the rest.
+  template <typename T>
+  void Keep(const lcm::ReceiveBuffer* rbuf, std::vector<T>* kept, bool (*accept)(const T&) = nullptr) {
+    T msg;
+    std::string why;
+    const bool ok = transport::DecodeAndValidate(rbuf, &msg, &why);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!ok || (accept != nullptr && !accept(msg))) {
+      ++invalid_;
+      return;
+    }
+    kept->push_back(msg);
+    cv_.notify_all();
+  }
+  // Waits until pred holds for a message of `kept` from index `since` on (copied to *out).
+  template <typename T>
+  bool WaitFirst(const std::vector<T>& kept, size_t since, const std::function<bool(const T&)>& pred, T* out) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return cv_.wait_for(lock, kWait, [&] {
+      for (size_t i = since; i < kept.size(); ++i) {
+        if (pred(kept[i])) {
+          if (out) *out = kept[i];
+          return true;
+        }
+      }
+      return false;
+    });
+  }
+
   lcm::LCM* lcm_;
   std::vector<lcm::Subscription*> subs_;
   std::mutex mutex_;
@@ -176,12 +148,7 @@ command_t MakeCommand(int8_t command, const std::string& argument) {
 }
 
 bool WaitFor(const std::function<bool()>& pred) {
-  const auto deadline = std::chrono::steady_clock::now() + kWait;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (pred()) return true;
-    std::this_thread::sleep_for(2ms);
-  }
-  return pred();
+  return test_support::WaitUntil(pred, std::chrono::duration<double>(kWait).count(), 0.002);
 }
 
 class ServerTest : public ::testing::Test {
@@ -199,6 +166,12 @@ class ServerTest : public ::testing::Test {
     server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
     probe_ = std::make_unique<Probe>(&lcm_, server_->channels());
     server_->Start();
+  }
+
+  // StartServer, and the same scene for the direct tracker the answers are checked against.
+  Scene StartServerOn(const std::string& scene_file) {
+    StartServer(scene_file);
+    return LoadScene(ScenePath(scene_file));
   }
 
   void TearDown() override {
@@ -246,8 +219,7 @@ std::vector<Eigen::Vector3d> PathPoses(const Scene& scene, const Model& model, i
 }
 
 TEST_F(ServerTest, ForceModelsMatchDirectTrackerInDeviceUnits) {
-  StartServer("curve2d_snap.yaml");
-  const Scene scene = LoadScene(ScenePath("curve2d_snap.yaml"));
+  const Scene scene = StartServerOn("curve2d_snap.yaml");
   EquilibriumTracker direct(MakeModel(scene.params), scene.solver);
   direct.Reset(scene.grasp_start);
   const Model& model = direct.model();
@@ -318,8 +290,7 @@ TEST_F(ServerTest, ForceModelsMatchDirectTrackerInDeviceUnits) {
 }
 
 TEST_F(ServerTest, ThreadGripDirectionFromOrientation) {
-  StartServer("thread3d_loop.yaml");
-  const Scene scene = LoadScene(ScenePath("thread3d_loop.yaml"));
+  const Scene scene = StartServerOn("thread3d_loop.yaml");
   EquilibriumTracker direct(MakeModel(scene.params), scene.solver);
   direct.Reset(scene.grasp_start);
   const Model& model = direct.model();

@@ -22,6 +22,7 @@
 #include "realtime/percentiles.h"
 #include "realtime/spsc_ring.h"
 #include "messages/validate.h"
+#include "sample_messages.h"
 
 namespace snapthread::transport {
 namespace {
@@ -31,37 +32,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // ---- sample messages ---------------------------------------------------------------
 
-device_state_t SampleDeviceState() {
-  device_state_t m;
-  m.utime = 123456789;
-  m.seq = 42;
-  m.device_id = "virtual-hand";
-  m.position[0] = 0.01; m.position[1] = -0.02; m.position[2] = 0.03;
-  m.orientation[0] = 1.0; m.orientation[1] = 0.0; m.orientation[2] = 0.0; m.orientation[3] = 0.0;
-  m.buttons = 1;
-  return m;
-}
+// The pose and the force model of the auth tests (tests/auth/sample_messages.h).
+device_state_t SampleDeviceState() { return auth::testing::Sample<device_state_t>(); }
 
-force_model_t SampleForceModel() {
-  force_model_t m{};
-  m.utime = 1700000000000000;
-  m.seq = 7;
-  m.device_seq = 41;
-  m.device_utime = 123456000;
-  m.server_receive_utime = 1700000000000100;
-  m.solve_us = 250;
-  m.status = force_model_t::STATUS_NEAR_FOLD;
-  for (int i = 0; i < 3; ++i) {
-    m.u0[i] = 0.01 * (i + 1);
-    m.f0[i] = -0.5 * (i + 1);
-    m.torque0[i] = 0.001 * i;
-    for (int j = 0; j < 3; ++j) m.K[i][j] = (i == j) ? -300.0 : 10.0 * (i + j);
-  }
-  m.has_torque = 1;
-  m.iterations = 3;
-  m.residual = 1e-9;
-  return m;
-}
+force_model_t SampleForceModel() { return auth::testing::Sample<force_model_t>(); }
 
 thread_shape_t SampleShape(int n) {
   thread_shape_t m{};

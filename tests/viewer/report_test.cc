@@ -15,10 +15,13 @@
 #include "snapthread/force_model_t.hpp"
 #include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
+#include "png_image.h"
 #include "test_support.h"
 
 namespace snapthread::viewer_test {
 namespace {
+
+using namespace test_support;  // the shared fixtures (tests/support)
 
 constexpr int64_t kT0 = 1700000000000000;  // log time origin, us
 constexpr int kModels = 200;
@@ -140,9 +143,9 @@ std::string WriteReferenceLog(const std::string& dir) {
 
 ProcessResult RunReport(const std::string& log, const std::string& out_dir) {
   const std::vector<std::string> argv = {BinDir() + "/snapthread-report", log, "--out", out_dir};
-  const int pid = StartProcess(argv, out_dir + ".stdout", out_dir + ".stderr");
-  EXPECT_GT(pid, 0);
-  return WaitProcess(pid, 120.0, out_dir + ".stdout", out_dir + ".stderr");
+  ChildProcess report(argv, OutputFiles(out_dir + ".stdout", out_dir + ".stderr", true));
+  EXPECT_TRUE(report.started());
+  return report.Finish(120.0);
 }
 
 std::string Line(const std::string& text, const std::string& start) {
@@ -175,7 +178,7 @@ void ExpectNonTrivialPng(const std::string& path) {
 }
 
 TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
-  const std::string dir = TempDir("report");
+  const std::string dir = FreshTempDir("report");
   const std::string log = WriteReferenceLog(dir);
   const ProcessResult r = RunReport(log, dir + "/out");
   ASSERT_TRUE(r.exited);
@@ -223,18 +226,24 @@ TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
   }
 }
 
-TEST(ReportTest, TruncatedLogGivesAPartialReportWithAWarning) {
-  const std::string dir = TempDir("report-trunc");
-  const std::string log = WriteReferenceLog(dir);
-  const auto size = std::filesystem::file_size(log);
-  // Cut inside the last event (the 3-byte OTHER_CHANNEL message).
-  std::filesystem::resize_file(log, size - 5);
+// A damaged log still gives a report (exit 0), marked partial with a warning.
+void RunPartialReport(const std::string& log, const std::string& dir, std::string* summary) {
   const ProcessResult r = RunReport(log, dir + "/out");
   ASSERT_TRUE(r.exited);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("WARNING: partial report"), std::string::npos) << r.err;
-  const std::string summary = ReadFile(dir + "/out/summary.txt");
-  EXPECT_NE(summary.find("read: PARTIAL"), std::string::npos) << summary;
+  *summary = ReadFile(dir + "/out/summary.txt");
+  EXPECT_NE(summary->find("read: PARTIAL"), std::string::npos) << *summary;
+}
+
+TEST(ReportTest, TruncatedLogGivesAPartialReportWithAWarning) {
+  const std::string dir = FreshTempDir("report-trunc");
+  const std::string log = WriteReferenceLog(dir);
+  const auto size = std::filesystem::file_size(log);
+  // Cut inside the last event (the 3-byte OTHER_CHANNEL message).
+  std::filesystem::resize_file(log, size - 5);
+  std::string summary;
+  ASSERT_NO_FATAL_FAILURE(RunPartialReport(log, dir, &summary));
   EXPECT_NE(summary.find("truncated log"), std::string::npos) << summary;
   // Everything before the cut is reported.
   EXPECT_NE(Line(summary, "channel RPT_FORCE_MODEL ").find("messages 197 "), std::string::npos)
@@ -244,7 +253,7 @@ TEST(ReportTest, TruncatedLogGivesAPartialReportWithAWarning) {
 }
 
 TEST(ReportTest, DamagedMiddleIsSkippedAndTheRestStillRead) {
-  const std::string dir = TempDir("report-damage");
+  const std::string dir = FreshTempDir("report-damage");
   const std::string log = WriteReferenceLog(dir);
   const auto size = std::filesystem::file_size(log);
   {
@@ -253,12 +262,8 @@ TEST(ReportTest, DamagedMiddleIsSkippedAndTheRestStillRead) {
     const std::string junk(300, '\xAB');
     f.write(junk.data(), std::streamsize(junk.size()));
   }
-  const ProcessResult r = RunReport(log, dir + "/out");
-  ASSERT_TRUE(r.exited);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.err.find("WARNING: partial report"), std::string::npos) << r.err;
-  const std::string summary = ReadFile(dir + "/out/summary.txt");
-  EXPECT_NE(summary.find("read: PARTIAL"), std::string::npos) << summary;
+  std::string summary;
+  ASSERT_NO_FATAL_FAILURE(RunPartialReport(log, dir, &summary));
   // The last event (after the damage) is still there; a few in the middle are lost.
   EXPECT_NE(Line(summary, "channel OTHER_CHANNEL ").find("messages 1 "), std::string::npos)
       << summary;
@@ -271,7 +276,7 @@ TEST(ReportTest, DamagedMiddleIsSkippedAndTheRestStillRead) {
 }
 
 TEST(ReportTest, NothingReadableExitsNonZero) {
-  const std::string dir = TempDir("report-junk");
+  const std::string dir = FreshTempDir("report-junk");
   const std::string log = dir + "/junk.lcmlog";
   std::ofstream(log) << std::string(4000, 'x');
   const ProcessResult r = RunReport(log, dir + "/out");

@@ -38,15 +38,8 @@ if [ "$(id -u)" -ne 0 ]; then prio=""; logger_prio=""; fi
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
 trap cleanup EXIT
-# lcm-logger closes its log on SIGINT; never wait for it forever.
-stop_logger() {
-  kill -INT "$1" 2>/dev/null
-  for _ in $(seq 50); do kill -0 "$1" 2>/dev/null || break; sleep 0.1; done
-  kill -KILL "$1" 2>/dev/null
-  wait "$1" 2>/dev/null
-}
-fail() { echo "FAIL: $*"; echo "--- outputs in $work"; for f in "$work"/*.txt; do echo "== $f"; tail -n 15 "$f"; done; exit 1; }
-json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))$2)" "$1"; }
+# stop_logger, fail, json, run_session
+source "$(dirname "$0")/../support/script_support.sh"
 
 $logger_prio lcm-logger -q -c "${session}_.*" --lcm-url="$url" -f "$work/session.lcmlog" > "$work/logger.txt" 2>&1 &
 logger_pid=$!; pids+=("$logger_pid")
@@ -58,13 +51,7 @@ for v in 1 2; do
   eval "viewer${v}_pid=$!"
 done
 sleep 0.5
-$prio "$bin/snapthread-server" --scene "$scene" --session "$session" --lcm-url "$url" \
-    --duration $((duration + 2)) --summary "$work/server.json" > "$work/server.txt" 2>&1 &
-server_pid=$!; pids+=("$server_pid")
-sleep 0.5
-$prio "$bin/snapthread-device" --backend virtual-hand --scene "$scene" --session "$session" --lcm-url "$url" \
-    --duration "$duration" --no-rt --summary "$work/device.json" > "$work/device.txt" 2>&1
-device_rc=$?
+run_session "$prio" "$prio"
 wait "$server_pid"; server_rc=$?
 wait "$viewer1_pid"; v1_rc=$?
 wait "$viewer2_pid"; v2_rc=$?

@@ -19,16 +19,20 @@
 #include "snapthread/thread_shape_t.hpp"
 #include "messages/channels.h"
 #include "spline.h"
+#include "png_image.h"
 #include "test_support.h"
 
 namespace snapthread::viewer_test {
 namespace {
 
+using namespace test_support;  // the shared fixtures (tests/support)
+
 using viewer::CatmullRomCurve;
 using viewer::OrbitCamera;
 using viewer::Point3;
 
-constexpr char kLoopbackUrl[] = "udpm://239.255.76.67:7667?ttl=0";
+using test_support::kLoopbackLcmUrl;
+constexpr const char* kLoopbackUrl = kLoopbackLcmUrl;
 constexpr int kWidth = 640;
 constexpr int kHeight = 480;
 constexpr int kNodes = 21;
@@ -156,9 +160,9 @@ ViewerRun RunViewerScreenshot(const std::string& session, const std::string& dir
       "--screenshot", run.png, "--after-shapes", std::to_string(after_shapes), "--timeout-s",
       std::to_string(timeout_s), "--width", std::to_string(kWidth), "--height",
       std::to_string(kHeight)};
-  const int pid = StartProcess(argv, dir + "/out.txt", dir + "/err.txt");
-  EXPECT_GT(pid, 0) << "cannot start xvfb-run";
-  if (pid > 0) run.result = WaitProcess(pid, timeout_s + 40.0, dir + "/out.txt", dir + "/err.txt");
+  ChildProcess viewer(argv, OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
+  EXPECT_TRUE(viewer.started()) << "cannot start xvfb-run";
+  if (viewer.started()) run.result = viewer.Finish(timeout_s + 40.0);
   return run;
 }
 
@@ -177,9 +181,8 @@ bool InOverlay(double x, double y, double margin) {
 }
 
 // Checks the screenshot against the projection of the arc with the viewer's camera fit.
-void ExpectArcDrawn(const Image& img) {
-  ASSERT_EQ(img.width, kWidth);
-  ASSERT_EQ(img.height, kHeight);
+// The camera the viewer fits to the arc.
+OrbitCamera ArcCamera() {
   const std::vector<Point3> nodes = ArcNodes();
   Eigen::Vector3d lo = nodes[0], hi = nodes[0];
   for (const auto& p : nodes) {
@@ -188,10 +191,21 @@ void ExpectArcDrawn(const Image& img) {
   }
   OrbitCamera camera;
   camera.Fit(lo, hi, double(kWidth) / kHeight);
+  return camera;
+}
+
+// The arc's spline as `camera` projects it, in pixels.
+std::vector<Eigen::Vector2d> ArcPixelPath(const OrbitCamera& camera) {
   std::vector<Eigen::Vector2d> path;
-  for (const auto& p : CatmullRomCurve(nodes, 8)) {
-    path.push_back(camera.ProjectToPixel(p, kWidth, kHeight));
-  }
+  for (const auto& p : CatmullRomCurve(ArcNodes(), 8)) path.push_back(camera.ProjectToPixel(p, kWidth, kHeight));
+  return path;
+}
+
+void ExpectArcDrawn(const Image& img) {
+  ASSERT_EQ(img.width, kWidth);
+  ASSERT_EQ(img.height, kHeight);
+  const OrbitCamera camera = ArcCamera();
+  const std::vector<Eigen::Vector2d> path = ArcPixelPath(camera);
   // 1) Along the projected path the tube is drawn (not background).
   int on = 0, checked = 0;
   for (const auto& q : path) {
@@ -235,7 +249,7 @@ void ExpectArcDrawn(const Image& img) {
 
 TEST(ViewerScreenshotTest, ShowsTheThreadAlongTheProjectedArc) {
   const std::string session = UniqueSession("VIEWARC");
-  const std::string dir = TempDir("viewer-arc");
+  const std::string dir = FreshTempDir("viewer-arc");
   ShapePublisher publisher(session, /*with_garbage=*/false);
   ASSERT_TRUE(publisher.Start()) << "LCM publisher failed on " << kLoopbackUrl
                                  << " (no multicast route? see deploy/multicast-route.sh)";
@@ -252,7 +266,7 @@ TEST(ViewerScreenshotTest, ShowsTheThreadAlongTheProjectedArc) {
 
 TEST(ViewerScreenshotTest, MalformedShapePacketsAreDroppedAndCounted) {
   const std::string session = UniqueSession("VIEWBAD");
-  const std::string dir = TempDir("viewer-bad");
+  const std::string dir = FreshTempDir("viewer-bad");
   ShapePublisher publisher(session, /*with_garbage=*/true);
   ASSERT_TRUE(publisher.Start());
   // 20 valid shapes: by then garbage of every kind has arrived between them.
@@ -275,18 +289,9 @@ TEST(ViewerScreenshotTest, MalformedShapePacketsAreDroppedAndCounted) {
 
 // Mean colour of the drawn path pixels (outside the overlays).
 Eigen::Vector3d PathColour(const Image& img) {
-  const std::vector<Point3> nodes = ArcNodes();
-  Eigen::Vector3d lo = nodes[0], hi = nodes[0];
-  for (const auto& p : nodes) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  OrbitCamera camera;
-  camera.Fit(lo, hi, double(kWidth) / kHeight);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int n = 0;
-  for (const auto& p : CatmullRomCurve(nodes, 8)) {
-    const Eigen::Vector2d q = camera.ProjectToPixel(p, kWidth, kHeight);
+  for (const Eigen::Vector2d& q : ArcPixelPath(ArcCamera())) {
     if (InOverlay(q.x(), q.y(), 4)) continue;
     const uint8_t* c = img.At(int(std::lround(q.x())), int(std::lround(q.y())));
     sum += Eigen::Vector3d(c[0], c[1], c[2]);
@@ -301,7 +306,7 @@ TEST(ViewerScreenshotTest, SolverStateIsColourCoded) {
   const int8_t states[2] = {0, 2};  // force_model_t::STATUS_REGULAR, STATUS_SNAPPED
   for (int i = 0; i < 2; ++i) {
     const std::string session = UniqueSession("VIEWSTATE");
-    const std::string dir = TempDir("viewer-state" + std::to_string(i));
+    const std::string dir = FreshTempDir("viewer-state" + std::to_string(i));
     ShapePublisher publisher(session, false, states[i]);
     ASSERT_TRUE(publisher.Start());
     const ViewerRun run = RunViewerScreenshot(session, dir, 3, 30.0);
@@ -322,7 +327,7 @@ TEST(ViewerScreenshotTest, SolverStateIsColourCoded) {
 // viewer shows the logged thread.
 TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
   const std::string session = UniqueSession("VIEWREPLAY");
-  const std::string dir = TempDir("viewer-replay");
+  const std::string dir = FreshTempDir("viewer-replay");
   const std::string log_path = dir + "/session.lcmlog";
   {
     lcm::LogFile log(log_path, "w");
@@ -347,15 +352,15 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
       BinDir() + "/snapthread-viewer", "--session", session, "--lcm-url", kLoopbackUrl,
       "--screenshot", dir + "/shot.png", "--after-shapes", "10", "--timeout-s", "30",
       "--width", std::to_string(kWidth), "--height", std::to_string(kHeight)};
-  const int viewer = StartProcess(viewer_argv, dir + "/out.txt", dir + "/err.txt");
-  ASSERT_GT(viewer, 0);
+  ChildProcess viewer(viewer_argv, OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
+  ASSERT_TRUE(viewer.started());
   std::this_thread::sleep_for(std::chrono::seconds(2));  // Xvfb + GL start-up
-  const int player = StartProcess({"lcm-logplayer", std::string("--lcm-url=") + kLoopbackUrl, log_path},
-                                  dir + "/player_out.txt", dir + "/player_err.txt");
-  ASSERT_GT(player, 0) << "cannot start lcm-logplayer (liblcm-bin)";
-  const ProcessResult v = WaitProcess(viewer, 60.0, dir + "/out.txt", dir + "/err.txt");
+  ChildProcess player({"lcm-logplayer", std::string("--lcm-url=") + kLoopbackUrl, log_path},
+                      OutputFiles(dir + "/player_out.txt", dir + "/player_err.txt", true));
+  ASSERT_TRUE(player.started()) << "cannot start lcm-logplayer (liblcm-bin)";
+  const ProcessResult v = viewer.Finish(60.0);
   // The player would go on to the end of the log; the viewer has what it needs.
-  WaitProcess(player, 0.2, dir + "/player_out.txt", dir + "/player_err.txt");
+  player.Finish(0.2);
   ASSERT_TRUE(v.exited) << v.err;
   ASSERT_EQ(v.exit_code, 0) << v.out << v.err;
   Image img;
@@ -399,19 +404,12 @@ class PoseCollector {
 // device metres through the scene's mapping.
 TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
   const std::string session = UniqueSession("VIEWGRASP");
-  const std::string dir = TempDir("viewer-grasp");
+  const std::string dir = FreshTempDir("viewer-grasp");
   const std::string scene_path = SourceDir() + "/scenes/curve2d_snap.yaml";
   const Scene scene = LoadScene(scene_path);
   // Where the viewer's camera puts the arc's grasp (-1, 0, 0), and the drag target.
-  const std::vector<Point3> nodes = ArcNodes();
-  Eigen::Vector3d lo = nodes[0], hi = nodes[0];
-  for (const auto& p : nodes) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  OrbitCamera camera;
-  camera.Fit(lo, hi, double(kWidth) / kHeight);
-  const Eigen::Vector2d grasp_px = camera.ProjectToPixel(nodes.back(), kWidth, kHeight);
+  const OrbitCamera camera = ArcCamera();
+  const Eigen::Vector2d grasp_px = camera.ProjectToPixel(ArcNodes().back(), kWidth, kHeight);
   const Eigen::Vector2d target_px(std::round(grasp_px.x() + 60), std::round(grasp_px.y() - 45));
   Eigen::Vector3d origin, direction;
   camera.PixelRay(target_px.x(), target_px.y(), kWidth, kHeight, &origin, &direction);
@@ -436,11 +434,11 @@ TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
                 title.c_str(), int(std::lround(grasp_px.x())), int(std::lround(grasp_px.y())),
                 int(target_px.x() - 20), int(target_px.y()), int(target_px.x()), int(target_px.y()));
   std::random_device rd;
-  const int pid = StartProcess({"xvfb-run", "-a", "-n", std::to_string(100 + rd() % 800), "-s",
-                                "-screen 0 1280x720x24", "bash", "-c", script},
-                               dir + "/out.txt", dir + "/err.txt");
-  ASSERT_GT(pid, 0);
-  const ProcessResult r = WaitProcess(pid, 40.0, dir + "/out.txt", dir + "/err.txt");
+  ChildProcess run({"xvfb-run", "-a", "-n", std::to_string(100 + rd() % 800), "-s",
+                    "-screen 0 1280x720x24", "bash", "-c", script},
+                   OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
+  ASSERT_TRUE(run.started());
+  const ProcessResult r = run.Finish(40.0);
   publisher.Stop();
   ASSERT_TRUE(r.exited) << r.err;
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
@@ -458,13 +456,13 @@ TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
   EXPECT_NEAR(last.position[1], expected_m.y(), 5e-4);
   EXPECT_NEAR(last.position[2], expected_m.z(), 1e-9);  // planar model: on the plane z = 0
   // The drag moved it: far from the grasp's own position.
-  const Eigen::Vector3d grasp_m = viewer::ModelToDeviceMetres(scene.device, nodes.back());
+  const Eigen::Vector3d grasp_m = viewer::ModelToDeviceMetres(scene.device, ArcNodes().back());
   EXPECT_GT(std::hypot(last.position[0] - grasp_m.x(), last.position[1] - grasp_m.y()), 5e-3);
 }
 
 TEST(ViewerScreenshotTest, TimesOutWithAClearMessageWhenNothingArrives) {
   const std::string session = UniqueSession("VIEWNONE");
-  const std::string dir = TempDir("viewer-none");
+  const std::string dir = FreshTempDir("viewer-none");
   const ViewerRun run = RunViewerScreenshot(session, dir, 1, 1.5);
   ASSERT_TRUE(run.result.exited) << run.result.err;
   EXPECT_EQ(run.result.exit_code, 2);

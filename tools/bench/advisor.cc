@@ -122,11 +122,7 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
     for (Method m : o.methods)
       for (double cutoff : o.cutoffs)
         for (int budget : o.budgets) {
-          Scene c = sc;
-          c.solver.method = m;
-          c.solver.cutoff = cutoff;
-          c.solver.max_iterations = budget;
-          const TimedSweep t = TimeSweep(c, path, o.repetitions, o.min_time_s);
+          const TimedSweep t = TimeSweep(WithSolver(sc, m, cutoff, budget), path, o.repetitions, o.min_time_s);
           AdviceCandidate cand;
           cand.n = chain ? n : 0;
           cand.method = m;

@@ -11,74 +11,34 @@
 #include <CLI/CLI.hpp>
 
 #include "bench.h"
+#include "tool_main.h"
 
 namespace fs = std::filesystem;
 using namespace snapthread;
 
 namespace {
 
-std::vector<std::string> Split(const std::string& s) {
-  std::vector<std::string> v;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) v.push_back(item);
-  return v;
-}
-
 std::vector<int> ParseBudgets(const std::string& s) {
-  std::vector<int> v;
-  for (const auto& item : Split(s)) {
-    if (item == "inf") {
-      v.push_back(0);
-      continue;
-    }
-    size_t used = 0;
-    int k = -1;
-    try {
-      k = std::stoi(item, &used);
-    } catch (const std::exception&) {
-    }
-    if (k < 0 || used != item.size())
-      throw std::invalid_argument("--budgets: '" + item + "' is not an iteration budget (integer >= 1, or inf)");
-    v.push_back(k);
-  }
-  return v;
+  return ParseList<int>(s, "--budgets", "is not an iteration budget (integer >= 1, or inf)",
+                        [](const std::string& item, int* k) {
+                          if (item == "inf") return (*k = 0) == 0;
+                          return ParseWhole(item, k) && *k >= 0;
+                        });
 }
 
 std::vector<int> ParseCounts(const std::string& s, const char* what) {
-  std::vector<int> v;
-  for (const auto& item : Split(s)) {
-    size_t used = 0;
-    int k = 0;
-    try {
-      k = std::stoi(item, &used);
-    } catch (const std::exception&) {
-    }
-    if (k < 2 || used != item.size())
-      throw std::invalid_argument(std::string(what) + ": '" + item + "' is not a segment count (integer >= 2)");
-    v.push_back(k);
-  }
-  return v;
+  return ParseList<int>(s, what, "is not a segment count (integer >= 2)",
+                        [](const std::string& item, int* k) { return ParseWhole(item, k) && *k >= 2; });
 }
 
 std::vector<double> ParseCutoffs(const std::string& s) {
-  std::vector<double> v;
-  for (const auto& item : Split(s)) {
-    size_t used = 0;
-    double c = 0;
-    try {
-      c = std::stod(item, &used);
-    } catch (const std::exception&) {
-    }
-    if (!(c > 0) || used != item.size()) throw std::invalid_argument("--cutoffs: '" + item + "' is not a positive number");
-    v.push_back(c);
-  }
-  return v;
+  return ParseList<double>(s, "--cutoffs", "is not a positive number",
+                           [](const std::string& item, double* c) { return ParseWhole(item, c) && *c > 0; });
 }
 
 std::vector<Method> ParseMethods(const std::string& s) {
   std::vector<Method> v;
-  for (const auto& item : Split(s)) {
+  for (const auto& item : SplitList(s)) {
     Method m;
     if (!ParseMethod(item, &m)) throw std::invalid_argument("--methods: unknown method '" + item + "'");
     v.push_back(m);
@@ -132,14 +92,7 @@ int main(int argc, char** argv) {
   app.add_option("--ladder", ladder_text, "advise: segment counts to try (default 5,8,10,15,20,30,50,80; reference 160)");
   app.add_option("--reference-n", reference_n, "advise: segments of the reference model (default 2 max(n, ladder max))")
       ->check(CLI::Range(2, 100000));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
-
-  try {
+  return RunTool("snapthread-bench", app, argc, argv, [&]() -> int {
     const std::string machine = MachineDescription();
     std::cerr << "snapthread-bench: " << machine << (quick ? " (quick)" : "") << '\n';
     const auto t_start = std::chrono::steady_clock::now();
@@ -170,7 +123,7 @@ int main(int argc, char** argv) {
       return a.found ? 0 : 3;
     }
 
-    const auto parts = Split(only);
+    const auto parts = SplitList(only);
     auto want = [&](const char* p) { return std::find(parts.begin(), parts.end(), p) != parts.end(); };
     for (const auto& p : parts)
       if (p != "accuracy" && p != "scaling" && p != "service")
@@ -190,7 +143,7 @@ int main(int argc, char** argv) {
         o.min_time_s = 0.01;
         o.substeps = 3;
       }
-      if (!sweeps_text.empty()) o.sweeps = Split(sweeps_text);
+      if (!sweeps_text.empty()) o.sweeps = SplitList(sweeps_text);
       if (!methods_text.empty()) o.methods = ParseMethods(methods_text);
       if (!cutoffs_text.empty()) o.cutoffs = ParseCutoffs(cutoffs_text);
       if (!budgets_text.empty()) o.budgets = ParseBudgets(budgets_text);
@@ -220,7 +173,7 @@ int main(int argc, char** argv) {
       }
       if (!ns_text.empty()) o.ns = ParseCounts(ns_text, "--ns");
       if (!methods_text.empty()) o.methods = ParseMethods(methods_text);
-      if (!backends_text.empty()) o.backends = Split(backends_text);
+      if (!backends_text.empty()) o.backends = SplitList(backends_text);
       if (repetitions > 0) o.repetitions = repetitions;
       o.fixed_length = fixed_length;
       const auto rows = RunScalingBench(scenes_dir, o, &std::cerr);
@@ -251,7 +204,7 @@ int main(int argc, char** argv) {
         o.duration_s = 3.0;
         o.repetitions = 1;
       }
-      if (!service_scenes.empty()) o.scenes = Split(service_scenes);
+      if (!service_scenes.empty()) o.scenes = SplitList(service_scenes);
       if (service_duration > 0) o.duration_s = service_duration;
       if (repetitions > 0) o.repetitions = repetitions;
       const auto runs = RunServiceBench(o, &std::cerr);
@@ -273,12 +226,6 @@ int main(int argc, char** argv) {
       std::cerr << "snapthread-bench: gnuplot failed (deploy/setup.sh installs gnuplot-nox)\n";
       return 1;
     }
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "snapthread-bench: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "snapthread-bench: " << e.what() << '\n';
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

@@ -77,10 +77,7 @@ std::vector<AccuracyRow> RunAccuracyBench(const std::string& scenes_dir, const A
       const auto t_m = Clock::now();
       for (double cutoff : o.cutoffs)
         for (int budget : o.budgets) {
-          Scene sc = scene;
-          sc.solver.method = m;
-          sc.solver.cutoff = cutoff;
-          sc.solver.max_iterations = budget;
+          const Scene sc = WithSolver(scene, m, cutoff, budget);
           const TimedSweep t = TimeSweep(sc, sw->controls, o.repetitions, o.min_time_s);
           AccuracyRow row;
           row.sweep = name;

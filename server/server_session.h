@@ -1,0 +1,21 @@
+// The solve thread's session: the scene and its tracker (server.cc, commands.cc).
+#pragma once
+
+#include <memory>
+
+#include <Eigen/Core>
+
+#include "scene/scene.h"
+#include "server.h"
+#include "tracking/tracker.h"
+
+namespace snapthread::server {
+
+struct Server::Session {
+  Scene scene;
+  std::unique_ptr<EquilibriumTracker> tracker;
+  // The grip direction of a device at rest (pose_mapping.h).
+  Eigen::Vector3d rest_direction = Eigen::Vector3d::UnitX();
+};
+
+}  // namespace snapthread::server

@@ -1,0 +1,28 @@
+# Shell helpers of the whole-service test scripts (tests/viewer/soak_test.sh,
+# deploy/netns/two_host_test.sh). Source it after setting $work (the outputs folder).
+
+# lcm-logger closes its log on SIGINT; never wait for it forever.
+stop_logger() {
+  kill -INT "$1" 2>/dev/null
+  for _ in $(seq 50); do kill -0 "$1" 2>/dev/null || break; sleep 0.1; done
+  kill -KILL "$1" 2>/dev/null
+  wait "$1" 2>/dev/null
+}
+# Prints the reason and the tail of every output in $work, exits 1.
+fail() { echo "FAIL: $*"; echo "--- outputs in $work"; for f in "$work"/*.txt; do echo "== $f"; tail -n 15 "$f"; done; exit 1; }
+# json FILE "['key']": a field of a JSON file.
+json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))$2)" "$1"; }
+# run_session SERVER_PREFIX DEVICE_PREFIX: snapthread-server (summary in $work/server.json,
+# $duration + 2 s) in the background, then snapthread-device (virtual hand, $duration s,
+# $work/device.json) to its end, both on $scene, $session, $url from $bin. Sets server_pid
+# (also appended to pids, which a cleanup trap may kill) and device_rc. A prefix is a
+# command such as "ip netns exec NS" or "nice -n -5", or empty.
+run_session() {
+  $1 "$bin/snapthread-server" --scene "$scene" --session "$session" --lcm-url "$url" \
+      --duration $((duration + 2)) --summary "$work/server.json" > "$work/server.txt" 2>&1 &
+  server_pid=$!; pids+=("$server_pid")
+  sleep 0.5
+  $2 "$bin/snapthread-device" --backend virtual-hand --scene "$scene" --session "$session" --lcm-url "$url" \
+      --duration "$duration" --no-rt --summary "$work/device.json" > "$work/device.txt" 2>&1
+  device_rc=$?
+}
