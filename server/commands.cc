@@ -10,6 +10,7 @@
 #include "server.h"
 #include "server_session.h"
 #include "snapthread/force_model_t.hpp"
+#include "solvers/registry.h"
 
 namespace snapthread::server {
 
@@ -39,20 +40,19 @@ void Server::ApplyCommand(const command_t& command) {
       break;
     }
     case command_t::SET_METHOD: {
-      Method m;
-      if (!ParseMethod(command.argument, &m)) {
+      if (SolverRegistry::Global().Find(command.argument) == nullptr) {
         ok = false;
-        message = "SET_METHOD refused: unknown method '" + command.argument +
-                  "' (expected newton, newton-ls or higher-order)";
+        message = "SET_METHOD refused: unknown method '" + command.argument + "' (expected " +
+                  SolverRegistry::Global().NamesText(", ", " or ") + ")";
         break;
       }
       try {
         SolverOptions options = session_->tracker->options();
-        options.method = m;
+        options.method = command.argument;
         session_->tracker->SetOptions(options);
         session_->scene.solver = options;
         method_override_ = command.argument;
-        message = std::string("SET_METHOD: now ") + ToString(m);
+        message = "SET_METHOD: now " + command.argument;
       } catch (const std::exception& e) {
         ok = false;
         message = std::string("SET_METHOD failed: ") + e.what();
@@ -65,7 +65,7 @@ void Server::ApplyCommand(const command_t& command) {
   }
   // The message first, then the counters: a caller that waits on a counter reads the
   // message of that command.
-  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), &message);
+  SetInfo(session_->scene.name, session_->tracker->options().method, &message);
   if (ok) {
     // A new start: the shape's snap count is "since the session (re)started".
     if (command.command != command_t::SET_METHOD) {

@@ -17,6 +17,7 @@
 #include "realtime/clock.h"
 #include "messages/lcm_url.h"
 #include "messages/validate.h"
+#include "solvers/registry.h"
 
 namespace snapthread::server {
 namespace {
@@ -67,7 +68,7 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
   // touching the network.
   Scene scene = LoadScene(params_.scene_path);
   session_ = MakeSession(scene);
-  SetInfo(session_->scene.name, ToString(session_->tracker->options().method), nullptr);
+  SetInfo(session_->scene.name, session_->tracker->options().method, nullptr);
 
   if (lcm != nullptr) {
     lcm_ = lcm;
@@ -90,11 +91,10 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
   session->scene = scene;
   SolverOptions options = scene.solver;
   if (!method_override_.empty()) {
-    Method m;
-    if (!ParseMethod(method_override_, &m)) {
+    if (SolverRegistry::Global().Find(method_override_) == nullptr) {
       throw std::invalid_argument("unknown method '" + method_override_ + "'");
     }
-    options.method = m;
+    options.method = method_override_;
   }
   session->scene.solver = options;
   // MakeModel / the tracker throw std::invalid_argument for invalid parameters.
@@ -128,7 +128,7 @@ void Server::Start() {
   receive_thread_ = std::thread([this] { ReceiveLoop(); });
   spdlog::info("server: session {} on {}, scene '{}' ({}), method {}", channels_.session,
                lcm_url_, session_->scene.name, session_->scene.file,
-               ToString(session_->tracker->options().method));
+               session_->tracker->options().method);
 }
 
 void Server::Stop() {
@@ -329,7 +329,7 @@ void Server::PublishStatus() {
   const transport::PercentileSummary window = status_window_.Compute();
   StatusInputs in;
   in.scene = session_->scene.name;
-  in.method = ToString(session_->tracker->options().method);
+  in.method = session_->tracker->options().method;
   in.summary = &session_->tracker->last().summary;
   in.status = last_status_;
   in.update_rate_hz = dt > 0.0 ? static_cast<double>(updates - updates_at_last_status_) / dt : 0.0;

@@ -19,6 +19,7 @@
 #include <spdlog/spdlog.h>
 
 #include "server.h"
+#include "solvers/registry.h"
 #include "server_params.h"
 #include "scene/scene.h"
 
@@ -73,7 +74,7 @@ int main(int argc, char** argv) {
   app.add_option("--status-rate-hz", params.status_rate_hz, "Solver status rate, Hz")
       ->capture_default_str();
   app.add_option("--method", params.method,
-                 "Override the scene's solver: newton | newton-ls | higher-order");
+                 "Override the scene's solver: " + snapthread::SolverRegistry::Global().NamesText(" | ", " | "));
   app.add_option("--duration", params.duration_s, "Run time in seconds; 0 = until SIGINT/SIGTERM")
       ->capture_default_str();
   app.add_option("--log-level", params.log_level,

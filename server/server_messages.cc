@@ -13,10 +13,7 @@ namespace {
 bool Finite(double v) { return std::isfinite(v); }
 
 bool ResultIsUsable(const TrackResult& r, int num_controls) {
-  if (r.summary.termination == Termination::kLinearSolverFailed ||
-      r.summary.termination == Termination::kNonFinite) {
-    return false;
-  }
+  if (!r.summary.IsSolutionUsable()) return false;
   if (r.force.size() != num_controls || r.stiffness.rows() != num_controls ||
       r.stiffness.cols() != num_controls) {
     return false;
@@ -36,20 +33,19 @@ void ZeroForceModel(force_model_t* m) {
 }  // namespace
 
 int8_t ClassifyStatus(const TrackResult* result) {
-  if (result == nullptr) return force_model_t::STATUS_INVALID;
-  if (result->summary.termination == Termination::kLinearSolverFailed ||
-      result->summary.termination == Termination::kNonFinite ||
-      !result->force.allFinite() || !result->stiffness.allFinite()) {
+  if (result == nullptr || !result->summary.IsSolutionUsable() || !result->force.allFinite() ||
+      !result->stiffness.allFinite()) {
     return force_model_t::STATUS_INVALID;
   }
-  // The tracker decides a snap from the state's jump to another branch; the solver's own
-  // flag only says its snap minimiser ran (it can land back on the same branch).
-  if (result->snapped) return force_model_t::STATUS_SNAPPED;
-  if (result->stiffness_regularized ||
-      result->summary.status == EquilibriumStatus::kNearFold) {
-    return force_model_t::STATUS_NEAR_FOLD;
+  // The equilibrium status was decided once (DecideStatus: the tracker knows whether the
+  // state changed branch; the solver's own snap flag only says its minimiser ran). The
+  // message adds only what it knows itself: K was floored although the state is regular.
+  switch (result->summary.status) {
+    case EquilibriumStatus::kSnapped: return force_model_t::STATUS_SNAPPED;
+    case EquilibriumStatus::kNearFold: return force_model_t::STATUS_NEAR_FOLD;
+    case EquilibriumStatus::kRegular: break;
   }
-  return force_model_t::STATUS_REGULAR;
+  return result->stiffness_regularized ? force_model_t::STATUS_NEAR_FOLD : force_model_t::STATUS_REGULAR;
 }
 
 double PlanarStiffness(const DeviceMapping& mapping) {

@@ -18,11 +18,12 @@
 
 namespace snapthread::server {
 
-// force_model_t.STATUS_* for one update. result == nullptr means the update failed
-// (threw): INVALID. A linear-solver failure or a non-finite result is INVALID too; a
-// spent budget is not (the state is the last accepted one and the force is usable).
-// Otherwise SNAPPED if the thread snapped at this update, NEAR_FOLD if the stiffness was
-// regularised or the solver reports a near-fold state, else REGULAR.
+// force_model_t.STATUS_* for one update: the decided summary.status (DecideStatus,
+// solvers/summary.h) as a message status. result == nullptr means the update failed
+// (threw): INVALID. A result that is not usable (!summary.IsSolutionUsable(): linear
+// solver failed, non-finite, invalid input) or not finite is INVALID too; a spent budget
+// is not (the state is the last accepted one and the force is usable). A regular state
+// whose stiffness was regularised is NEAR_FOLD (the device gets a floored K).
 int8_t ClassifyStatus(const TrackResult* result);
 
 // The planar constraint's stiffness for planar models, N/m (see BuildForceModel).

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "solvers/solver.h"
+#include "solvers/registry.h"
 #include "messages/channels.h"
 
 namespace snapthread::server {
@@ -44,10 +44,9 @@ bool ServerParams::IsValid(std::string* error) const {
     return Fail(error, "--status-rate-hz: must be in (0, 1000], got " + std::to_string(status_rate_hz));
   }
   if (!method.empty()) {
-    Method m;
-    if (!ParseMethod(method, &m)) {
-      return Fail(error, "--method: unknown method '" + method +
-                             "' (expected newton, newton-ls or higher-order)");
+    if (SolverRegistry::Global().Find(method) == nullptr) {
+      return Fail(error, "--method: unknown method '" + method + "' (expected " +
+                             SolverRegistry::Global().NamesText(", ", " or ") + ")");
     }
   }
   if (!IsKnownLogLevel(log_level)) {

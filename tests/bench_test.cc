@@ -121,7 +121,7 @@ TEST(BenchPaths, HandSpeedPathMatchesTheStandardSweeps) {
 
 TEST(BenchPaths, HandSpeedControlMovesSlowlyAndStaysNearTheStart) {
   const Scene base = testing::SceneFile("thread3d_loop.yaml");
-  const Scene s = HandSpeedScene(base, 40, Method::kHigherOrder, "banded", 1e-6);
+  const Scene s = HandSpeedScene(base, 40, "higher-order", "banded", 1e-6);
   EXPECT_FALSE(s.params.grip_direction);
   ASSERT_EQ(s.grasp_start.size(), 3);
   const double total = 40 * base.params.segment_length;
@@ -145,7 +145,7 @@ TEST(BenchPaths, FixedLengthHandSpeedSceneKeepsTheThread) {
   const Scene base = testing::SceneFile("thread3d_loop.yaml");
   const double total = base.params.n * base.params.segment_length;
   for (int n : {5, 40, 400}) {
-    const Scene s = HandSpeedScene(base, n, Method::kNewton, "auto", 1e-6, true);
+    const Scene s = HandSpeedScene(base, n, "newton", "auto", 1e-6, true);
     EXPECT_EQ(s.params.n, n);
     EXPECT_FALSE(s.params.grip_direction);
     EXPECT_NEAR(s.params.n * s.params.segment_length, total, 1e-12);
@@ -164,7 +164,7 @@ TEST(BenchScaling, HandSpeedUpdatesConvergeWithoutSnapping) {
   o.repetitions = 2;
   o.min_sample_s = 0.0;
   o.min_updates = 100;
-  for (Method m : {Method::kNewton, Method::kHigherOrder}) {
+  for (const char* m : {"newton", "higher-order"}) {
     const ScalingRow r = TimeHandSpeed(HandSpeedScene(base, 8, m, "auto", 1e-6), o);
     EXPECT_EQ(r.n, 8);
     EXPECT_EQ(r.updates, 100);
@@ -246,7 +246,7 @@ TEST(BenchService, MissingBinariesAreReportedNotThrown) {
   EXPECT_NE(r.error.find("missing"), std::string::npos) << r.error;
 }
 
-AdviceCandidate Cand(int n, Method m, double rate, double err) {
+AdviceCandidate Cand(int n, const std::string& m, double rate, double err) {
   AdviceCandidate c;
   c.n = n;
   c.method = m;
@@ -257,12 +257,12 @@ AdviceCandidate Cand(int n, Method m, double rate, double err) {
 
 TEST(BenchAdvisor, SelectCheapestPicksTheFastestAcceptableCandidate) {
   std::vector<AdviceCandidate> c = {
-      Cand(10, Method::kNewton, 9e4, 0.2),         // 0 fastest, too inaccurate
-      Cand(10, Method::kNewtonLineSearch, 5e4, 0.01),
-      Cand(10, Method::kHigherOrder, 7e4, 0.04),   // 2 the answer
-      Cand(10, Method::kHigherOrder, 7.2e4, 0.06), // 3 faster, misses the error target
-      Cand(10, Method::kNewtonLineSearch, 900, 0.001),  // 4 too slow
-      Cand(10, Method::kNewton, 8e4, 0.03),        // 5 fast and accurate enough, but chatters
+      Cand(10, "newton", 9e4, 0.2),         // 0 fastest, too inaccurate
+      Cand(10, "newton-ls", 5e4, 0.01),
+      Cand(10, "higher-order", 7e4, 0.04),   // 2 the answer
+      Cand(10, "higher-order", 7.2e4, 0.06), // 3 faster, misses the error target
+      Cand(10, "newton-ls", 900, 0.001),  // 4 too slow
+      Cand(10, "newton", 8e4, 0.03),        // 5 fast and accurate enough, but chatters
   };
   c[5].spurious_reversals = 3;
   EXPECT_EQ(SelectCheapest(c, 0.05, 1000), 2);
@@ -273,8 +273,8 @@ TEST(BenchAdvisor, SelectCheapestPicksTheFastestAcceptableCandidate) {
   c[5].spurious_reversals = 0;
   EXPECT_EQ(SelectCheapest(c, 0.05, 1000), 5);  // without the chatter it is the fastest
   // Rates within kRateTieFraction are a tie (measurement noise): the more accurate wins.
-  EXPECT_EQ(SelectCheapest({Cand(5, Method::kNewton, 1e3, 0.03), Cand(5, Method::kNewton, 0.97e3, 0.02)}, 0.05, 10), 1);
-  EXPECT_EQ(SelectCheapest({Cand(5, Method::kNewton, 1e3, 0.03), Cand(5, Method::kNewton, 0.9e3, 0.02)}, 0.05, 10), 0);
+  EXPECT_EQ(SelectCheapest({Cand(5, "newton", 1e3, 0.03), Cand(5, "newton", 0.97e3, 0.02)}, 0.05, 10), 1);
+  EXPECT_EQ(SelectCheapest({Cand(5, "newton", 1e3, 0.03), Cand(5, "newton", 0.9e3, 0.02)}, 0.05, 10), 0);
 }
 
 // A small strip: 6 segments (resized by the advisor), compressed and lifted a little (no snap), 120 updates.
@@ -297,7 +297,7 @@ AdvisorOptions SmallOptions() {
   // errors 0.09 / 0.32 / 0.33 for n = 3 / 4 / 6): the ladder starts where the error falls.
   o.n_ladder = {8, 12, 16, 24};
   o.reference_n = 48;
-  o.methods = {Method::kNewton, Method::kHigherOrder};
+  o.methods = {"newton", "higher-order"};
   o.cutoffs = {1e-4, 1e-8};
   o.budgets = {1, 0};
   o.repetitions = 1;

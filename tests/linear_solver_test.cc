@@ -19,6 +19,7 @@
 
 #include "linalg/linear_solver.h"
 #include "models/models.h"
+#include "solvers/solver.h"
 
 // ---------------------------------------------------------------------------------
 // Allocation counting. glibc lets a program replace malloc; the replacements forward
@@ -503,6 +504,42 @@ TEST_P(LinearSolverTest, RepeatedFactorizeAndSolveDoNotAllocate) {
     for (LinearSolverStatus s : statuses) EXPECT_EQ(s, LinearSolverStatus::kSuccess);
     EXPECT_EQ(counter.mallocs(), 0) << "n = " << n;
     EXPECT_EQ(counter.news(), 0) << "n = " << n;
+  }
+}
+
+// The equilibrium solvers built on these backends keep their workspace from the first
+// solve (SolverBase): later solves along a path do not touch the heap either, for every
+// method and backend.
+TEST_P(LinearSolverTest, EquilibriumSolvesAfterTheFirstDoNotAllocate) {
+  ModelParams p;
+  p.model = "thread3d";
+  p.n = 12;
+  auto model = MakeModel(p);
+  for (const char* method : {"newton", "newton-ls", "higher-order"}) {
+    SolverOptions o;
+    o.method = method;
+    o.linear_solver = GetParam();
+    auto solver = MakeSolver(*model, o);
+    Vec u = Vec::Zero(model->NumControls());
+    u[0] = 0.8 * p.n;
+    u[1] = 0.5;
+    Vec x = model->InitialState(u);
+    SolverOptions strict = o;
+    strict.method = "newton-ls";
+    strict.max_iterations = 0;
+    MakeSolver(*model, strict)->Solve(u, &x);
+    SolverSummary warm = solver->Solve(u, &x);
+    ASSERT_TRUE(warm.IsConverged()) << method << ": " << warm.BriefReport();
+    std::vector<Termination> terminations(10);
+    AllocationCounter counter;
+    for (int k = 0; k < 10; ++k) {
+      u[1] += 0.01;
+      terminations[k] = solver->Solve(u, &x).termination;
+    }
+    counter.Stop();
+    for (Termination t : terminations) EXPECT_EQ(t, Termination::kConverged) << method;
+    EXPECT_EQ(counter.mallocs(), 0) << method;
+    EXPECT_EQ(counter.news(), 0) << method;
   }
 }
 

@@ -73,7 +73,7 @@ std::vector<StandardSweep> StandardSweeps(const std::string& dir) {
 std::vector<SweepRow> ReferenceTrace(const Scene& scene_in, const std::vector<Vec>& controls, int substeps,
                                      int max_iterations) {
   Scene scene = scene_in;
-  scene.solver.method = Method::kNewtonLineSearch;
+  scene.solver.method = "newton-ls";
   scene.solver.cutoff = 1e-10;
   scene.solver.max_iterations = max_iterations;
   std::vector<Vec> fine{controls.front()};
@@ -200,7 +200,7 @@ void WriteStabilityCsv(const std::vector<StabilityRow>& rows, std::ostream& out)
          "hessians_per_update,us_per_update\n";
   out << std::setprecision(6);
   for (const auto& r : rows)
-    out << r.sweep << ',' << ToString(r.method) << ',' << r.budget << ',' << r.reversals << ','
+    out << r.sweep << ',' << r.method << ',' << r.budget << ',' << r.reversals << ','
         << r.reference_reversals << ',' << r.spurious_reversals << ',' << r.snaps << ',' << r.reference_snaps << ','
         << r.snap_error_steps << ',' << r.extra_snaps << ',' << r.force_error_max << ',' << r.force_error_rms << ','
         << r.state_error_max << ',' << r.mean_gradients << ',' << r.mean_hessians << ',' << r.mean_us << '\n';
@@ -215,7 +215,7 @@ void PrintStabilityTable(const std::vector<StabilityRow>& rows, std::ostream& ou
     const std::string budget = r.budget == 0 ? "inf" : std::to_string(r.budget);
     const std::string snap_err = r.snap_error_steps < 0 ? "missed" : std::to_string(r.snap_error_steps);
     std::snprintf(buf, sizeof buf, "%-16s %-12s %6s %9d %3d/%-2d %9s %6d %11.3e %11.3e %7.2f %7.2f\n",
-                  r.sweep.c_str(), ToString(r.method), budget.c_str(), r.spurious_reversals, r.snaps,
+                  r.sweep.c_str(), r.method.c_str(), budget.c_str(), r.spurious_reversals, r.snaps,
                   r.reference_snaps, snap_err.c_str(), r.extra_snaps, r.force_error_max, r.force_error_rms,
                   r.mean_gradients, r.mean_hessians);
     out << buf;

@@ -26,7 +26,7 @@ std::vector<StandardSweep> StandardSweeps(const std::string& scenes_dir);
 
 struct StabilityRow {
   std::string sweep;
-  Method method = Method::kNewton;
+  std::string method;  // a registered solver name
   int budget = 0;              // iterations per update, 0 = unlimited
   int reversals = 0;           // sign changes of successive force differences (all components)
   int reference_reversals = 0;

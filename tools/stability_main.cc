@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "solvers/registry.h"
 #include "stability.h"
 #include "tool_main.h"
 
@@ -42,11 +43,11 @@ std::vector<int> ParseInts(const std::string& s, const char* what) {
 
 // Charted force traces of one sweep at one budget: reference and every method.
 void WriteTraces(const fs::path& file, const StandardSweep& sw, const std::vector<SweepRow>& ref,
-                 const std::map<Method, std::vector<SweepRow>>& traces) {
+                 const std::vector<std::pair<std::string, std::vector<SweepRow>>>& traces) {
   std::ofstream out(file);
   const int c = sw.force_component;
   out << "step,control_distance,reference";
-  for (const auto& [m, t] : traces) out << ',' << ToString(m);
+  for (const auto& [m, t] : traces) out << ',' << m;
   out << '\n';
   for (size_t i = 0; i < ref.size(); ++i) {
     out << i << ',' << i * sw.step << ',' << ref[i].force[c];
@@ -68,10 +69,16 @@ bool Plot(const fs::path& dir, const std::vector<std::pair<std::string, int>>& s
      << " iterations per update (reference: newton-ls, cutoff 1e-10, 10x finer steps)'\n";
   for (const auto& [name, snap] : sweeps) {
     const std::string f = (dir / ("traces_" + name + ".csv")).string();
-    const std::string curves = "'" + f + "' using 1:4 with lines lw 1 lc rgb '#1f77b4' title 'newton', " +
-                               "'' using 1:5 with lines lw 1 lc rgb '#ff7f0e' title 'newton-ls', " +
-                               "'' using 1:6 with lines lw 2 lc rgb '#2ca02c' title 'higher-order', " +
-                               "'' using 1:3 with lines lw 1 dt 2 lc rgb '#d62728' title 'reference'\n";
+    // One curve per registered method (columns 4, 5, ... of the traces), the default
+    // method (the seed's proposal) drawn thicker, then the reference.
+    std::string curves;
+    int column = 4;
+    for (const std::string& m : SolverRegistry::Global().Names()) {
+      curves += (curves.empty() ? "'" + f + "'" : std::string("''")) + " using 1:" + std::to_string(column++) +
+                " with lines lw " + (m == SolverOptions{}.method ? "2" : "1") + " lc rgb '" + MethodColor(m) +
+                "' title '" + m + "', ";
+    }
+    curves += "'' using 1:3 with lines lw 1 dt 2 lc rgb '#d62728' title 'reference'\n";
     gp << "set title '" << name << "'\nset xlabel 'update'\nset ylabel 'force component'\nset autoscale x\n"
        << "plot " << curves;
     gp << "set title '" << name << ": zoom on the first snap'\n";
@@ -173,8 +180,8 @@ int main(int argc, char** argv) {
       std::cerr << "stability: " << sw.name << " (" << sw.controls.size() << " updates): " << sw.description << '\n';
       const Scene scene = LoadScene(sw.scene_file);
       const auto ref = ReferenceTrace(scene, sw.controls, substeps);
-      std::map<Method, std::vector<SweepRow>> chart;
-      for (Method m : {Method::kNewton, Method::kNewtonLineSearch, Method::kHigherOrder}) {
+      std::vector<std::pair<std::string, std::vector<SweepRow>>> chart;
+      for (const std::string& m : SolverRegistry::Global().Names()) {
         for (int k : budgets) {
           Scene sc = scene;
           sc.solver.method = m;
@@ -186,10 +193,10 @@ int main(int argc, char** argv) {
           row.method = m;
           row.budget = k;
           table.push_back(row);
-          if (k == plot_budget) chart[m] = std::move(trace);
+          if (k == plot_budget) chart.emplace_back(m, std::move(trace));
         }
       }
-      if (chart.size() == 3) {
+      if (chart.size() == SolverRegistry::Global().Entries().size()) {
         WriteTraces(fs::path(out_dir) / ("traces_" + sw.name + ".csv"), sw, ref, chart);
         int first_snap = 0;
         for (const auto& r : ref)

@@ -76,7 +76,7 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
   return rows;
 }
 
-void WriteSweepCsv(const std::vector<SweepRow>& rows, Method method, std::ostream& out) {
+void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out) {
   out << "step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,"
          "solve_us,status,termination,gradient_evals,hessian_evals\n";
   out << std::setprecision(12);
@@ -85,7 +85,7 @@ void WriteSweepCsv(const std::vector<SweepRow>& rows, Method method, std::ostrea
     const bool planar = r.u.size() == 2;
     out << r.step << ',' << comp(r.u, 0) << ',' << comp(r.u, 1) << ',' << (planar ? 0.0 : comp(r.u, 2)) << ','
         << comp(r.force, 0) << ',' << comp(r.force, 1) << ',' << (planar ? 0.0 : comp(r.force, 2)) << ','
-        << r.probe << ',' << r.energy << ',' << r.residual << ',' << r.iterations << ',' << ToString(method)
+        << r.probe << ',' << r.energy << ',' << r.residual << ',' << r.iterations << ',' << method
         << ',' << r.lambda_min << ',' << (r.snapped ? 1 : 0) << ',' << std::setprecision(4) << r.solve_us
         << std::setprecision(12) << ',' << ToString(r.status) << ',' << ToString(r.termination) << ','
         << r.gradient_evaluations << ',' << r.hessian_evaluations << '\n';
@@ -109,6 +109,15 @@ Vec ParsePoint(const std::string& text, int dim, const std::string& what) {
     throw std::invalid_argument(what + ": expected " + std::to_string(dim) + " comma-separated numbers (" +
                                 (dim == 2 ? "X,Y" : "X,Y,Z") + "), got '" + text + "'");
   return Eigen::Map<Vec>(vals.data(), dim);
+}
+
+const char* MethodColor(std::string_view method) {
+  static constexpr const char* kPalette[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"};
+  const auto& entries = SolverRegistry::Global().Entries();
+  for (size_t i = 0; i < entries.size(); ++i) {
+    if (entries[i].name == method) return kPalette[i % std::size(kPalette)];
+  }
+  return "#000000";
 }
 
 }  // namespace snapthread

@@ -4,9 +4,11 @@
 
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scene/scene.h"
+#include "solvers/registry.h"
 #include "tracking/tracker.h"
 
 namespace snapthread {
@@ -45,7 +47,10 @@ std::unique_ptr<EquilibriumTracker> MakeTracker(const Scene& scene);
 
 // The CSV of snapthread-sweep: header, then one line per row. The first columns are
 // step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,solve_us
-void WriteSweepCsv(const std::vector<SweepRow>& rows, Method method, std::ostream& out);
+void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out);
+
+// Line colour of a registered method in the gnuplot charts (by registration order).
+const char* MethodColor(std::string_view method);
 
 // Parses "x,y[,z]" with `dim` finite numbers; throws std::invalid_argument naming `what`.
 Vec ParsePoint(const std::string& text, int dim, const std::string& what);

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "solvers/registry.h"
 #include "sweep.h"
 #include "tool_main.h"
 
@@ -26,7 +27,7 @@ int main(int argc, char** argv) {
   path_opt->excludes(from_opt)->excludes(to_opt);
   app.add_option("--steps", steps, "number of equal steps N (rows 0..N), or per leg with --path");
   app.add_flag("--back", back, "continue N more steps back to --from (2N+1 rows)");
-  app.add_option("--method", method, "newton | newton-ls | higher-order (default: the scene's)");
+  app.add_option("--method", method, SolverRegistry::Global().NamesText(" | ", " | ") + " (default: the scene's)");
   app.add_option("--cutoff", cutoff, "stop when |E_x| < cutoff (default: the scene's)");
   app.add_option("--max-iterations", max_iterations, "iteration budget per step, 0 = unlimited");
   app.add_option("--set", sets, "override a scene key, e.g. --set params.n=20 (repeatable)");
@@ -35,8 +36,12 @@ int main(int argc, char** argv) {
     std::vector<SceneOverride> overrides;
     for (const auto& s : sets) overrides.push_back(ParseOverride(s));
     Scene scene = LoadScene(scene_file, overrides);
-    if (!method.empty() && !ParseMethod(method, &scene.solver.method))
-      throw std::invalid_argument("--method: expected newton, newton-ls or higher-order, got '" + method + "'");
+    if (!method.empty()) {
+      if (SolverRegistry::Global().Find(method) == nullptr)
+        throw std::invalid_argument("--method: expected " + SolverRegistry::Global().NamesText(", ", " or ") +
+                                    ", got '" + method + "'");
+      scene.solver.method = method;
+    }
     if (app.count("--cutoff")) {
       if (!(cutoff > 0.0)) throw std::invalid_argument("--cutoff: expected a number > 0");
       scene.solver.cutoff = cutoff;

@@ -91,7 +91,7 @@ bool FollowedMinimum(const ReducedQuartic& q, double cap, double* s_out) {
 
 HigherOrderSolver::HigherOrderSolver(const Model& model, const SolverOptions& options)
     : SolverBase(model, options) {
-  for (Vec* v : {&delta_, &vt_, &w_, &rhs_, &gp_, &gm_, &xs_}) v->resize(n_);
+  for (Vec* v : {&delta_, &vt_, &w_, &rhs_, &gp_, &gm_, &xs_}) v->resize(num_states());
   col_k_rows_.reserve(64);
   col_k_pos_.reserve(64);
   row_k_pos_.reserve(64);
@@ -101,10 +101,10 @@ LinearSolverStatus HigherOrderSolver::FactorRestricted(int k, SolverSummary* s) 
   // H_{-k,-k} of (2.52): the same pattern with row and column k replaced by e_k, so the
   // symbolic analysis is shared and a solve returns vectors with component k equal to
   // the right-hand side's k-th entry.
-  std::copy(h_.valuePtr(), h_.valuePtr() + h_.nonZeros(), h_mod_.valuePtr());
-  const int* outer = h_mod_.outerIndexPtr();
-  const int* inner = h_mod_.innerIndexPtr();
-  double* val = h_mod_.valuePtr();
+  SparseMatrix& h_mod = ModifiedHessian();
+  const int* outer = h_mod.outerIndexPtr();
+  const int* inner = h_mod.innerIndexPtr();
+  double* val = h_mod.valuePtr();
   for (int p = outer[k]; p < outer[k + 1]; ++p) {
     const int i = inner[p];
     val[p] = (i == k) ? 1.0 : 0.0;
@@ -115,14 +115,13 @@ LinearSolverStatus HigherOrderSolver::FactorRestricted(int k, SolverSummary* s) 
     const int* it = std::lower_bound(b, e, k);
     if (it != e && *it == k) val[it - inner] = 0.0;
   }
-  ++s->factorizations;
-  return alt_factor_->Factorize(h_mod_);
+  return FactorModified(s);
 }
 
 HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec* x,
                                                                SolverSummary* s) {
   s->used_reduction = true;
-  const Vec& v = eig_.vector();
+  const Vec& v = LowestEigenvector();
   // Scale v so its largest-modulus component v_k = 1 (2.44).
   int k = 0;
   v.cwiseAbs().maxCoeff(&k);
@@ -132,18 +131,20 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
   // It equals v at the fold and makes the correction exactly Newton on a quadratic.
   rhs_.setZero();
   {
-    const int* outer = h_.outerIndexPtr();
-    const int* inner = h_.innerIndexPtr();
-    const double* val = h_.valuePtr();
+    const SparseMatrix& hess = Hessian();
+    const int* outer = hess.outerIndexPtr();
+    const int* inner = hess.innerIndexPtr();
+    const double* val = hess.valuePtr();
     for (int p = outer[k]; p < outer[k + 1]; ++p) rhs_[inner[p]] = -val[p];
   }
   rhs_[k] = 1.0;
-  if (alt_factor_->Solve(rhs_, &vt_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+  if (SolveModified(rhs_, &vt_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
 
   // Newton in the complement: delta with delta_k = 0 and (E_x + H delta)_{-k} = 0.
-  rhs_ = -g_;
+  const Vec& g = Gradient();
+  rhs_ = -g;
   rhs_[k] = 0.0;
-  if (alt_factor_->Solve(rhs_, &delta_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+  if (SolveModified(rhs_, &delta_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
 
   // r = D^3E[v', v'] by central differences of the analytic gradient (2.37), and
   // q = (g+ - g-)/2h = H v' + h^2/6 D^4E[v',v',v'] for the quartic coefficient.
@@ -153,15 +154,16 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
   xs_ = *x - h * vt_;
   EvalGradient(xs_, u, &gm_, s);
   // r into rhs_ (scratch), q into gp_.
-  rhs_ = (gp_ - 2.0 * g_ + gm_) / (h * h);
+  rhs_ = (gp_ - 2.0 * g + gm_) / (h * h);
   gp_ = (gp_ - gm_) / (2.0 * h);
 
   // Hv' has zero components off k by construction of v'; (Hv')_k = H_{k,:} v'.
   double hvv = 0.0;
   {
-    const int* outer = h_.outerIndexPtr();
-    const int* inner = h_.innerIndexPtr();
-    const double* val = h_.valuePtr();
+    const SparseMatrix& hess = Hessian();
+    const int* outer = hess.outerIndexPtr();
+    const int* inner = hess.innerIndexPtr();
+    const double* val = hess.valuePtr();
     for (int p = outer[k]; p < outer[k + 1]; ++p) hvv += val[p] * vt_[inner[p]];
   }
   const double r_v = rhs_.dot(vt_);           // D^3E[v',v',v']
@@ -170,7 +172,7 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
   // (2.52): H_{-k,-k} w_{-k} = -1/2 r_{-k}, w_k = 0.
   gm_ = -0.5 * rhs_;
   gm_[k] = 0.0;
-  if (alt_factor_->Solve(gm_, &w_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+  if (SolveModified(gm_, &w_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
   const double r_w = rhs_.dot(w_);            // D^3E[v',v',w]
 
   // (2.54-2.55) along c(s) = x + delta + s v' + s^2 w. With (Hv')_{-k} = 0, w_k = 0
@@ -178,22 +180,22 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
   //   phi1 = E_x.v'   phi2 = 1/2 v'^T H v'   phi3 = 1/6 D^3[v'^3] + v'^T H w = 1/6 D^3[v'^3]
   //   phi4 = 1/2 w^T H w + 1/2 D^3[v',v',w] + 1/24 D^4[v'^4] = 1/4 r.w + 1/24 D^4[v'^4]
   ReducedQuartic q;
-  q.phi1 = g_.dot(vt_);
+  q.phi1 = g.dot(vt_);
   q.phi2 = 0.5 * hvv;
   q.phi3 = r_v / 6.0;
   q.phi4 = 0.25 * r_w + d4 / 24.0;
 
   double s_star = 0.0;
-  if (!FollowedMinimum(q, options_.max_reduction_step, &s_star)) return StepResult::kSnap;
+  if (!FollowedMinimum(q, options().max_reduction_step, &s_star)) return StepResult::kSnap;
 
   // Energy decrease (Armijo-type) on every higher-order step (DESIGN.md #4): backtrack
   // along the curve; a step that cannot decrease the energy is refused.
-  const double e0 = model_.Energy(*x, u);
+  const double e0 = model().Energy(*x, u);
   double alpha = 1.0;
   for (int it = 0; it < 12; ++it) {
     const double ss = alpha * s_star;
     xs_ = *x + alpha * delta_ + ss * vt_ + (ss * ss) * w_;
-    const double e = model_.Energy(xs_, u);
+    const double e = model().Energy(xs_, u);
     if (std::isfinite(e) && e <= e0 + 1e-14 * std::abs(e0)) {
       x->swap(xs_);
       return StepResult::kAccepted;
@@ -210,10 +212,9 @@ bool HigherOrderSolver::FinishSnap(const Vec& u, Vec* x, SolverSummary* s) {
 
 SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   SolverSummary s;
-  BeginSolve(&s);
+  if (!BeginSolve(u, *x, &s)) return s;
   Vec& xr = *x;
-  last_good_ = xr;
-  double r = EvalGradient(xr, u, &g_, &s);
+  double r = EvalGradient(xr, u, &s);
   s.termination = Termination::kBudgetSpent;
   bool newton_stalled = false;
   int reduction_stalls = 0;
@@ -223,8 +224,8 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       s.termination = Termination::kLinearSolverFailed;
       s.message = "snap minimiser did not converge";
     }
-    r = EvalGradient(xr, u, &g_, &s);
-    if (s.termination != Termination::kLinearSolverFailed && r < options_.cutoff)
+    r = EvalGradient(xr, u, &s);
+    if (s.termination != Termination::kLinearSolverFailed && r < options().cutoff)
       s.termination = Termination::kConverged;
   };
   while (NextIteration(r, x, &s)) {
@@ -232,34 +233,34 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
     bool degenerate = true;
     double lambda0 = 0.0;
     if (st == LinearSolverStatus::kSuccess) {
-      lambda0 = eig_.Update(*factor_, h_, 1);
-      // DESIGN.md #1: degeneracy against a reference lambda_0, never against the
-      // largest diagonal entry (stretching sets the diagonal).
-      const bool indefinite = factor_->NegativePivots() > 0;
-      const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : lambda0;
-      degenerate = indefinite || !(lambda0 > options_.degeneracy_ratio * ref) || newton_stalled;
+      lambda0 = UpdateEigenpair(1);
+      // DESIGN.md #1: degeneracy against a reference lambda_0 (the test DecideStatus
+      // applies to the returned state).
+      degenerate = NearFold(lambda0, HessianFactor().NegativePivots(), ReferenceLambda(),
+                            options().degeneracy_ratio) ||
+                   newton_stalled;
     }
     if (!degenerate) {
       // Regular: the Newton step (2.18).
-      if (factor_->Solve(g_, &dx_) != LinearSolverStatus::kSuccess) {
+      if (ComputeNewtonStep() != LinearSolverStatus::kSuccess) {
         s.termination = Termination::kLinearSolverFailed;
         break;
       }
       // A Newton step longer than the reduction's cap leaves the region where the
       // quadratic model holds: the control step has carried the state over a fold while
       // lambda_0 still looked regular (DESIGN.md's open case). Finish it as a snap.
-      if (dx_.lpNorm<Eigen::Infinity>() > options_.max_reduction_step) {
+      if (NewtonStep().lpNorm<Eigen::Infinity>() > options().max_reduction_step) {
         snap_and_stop();
         break;
       }
       // Approaching a fold (lambda_0 below its reference) a Newton step must also
       // lower the energy; one that raises it is aimed at the saddle that is about to
       // meet the followed minimum, so this iteration uses the reduction instead.
-      const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : lambda0;
+      const double ref = ReferenceLambda() > 0.0 ? ReferenceLambda() : lambda0;
       bool take_newton = true;
       if (lambda0 < 1.0 * ref) {
-        xs_ = xr - dx_;
-        take_newton = model_.Energy(xs_, u) <= model_.Energy(xr, u);
+        xs_ = xr - NewtonStep();
+        take_newton = model().Energy(xs_, u) <= model().Energy(xr, u);
       }
       if (!take_newton) {
         degenerate = true;
@@ -271,17 +272,17 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       // even halve |E_x| says the quadratic model has failed (a fold is close): the
       // next iteration uses the reduction.
       const double r_before = r;
-      r = EvalGradient(xr, u, &g_, &s);
+      r = EvalGradient(xr, u, &s);
       newton_stalled = !(r < 0.5 * r_before);
       continue;
     }
     {
       // A factorisation that failed on an exactly singular E_xx still allows the
       // reduction: it needs only the restricted factor and the last eigenvector.
-      const bool many_negative = st == LinearSolverStatus::kSuccess && factor_->NegativePivots() > 1;
+      const bool many_negative = st == LinearSolverStatus::kSuccess && HessianFactor().NegativePivots() > 1;
       StepResult res = StepResult::kFailed;
       if (!many_negative) {
-        eig_.EnsureInitialized(n_);
+        EnsureEigenvector();
         res = ReductionStep(u, &xr, &s);
       }
       if (res == StepResult::kSnap || many_negative) {
@@ -290,7 +291,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       }
       if (res == StepResult::kFailed) {
         // The reduction could not decrease the energy: one globalised step instead.
-        if (!GlobalizedStep(u, &xr, &g_, &s)) {
+        if (!GlobalizedStep(u, &xr, &s)) {
           s.termination = Termination::kLinearSolverFailed;
           s.message = "no descent step found";
           break;
@@ -303,7 +304,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       // A reduction step that raises |E_x| (the energy fell, the force grew) says the
       // same at once.
       const double r_before = r;
-      r = EvalGradient(xr, u, &g_, &s);
+      r = EvalGradient(xr, u, &s);
       reduction_stalls = (r < 0.5 * r_before) ? 0 : reduction_stalls + 1;
       if (reduction_stalls >= 2 || r > r_before) {
         snap_and_stop();
@@ -312,17 +313,8 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       continue;
     }
   }
-  Conclude(u, x, &s, /*leave_saddles=*/true);
-  // The budget ran out on an indefinite E_xx: the state
-  // is past the fold, where the followed minimum no longer exists. Finish the snap in
-  // this update (DESIGN.md #4) instead of crawling over the next ones. (If a minimum is
-  // right there after all, the minimiser simply converges to it: no jump, no snap.)
-  if (s.termination == Termination::kBudgetSpent && s.negative_pivots > 0) {
-    s.snapped = true;
-    if (MinimizeFully(u, x, &s)) s.termination = Termination::kConverged;
-    Finish(*x, u, &s);
-    Classify(&s);
-  }
+  // A budget spent on an indefinite E_xx finishes the snap in this update (Conclude).
+  Conclude(u, x, &s, /*leave_saddles=*/true, /*finish_snap_on_spent_budget=*/true);
   return s;
 }
 

@@ -9,55 +9,64 @@ namespace snapthread {
 
 SolverBase::SolverBase(const Model& model, const SolverOptions& options)
     : model_(model), options_(options), n_(model.NumStates()) {
-  h_ = model_.HessianPattern();
-  h_mod_ = h_;
+  if (n_ <= 0) throw std::invalid_argument("solver: the model has no state variables");
+  Workspace& w = ws_;
+  w.h = model_.HessianPattern();
+  if (w.h.rows() != n_ || w.h.cols() != n_)
+    throw std::invalid_argument("solver: the model's Hessian pattern is not NumStates() square");
+  w.h_mod = w.h;
   std::string error;
-  factor_ = MakeLinearSolver(options_.linear_solver, n_, model_.HessianBandwidth(), &error);
-  alt_factor_ = MakeLinearSolver(options_.linear_solver, n_, model_.HessianBandwidth(), &error);
-  if (!factor_ || !alt_factor_) throw std::invalid_argument("solver.linear_solver: " + error);
-  if (factor_->Analyze(h_) != LinearSolverStatus::kSuccess ||
-      alt_factor_->Analyze(h_) != LinearSolverStatus::kSuccess) {
-    throw std::runtime_error("linear solver analysis failed: " + factor_->message());
+  w.factor = MakeLinearSolver(options_.linear_solver, n_, model_.HessianBandwidth(), &error);
+  w.alt_factor = MakeLinearSolver(options_.linear_solver, n_, model_.HessianBandwidth(), &error);
+  if (!w.factor || !w.alt_factor) throw std::invalid_argument("solver.linear_solver: " + error);
+  if (w.factor->Analyze(w.h) != LinearSolverStatus::kSuccess ||
+      w.alt_factor->Analyze(w.h) != LinearSolverStatus::kSuccess) {
+    throw std::runtime_error("linear solver analysis failed: " + w.factor->message());
   }
-  diag_index_.assign(n_, -1);
+  w.diag_index.assign(n_, -1);
   for (int j = 0; j < n_; ++j) {
-    for (int p = h_.outerIndexPtr()[j]; p < h_.outerIndexPtr()[j + 1]; ++p) {
-      if (h_.innerIndexPtr()[p] == j) diag_index_[j] = p;
+    for (int p = w.h.outerIndexPtr()[j]; p < w.h.outerIndexPtr()[j + 1]; ++p) {
+      if (w.h.innerIndexPtr()[p] == j) w.diag_index[j] = p;
     }
-    if (diag_index_[j] < 0) throw std::logic_error("Hessian pattern lacks a diagonal entry");
+    if (w.diag_index[j] < 0) throw std::logic_error("Hessian pattern lacks a diagonal entry");
   }
-  eig_.Resize(n_);
-  g_.resize(n_);
-  dx_.resize(n_);
-  trial_.resize(n_);
-  last_good_.resize(n_);
-  dx_scratch_.resize(n_);
+  w.eig.Resize(n_);
+  for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch}) v->resize(n_);
 }
 
 void SolverBase::Reset() {
-  eig_.Reset();
+  ws_.eig.Reset();
   factor_valid_ = false;
   lambda_ref_ = -1.0;
 }
 
-void SolverBase::Classify(SolverSummary* s) {
-  const bool indefinite = s->negative_pivots != 0;
-  const double ref = lambda_ref_ > 0.0 ? lambda_ref_ : s->lambda_min;
-  const bool near_fold = indefinite || !(s->lambda_min > options_.degeneracy_ratio * ref);
-  if (!near_fold && (s->IsConverged() || s->snapped)) lambda_ref_ = s->lambda_min;
-  // kSnapped is decided by the caller from the jump of the state (EquilibriumTracker).
-  s->status = near_fold ? EquilibriumStatus::kNearFold : EquilibriumStatus::kRegular;
+const SymmetricLinearSolver* SolverBase::Factorization() const {
+  return factor_valid_ ? ws_.factor.get() : nullptr;
 }
 
 int SolverBase::Budget() const {
   return options_.max_iterations > 0 ? options_.max_iterations : SolverOptions::kUnlimitedIterations;
 }
 
-void SolverBase::BeginSolve(SolverSummary* s) {
+bool SolverBase::BeginSolve(const Vec& u, const Vec& x, SolverSummary* s) {
   *s = SolverSummary{};
   start_ = Clock::now();
   factor_valid_ = false;
   factor_before_tiny_step_ = false;
+  // Eigen checks sizes only with assertions on: a Release build must check here.
+  const char* why = nullptr;
+  if (x.size() != n_) why = "the state has the wrong size";
+  else if (u.size() != model_.NumControls()) why = "the controls have the wrong size";
+  else if (!x.allFinite()) why = "the warm start is not finite";
+  else if (!u.allFinite()) why = "the controls are not finite";
+  if (why != nullptr) {
+    s->termination = Termination::kInvalidInput;
+    s->message = why;
+    s->negative_pivots = -1;
+    return false;
+  }
+  ws_.last_good = x;
+  return true;
 }
 
 // A Newton step this small (model length units) changes E_xx by a relative O(1e-6):
@@ -67,13 +76,13 @@ void SolverBase::BeginSolve(SolverSummary* s) {
 constexpr double kReuseStep = 1e-6;
 
 void SolverBase::TakeNewtonStep(Vec* x) {
-  *x -= dx_;
-  factor_before_tiny_step_ = dx_.lpNorm<Eigen::Infinity>() <= kReuseStep;
+  *x -= ws_.dx;
+  factor_before_tiny_step_ = ws_.dx.lpNorm<Eigen::Infinity>() <= kReuseStep;
 }
 
 bool SolverBase::NextIteration(double r, Vec* x, SolverSummary* s) {
   if (!std::isfinite(r)) {
-    *x = last_good_;
+    *x = ws_.last_good;
     s->termination = Termination::kNonFinite;
     s->message = "non-finite gradient; state restored";
     return false;
@@ -97,20 +106,35 @@ bool SolverBase::NextIteration(double r, Vec* x, SolverSummary* s) {
     return false;
   }
   ++s->iterations;
-  last_good_ = *x;
+  ws_.last_good = *x;
   return true;
 }
 
-void SolverBase::Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_saddles) {
+void SolverBase::Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_saddles,
+                          bool finish_snap_on_spent_budget) {
   bool gradient_current = s->termination != Termination::kNonFinite;
   if (!x->allFinite()) {
-    *x = last_good_;
+    *x = ws_.last_good;
     s->termination = Termination::kNonFinite;
     gradient_current = false;
   }
   Finish(*x, u, s, gradient_current);
   if (leave_saddles) LeaveSaddle(u, x, s);
-  Classify(s);
+  // The budget ran out on an indefinite E_xx: the state is past the fold, where the
+  // followed minimum no longer exists. Finish the snap in this update (DESIGN.md #4)
+  // instead of crawling over the next ones. (If a minimum is right there after all, the
+  // minimiser simply converges to it: no jump, no snap.)
+  if (finish_snap_on_spent_budget && s->termination == Termination::kBudgetSpent &&
+      s->negative_pivots > 0) {
+    s->snapped = true;
+    if (MinimizeFully(u, x, s)) s->termination = Termination::kConverged;
+    Finish(*x, u, s);
+  }
+  // The status against the reference of the last regular state, then the reference.
+  s->lambda_ref = lambda_ref_;
+  s->status = DecideStatus(*s, options_.degeneracy_ratio, /*left_branch=*/false);
+  if (s->status == EquilibriumStatus::kRegular && (s->IsConverged() || s->snapped))
+    lambda_ref_ = s->lambda_min;
 }
 
 bool SolverBase::BudgetLeft(const SolverSummary& s) const {
@@ -128,54 +152,70 @@ double SolverBase::EvalGradient(const Vec& x, const Vec& u, Vec* g, SolverSummar
   return g->norm();
 }
 
+double SolverBase::EvalGradient(const Vec& x, const Vec& u, SolverSummary* s) {
+  return EvalGradient(x, u, &ws_.g, s);
+}
+
 LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummary* s) {
-  model_.Hessian(x, u, &h_);
+  model_.Hessian(x, u, &ws_.h);
   ++s->hessian_evaluations;
   ++s->factorizations;
-  const LinearSolverStatus st = factor_->Factorize(h_);
+  const LinearSolverStatus st = ws_.factor->Factorize(ws_.h);
   factor_valid_ = st == LinearSolverStatus::kSuccess;
   factor_before_tiny_step_ = false;
   return st;
 }
 
-LinearSolverStatus SolverBase::FactorShifted(double shift, SolverSummary* s) {
-  std::copy(h_.valuePtr(), h_.valuePtr() + h_.nonZeros(), h_mod_.valuePtr());
-  for (int i = 0; i < n_; ++i) h_mod_.valuePtr()[diag_index_[i]] += shift;
-  ++s->factorizations;
-  return alt_factor_->Factorize(h_mod_);
+SparseMatrix& SolverBase::ModifiedHessian() {
+  std::copy(ws_.h.valuePtr(), ws_.h.valuePtr() + ws_.h.nonZeros(), ws_.h_mod.valuePtr());
+  return ws_.h_mod;
 }
 
-bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s) {
+LinearSolverStatus SolverBase::FactorModified(SolverSummary* s) {
+  ++s->factorizations;
+  return ws_.alt_factor->Factorize(ws_.h_mod);
+}
+
+LinearSolverStatus SolverBase::FactorShifted(double shift, SolverSummary* s) {
+  double* val = ModifiedHessian().valuePtr();
+  for (int i = 0; i < n_; ++i) val[ws_.diag_index[i]] += shift;
+  return FactorModified(s);
+}
+
+bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, SolverSummary* s) {
+  Workspace& w = ws_;
+  const Vec* g = &w.g;
   // Inertia-corrected Newton (Nocedal & Wright, Alg. 3.3): add tau I until the LDL^T
   // has no negative pivot, then backtrack on the energy (Armijo).
   const LinearSolverStatus st = FactorAt(*x, u, s);
-  const SymmetricLinearSolver* f = factor_.get();
-  if (st != LinearSolverStatus::kSuccess || factor_->NegativePivots() > 0) {
+  const SymmetricLinearSolver* f = w.factor.get();
+  if (st != LinearSolverStatus::kSuccess || w.factor->NegativePivots() > 0) {
     double max_diag = 0.0;
-    for (int i = 0; i < n_; ++i) max_diag = std::max(max_diag, std::abs(h_.valuePtr()[diag_index_[i]]));
+    for (int i = 0; i < n_; ++i) max_diag = std::max(max_diag, std::abs(w.h.valuePtr()[w.diag_index[i]]));
     double tau = std::max(1e-3 * max_diag, 1e-8);
     if (st == LinearSolverStatus::kSuccess) {
       // Indefinite but factorised: shift by twice the most negative eigenvalue's size
       // (tracked by inverse iteration), so the step along that mode is as long as a
       // Newton step, not a creeping gradient step (escaping a symmetric saddle).
-      const double lambda0 = eig_.Update(*factor_, h_, 4);
+      const double lambda0 = UpdateEigenpair(4);
       if (lambda0 < 0.0) tau = std::max(2.0 * std::abs(lambda0), 1e-10 * max_diag);
     }
     bool ok = false;
     for (int k = 0; k < 60; ++k) {
-      if (FactorShifted(tau, s) == LinearSolverStatus::kSuccess && alt_factor_->NegativePivots() == 0) {
+      if (FactorShifted(tau, s) == LinearSolverStatus::kSuccess && w.alt_factor->NegativePivots() == 0) {
         ok = true;
         break;
       }
       tau *= 4.0;
     }
     if (!ok) return false;
-    f = alt_factor_.get();
+    f = w.alt_factor.get();
   }
-  if (f->Solve(*g, &dx_) != LinearSolverStatus::kSuccess) return false;
-  dx_ = -dx_;
+  Vec& dx = w.dx;
+  if (f->Solve(*g, &dx) != LinearSolverStatus::kSuccess) return false;
+  dx = -dx;
   const double e0 = model_.Energy(*x, u);
-  const double slope = g->dot(dx_);
+  const double slope = g->dot(dx);
   if (!(slope < 0.0)) return false;
   // Near convergence the decrease falls below the round-off of E itself; there the
   // full step is accepted when it reduces |E_x| (a gradient-norm fallback).
@@ -183,17 +223,17 @@ bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s) 
   const double g0 = g->norm();
   double alpha = 1.0;
   for (int k = 0; k < 40; ++k) {
-    trial_ = *x + alpha * dx_;
-    const double e = model_.Energy(trial_, u);
+    w.trial = *x + alpha * dx;
+    const double e = model_.Energy(w.trial, u);
     if (std::isfinite(e) && e <= e0 + 1e-4 * alpha * slope) {
-      x->swap(trial_);
+      x->swap(w.trial);
       return true;
     }
     if (std::isfinite(e) && std::abs(e - e0) <= noise) {
-      model_.Gradient(trial_, u, &dx_scratch_);
+      model_.Gradient(w.trial, u, &w.dx_scratch);
       ++s->gradient_evaluations;
-      if (dx_scratch_.norm() < g0) {
-        x->swap(trial_);
+      if (w.dx_scratch.norm() < g0) {
+        x->swap(w.trial);
         return true;
       }
     }
@@ -203,7 +243,7 @@ bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s) 
 }
 
 void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradient_current) {
-  s->residual = gradient_current ? g_.norm() : EvalGradient(x, u, &g_, s);
+  s->residual = gradient_current ? ws_.g.norm() : EvalGradient(x, u, s);
   s->energy = model_.Energy(x, u);
   // The factorisation at the returned state serves implicit differentiation (K) and
   // the eigenvalue estimate (or the one before a tiny last Newton step, kReuseStep).
@@ -211,9 +251,9 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradi
       (factor_before_tiny_step_ && factor_valid_) ? LinearSolverStatus::kSuccess : FactorAt(x, u, s);
   factor_before_tiny_step_ = false;
   if (st == LinearSolverStatus::kSuccess) {
-    s->negative_pivots = factor_->NegativePivots();
+    s->negative_pivots = ws_.factor->NegativePivots();
     // Two warm-started steps track the eigenpair; a cold start or a new branch needs more.
-    s->lambda_min = eig_.Update(*factor_, h_, eig_.initialized() && !s->snapped ? 2 : 40);
+    s->lambda_min = UpdateEigenpair(ws_.eig.initialized() && !s->snapped ? 2 : 40);
   } else {
     s->negative_pivots = -1;
     s->lambda_min = 0.0;  // singular to working precision
@@ -223,39 +263,40 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradi
 
 bool SolverBase::MinimizeFully(const Vec& u, Vec* x, SolverSummary* s) {
   constexpr int kMaxIterations = 400;  // the snap minimiser converges in ~10-20
-  double r = EvalGradient(*x, u, &g_, s);
+  double r = EvalGradient(*x, u, s);
   for (int it = 0; it < kMaxIterations; ++it) {
     if (!std::isfinite(r)) return false;
     if (r < options_.cutoff) {
       // Stationary: a minimum only if E_xx has no negative pivot.
-      if (FactorAt(*x, u, s) != LinearSolverStatus::kSuccess || factor_->NegativePivots() == 0) return true;
-      eig_.Update(*factor_, h_, 8);
-      const Vec& v = eig_.vector();
+      if (FactorAt(*x, u, s) != LinearSolverStatus::kSuccess || ws_.factor->NegativePivots() == 0) return true;
+      UpdateEigenpair(8);
+      const Vec& v = ws_.eig.vector();
+      Vec& trial = ws_.trial;
       const double e0 = model_.Energy(*x, u);
       // Along the negative mode E falls as lambda s^2 / 2 for small s, and may rise
       // again at once (a pitchfork's quartic): halve the step until E decreases.
       double step = 0.2 * options_.max_reduction_step / std::max(v.lpNorm<Eigen::Infinity>(), 1e-300);
       bool moved = false;
       for (int k = 0; k < 30 && !moved; ++k, step *= 0.5) {
-        trial_ = *x + step * v;
-        const double ep = model_.Energy(trial_, u);
-        trial_ = *x - step * v;
-        const double em = model_.Energy(trial_, u);
+        trial = *x + step * v;
+        const double ep = model_.Energy(trial, u);
+        trial = *x - step * v;
+        const double em = model_.Energy(trial, u);
         if (std::min(ep, em) < e0) {
           *x += (ep < em ? step : -step) * v;
           moved = true;
         }
       }
       if (!moved) return true;  // flat to round-off: accept
-      r = EvalGradient(*x, u, &g_, s);
+      r = EvalGradient(*x, u, s);
       continue;
     }
     ++s->iterations;
-    if (!GlobalizedStep(u, x, &g_, s)) {
-      r = EvalGradient(*x, u, &g_, s);
+    if (!GlobalizedStep(u, x, s)) {
+      r = EvalGradient(*x, u, s);
       return r < 1e3 * options_.cutoff;
     }
-    r = EvalGradient(*x, u, &g_, s);
+    r = EvalGradient(*x, u, s);
   }
   return r < options_.cutoff;
 }
@@ -270,19 +311,17 @@ void SolverBase::LeaveSaddle(const Vec& u, Vec* x, SolverSummary* s) {
   Finish(*x, u, s);
 }
 
-NewtonSolver::NewtonSolver(const Model& model, const SolverOptions& options)
-    : SolverBase(model, options) {}
+NewtonSolver::NewtonSolver(const Model& model, const SolverOptions& options, bool line_search)
+    : SolverBase(model, options), line_search_(line_search) {}
 
 SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
   SolverSummary s;
-  BeginSolve(&s);
-  const bool line_search = options_.method == Method::kNewtonLineSearch;
-  last_good_ = *x;
-  double r = EvalGradient(*x, u, &g_, &s);
+  if (!BeginSolve(u, *x, &s)) return s;
+  double r = EvalGradient(*x, u, &s);
   s.termination = Termination::kBudgetSpent;
   while (NextIteration(r, x, &s)) {
-    if (line_search) {
-      if (!GlobalizedStep(u, x, &g_, &s)) {
+    if (line_search_) {
+      if (!GlobalizedStep(u, x, &s)) {
         s.termination = Termination::kLinearSolverFailed;
         s.message = "no descent step found";
         break;
@@ -290,18 +329,18 @@ SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
     } else {
       // (2.18): linearise the field E_x at x_i, solve for its zero.
       if (FactorAt(*x, u, &s) != LinearSolverStatus::kSuccess ||
-          factor_->Solve(g_, &dx_) != LinearSolverStatus::kSuccess) {
+          ComputeNewtonStep() != LinearSolverStatus::kSuccess) {
         s.termination = Termination::kLinearSolverFailed;
-        s.message = std::string("factorisation failed: ") + factor_->message();
+        s.message = std::string("factorisation failed: ") + HessianFactor().message();
         break;
       }
       TakeNewtonStep(x);
     }
-    r = EvalGradient(*x, u, &g_, &s);
+    r = EvalGradient(*x, u, &s);
   }
   // Plain Newton (2.18) is kept as the seed's baseline: it may sit on a maximum or a
   // saddle (Fig 2.5). The globalised variant may not.
-  Conclude(u, x, &s, line_search);
+  Conclude(u, x, &s, line_search_);
   return s;
 }
 

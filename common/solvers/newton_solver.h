@@ -3,88 +3,135 @@
 
 #include <chrono>
 #include <memory>
+#include <vector>
 
 #include "solvers/eigen_tracking.h"
 #include "solvers/solver.h"
 
 namespace snapthread {
 
-// State shared by all methods: the model, one Hessian with its fixed pattern, its
-// factorisation (symbolic analysis done once), a second factorisation object for
-// modified matrices with the same pattern (shifted or restricted), the tracked lowest
-// eigenpair, and evaluation counters.
+// What every method shares: the model, one Hessian with its fixed pattern and its
+// factorisation (symbolic analysis done once), a second factorisation for modified
+// matrices with the same pattern (shifted or restricted), the tracked lowest eigenpair,
+// the loop head and tail, and the globalised fallbacks. All of it lives in a private
+// workspace sized once in the constructor (no allocation per solve after the first);
+// a method reaches it only through the functions below.
 class SolverBase : public EquilibriumSolver {
  public:
   SolverBase(const Model& model, const SolverOptions& options);
-  Method method() const override { return options_.method; }
+  const std::string& method() const override { return options_.method; }
   void Reset() override;
-  const SymmetricLinearSolver* Factorization() const override {
-    return factor_valid_ ? factor_.get() : nullptr;
-  }
-  const Vec& LowestEigenvector() const override { return eig_.vector(); }
+  const SymmetricLinearSolver* Factorization() const override;
+  const Vec& LowestEigenvector() const override { return ws_.eig.vector(); }
 
  protected:
-  using Clock = std::chrono::steady_clock;
+  const Model& model() const { return model_; }
+  const SolverOptions& options() const { return options_; }
+  int num_states() const { return n_; }
 
-  void BeginSolve(SolverSummary* s);
-  bool BudgetLeft(const SolverSummary& s) const;
-  double EvalGradient(const Vec& x, const Vec& u, Vec* g, SolverSummary* s) const;
-  // Assembles E_xx at x into h_ and factorises it into factor_.
-  LinearSolverStatus FactorAt(const Vec& x, const Vec& u, SolverSummary* s);
-  // Factorises h_ + shift I into alt_factor_ (pattern includes the diagonal).
-  LinearSolverStatus FactorShifted(double shift, SolverSummary* s);
-  // Final bookkeeping at the returned state: factorisation for implicit
-  // differentiation, lowest eigenpair, inertia, residual, energy, timing.
-  // gradient_current: g_ already holds E_x(x) (saves one evaluation per update).
-  void Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradient_current = false);
-  // Newton-ls step: inertia-corrected Newton direction + Armijo backtracking from x
-  // with gradient g. Returns false if no decrease could be found.
-  bool GlobalizedStep(const Vec& u, Vec* x, Vec* g, SolverSummary* s);
-  int Budget() const;
-  // Takes the plain Newton step x -= dx_ (factor_ is E_xx at x) and records whether it
-  // was small enough for Finish() to keep using factor_.
-  void TakeNewtonStep(Vec* x);
+  // --- a solve's frame ---------------------------------------------------------------
+  // Starts a solve from the warm start x (remembered as the last finite state).
+  // Returns false, with summary->termination = kInvalidInput and a message, when x or
+  // u has the wrong size or is not finite: then the method must return at once.
+  bool BeginSolve(const Vec& u, const Vec& x, SolverSummary* s);
   // Loop head shared by every method: stops on a non-finite residual (restoring the last
   // finite state), on convergence or when the budget is spent; otherwise counts the
   // iteration, remembers the state and returns true.
   bool NextIteration(double r, Vec* x, SolverSummary* s);
-  // Loop tail: restore a non-finite state, Finish(), leave a saddle (globalised methods
-  // only), Classify().
-  void Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_saddles);
+  // Loop tail: restore a non-finite state, Finish(); for globalised methods leave a
+  // saddle (LeaveSaddle); with finish_snap_on_spent_budget, a budget spent on an
+  // indefinite E_xx finishes the snap (the followed minimum is gone, DESIGN.md #4);
+  // then the status (DecideStatus) and the reference eigenvalue.
+  void Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_saddles,
+                bool finish_snap_on_spent_budget = false);
+
+  // --- gradient ----------------------------------------------------------------------
+  // E_x(x, u) into the workspace gradient; returns its norm.
+  double EvalGradient(const Vec& x, const Vec& u, SolverSummary* s);
+  // E_x(x, u) into *g (a method's own vector); returns its norm.
+  double EvalGradient(const Vec& x, const Vec& u, Vec* g, SolverSummary* s) const;
+  const Vec& Gradient() const { return ws_.g; }
+
+  // --- Hessian and its factorisations ------------------------------------------------
+  // Assembles E_xx at x and factorises it (HessianFactor()).
+  LinearSolverStatus FactorAt(const Vec& x, const Vec& u, SolverSummary* s);
+  const SparseMatrix& Hessian() const { return ws_.h; }
+  const SymmetricLinearSolver& HessianFactor() const { return *ws_.factor; }
+  // A modified copy of E_xx (same pattern): ModifiedHessian() returns the copy with the
+  // current values, the method edits its values, FactorModified() factorises it into
+  // the second factorisation that SolveModified() uses.
+  SparseMatrix& ModifiedHessian();
+  LinearSolverStatus FactorModified(SolverSummary* s);
+  LinearSolverStatus SolveModified(const Vec& b, Vec* x) const { return ws_.alt_factor->Solve(b, x); }
+
+  // --- steps ---------------------------------------------------------------------------
+  // The Newton step (2.18) d = E_xx^-1 E_x with HessianFactor() and Gradient().
+  LinearSolverStatus ComputeNewtonStep() { return ws_.factor->Solve(ws_.g, &ws_.dx); }
+  const Vec& NewtonStep() const { return ws_.dx; }
+  // Takes x -= NewtonStep() and records whether it was small enough for Finish() to
+  // keep using the factorisation (see kReuseStep in newton_solver.cc).
+  void TakeNewtonStep(Vec* x);
+  // Newton-ls step: inertia-corrected Newton direction + Armijo backtracking from x with
+  // Gradient(). Returns false if no decrease could be found.
+  bool GlobalizedStep(const Vec& u, Vec* x, SolverSummary* s);
   // Globalised minimisation to the cutoff past the iteration budget (a snap is finished
   // inside its control step, DESIGN.md #4). From a saddle, where the gradient vanishes,
   // it first leaves along the negative mode of E_xx (the side that lowers E).
   bool MinimizeFully(const Vec& u, Vec* x, SolverSummary* s);
+
+  // --- lowest eigenpair ----------------------------------------------------------------
+  // `iterations` steps of inverse iteration with HessianFactor(); the Rayleigh quotient.
+  double UpdateEigenpair(int iterations) { return ws_.eig.Update(*ws_.factor, ws_.h, iterations); }
+  // Sets the deterministic start vector if none has been tracked yet.
+  void EnsureEigenvector() { ws_.eig.EnsureInitialized(n_); }
+  // lambda_0 at the last regular converged state (DESIGN.md #1); <= 0: none yet.
+  double ReferenceLambda() const { return lambda_ref_; }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+
+  struct Workspace {
+    SparseMatrix h, h_mod;
+    std::unique_ptr<SymmetricLinearSolver> factor, alt_factor;
+    std::vector<int> diag_index;  // position of (i,i) in h.valuePtr()
+    SmallestEigenpair eig;
+    Vec g, dx, trial, last_good, dx_scratch;
+  };
+
+  bool BudgetLeft(const SolverSummary& s) const;
+  int Budget() const;
+  // Factorises E_xx + shift I into the second factorisation (the pattern has the diagonal).
+  LinearSolverStatus FactorShifted(double shift, SolverSummary* s);
+  // Final bookkeeping at the returned state: factorisation for implicit
+  // differentiation, lowest eigenpair, inertia, residual, energy, timing.
+  // gradient_current: the workspace gradient already holds E_x(x).
+  void Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradient_current = false);
   // After Finish(): a "converged" state with negative pivots is a saddle, not the
   // followed minimum. Leave it and minimise (counted as a snap); then Finish again.
   void LeaveSaddle(const Vec& u, Vec* x, SolverSummary* s);
-  // Sets summary.status from the final eigenvalue against the reference lambda_0 of
-  // the last regular converged state (DESIGN.md #1), and updates that reference.
-  void Classify(SolverSummary* s);
 
   const Model& model_;
-  SolverOptions options_;
-  int n_;
-  SparseMatrix h_, h_mod_;
-  std::unique_ptr<SymmetricLinearSolver> factor_, alt_factor_;
+  const SolverOptions options_;
+  const int n_;
+  Workspace ws_;
   bool factor_valid_ = false;
-  // factor_ holds E_xx at the state before the last, tiny, plain Newton step: Finish()
-  // may use it instead of factorising again (see kReuseStep in newton_solver.cc).
+  // The factorisation holds E_xx at the state before the last, tiny, plain Newton step:
+  // Finish() may use it instead of factorising again (kReuseStep).
   bool factor_before_tiny_step_ = false;
-  double lambda_ref_ = -1.0;  // lambda_0 at the last regular converged state
-  double best_residual_ = 0.0;  // stagnation tracking in NextIteration
+  double lambda_ref_ = -1.0;     // lambda_0 at the last regular converged state
+  double best_residual_ = 0.0;   // stagnation tracking in NextIteration
   int stalled_iterations_ = 0;
-  std::vector<int> diag_index_;  // position of (i,i) in h_.valuePtr()
-  SmallestEigenpair eig_;
-  Vec g_, dx_, trial_, last_good_, dx_scratch_;
   Clock::time_point start_;
 };
 
 // newton (2.18) and newton-ls.
 class NewtonSolver final : public SolverBase {
  public:
-  NewtonSolver(const Model& model, const SolverOptions& options);
+  NewtonSolver(const Model& model, const SolverOptions& options, bool line_search);
   SolverSummary Solve(const Vec& u, Vec* x) override;
+
+ private:
+  const bool line_search_;
 };
 
 }  // namespace snapthread

@@ -4,23 +4,6 @@
 
 namespace snapthread {
 
-const char* ToString(Method m) {
-  switch (m) {
-    case Method::kNewton: return "newton";
-    case Method::kNewtonLineSearch: return "newton-ls";
-    case Method::kHigherOrder: return "higher-order";
-  }
-  return "unknown";
-}
-
-bool ParseMethod(std::string_view name, Method* m) {
-  if (name == "newton") *m = Method::kNewton;
-  else if (name == "newton-ls") *m = Method::kNewtonLineSearch;
-  else if (name == "higher-order") *m = Method::kHigherOrder;
-  else return false;
-  return true;
-}
-
 bool SolverOptions::IsValid(std::string* error) const {
   auto fail = [&](const char* m) {
     if (error) *error = m;

@@ -4,17 +4,13 @@
 #pragma once
 
 #include <string>
-#include <string_view>
 
 namespace snapthread {
 
-enum class Method { kNewton, kNewtonLineSearch, kHigherOrder };
-const char* ToString(Method m);
-// "newton" | "newton-ls" | "higher-order"; false for an unknown name.
-bool ParseMethod(std::string_view name, Method* m);
-
 struct SolverOptions {
-  Method method = Method::kHigherOrder;
+  // A registered solver's name (solvers/registry.h: "newton", "newton-ls",
+  // "higher-order"). A name, not an enum, so this struct needs no solver code.
+  std::string method = "higher-order";
   // Stop when the internal force ||E_x||_2 < cutoff (the seed uses 1e-6, its reference
   // runs 1e-10).
   double cutoff = 1e-6;

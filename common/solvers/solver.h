@@ -13,48 +13,15 @@
 #include "linalg/linear_solver.h"
 #include "models/model.h"
 #include "solvers/options.h"
+#include "solvers/summary.h"
 
 namespace snapthread {
-
-enum class Termination {
-  kConverged,           // ||E_x|| < cutoff
-  kBudgetSpent,         // iteration or time budget spent first
-  kLinearSolverFailed,  // factorisation failed and no fallback could proceed
-  kNonFinite,           // a NaN/Inf appeared; the state was restored
-};
-const char* ToString(Termination t);
-
-// What the equilibrium looks like to a user of the force: regular, near a fold
-// (E_xx nearly singular: stiffness from the reduction), or the state just snapped.
-enum class EquilibriumStatus { kRegular = 0, kNearFold = 1, kSnapped = 2 };
-const char* ToString(EquilibriumStatus s);
-
-struct SolverSummary {
-  Termination termination = Termination::kBudgetSpent;
-  EquilibriumStatus status = EquilibriumStatus::kRegular;
-  int iterations = 0;
-  int gradient_evaluations = 0;
-  int hessian_evaluations = 0;
-  int factorizations = 0;
-  double residual = 0.0;     // ||E_x||_2 at the returned state
-  double energy = 0.0;
-  double lambda_min = 0.0;   // smallest eigenvalue estimate of E_xx at the returned state
-  int negative_pivots = 0;   // inertia of E_xx at the returned state
-  // higher-order: the reduction found that the followed minimum had vanished and the
-  // snap minimiser ran (whether the state really changed branch is the tracker's call).
-  bool snapped = false;
-  bool used_reduction = false;  // higher-order: the one-direction reduction was used
-  double solve_us = 0.0;
-  std::string message;
-
-  bool IsConverged() const { return termination == Termination::kConverged; }
-  std::string BriefReport() const;
-};
 
 class EquilibriumSolver {
  public:
   virtual ~EquilibriumSolver() = default;
-  virtual Method method() const = 0;
+  // The registered name (SolverOptions::method) this solver was made under.
+  virtual const std::string& method() const = 0;
   // Moves *x (the warm start) to an equilibrium of E(., u). x keeps the last accepted
   // state on failure; it never holds NaN on return.
   virtual SolverSummary Solve(const Vec& u, Vec* x) = 0;
@@ -68,7 +35,9 @@ class EquilibriumSolver {
   virtual const Vec& LowestEigenvector() const = 0;
 };
 
-// Throws std::invalid_argument if !options.IsValid().
+// Makes the registered solver options.method (solvers/registry.h). Throws
+// std::invalid_argument naming the field if !options.IsValid(), or if the method or the
+// linear solver is not registered (listing the registered names).
 std::unique_ptr<EquilibriumSolver> MakeSolver(const Model& model, const SolverOptions& options);
 
 }  // namespace snapthread

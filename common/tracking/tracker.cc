@@ -41,7 +41,7 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   SolverOptions strict = options_;
   strict.max_iterations = 0;
   strict.max_time_us = 0.0;
-  strict.method = Method::kNewtonLineSearch;
+  strict.method = "newton-ls";
   auto start_solver = MakeSolver(*model_, strict);
   result_.summary = start_solver->Solve(u, &x_);
   // The globalised solve can still stop on a saddle when the start is symmetric (a
@@ -98,10 +98,11 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   u_ = u;
   result_.summary = solver_->Solve(u, &x_);
   // A snap is a jump to another branch: the state left the predicted one by more than
-  // the threshold (for every method alike, so the charts compare like with like).
+  // the threshold (for every method alike, so the charts compare like with like). The
+  // status is DecideStatus's, now with that fact.
   const double jump = (x_ - x_pred_).lpNorm<Eigen::Infinity>();
-  result_.snapped = jump > snap_threshold_;
-  if (result_.snapped) result_.summary.status = EquilibriumStatus::kSnapped;
+  result_.summary.status = DecideStatus(result_.summary, options_.degeneracy_ratio, jump > snap_threshold_);
+  result_.snapped = result_.summary.status == EquilibriumStatus::kSnapped;
   // After a snap the secant would point along the jump: restart it.
   have_prev_ = !result_.snapped;
   ComputeForces();

@@ -166,11 +166,14 @@ TEST(ServerMessagesTest, StatusFlags) {
   r.stiffness_regularized = false;
   r.summary.status = EquilibriumStatus::kNearFold;
   EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_NEAR_FOLD);
+  r.summary.status = EquilibriumStatus::kSnapped;
   r.snapped = true;
   EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_SNAPPED);
   r.summary.termination = Termination::kBudgetSpent;
   EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_SNAPPED);
   r.summary.termination = Termination::kLinearSolverFailed;
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_INVALID);
+  r.summary.termination = Termination::kInvalidInput;
   EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_INVALID);
   EXPECT_EQ(ClassifyStatus(nullptr), force_model_t::STATUS_INVALID);
 }

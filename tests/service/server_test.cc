@@ -465,7 +465,7 @@ TEST_F(ServerTest, CommandsResetSetMethodLoadScene) {
   // The method override from SET_METHOD survives the new scene.
   EXPECT_EQ(server_->Stats().method, "newton");
   SolverOptions options = zeeman.solver;
-  options.method = Method::kNewton;
+  options.method = "newton";
   EquilibriumTracker direct(MakeModel(zeeman.params), options);
   direct.Reset(zeeman.grasp_start);
   const auto zposes = PathPoses(zeeman, direct.model(), 30, 0.0);

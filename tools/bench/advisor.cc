@@ -119,7 +119,7 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
       if (e > a.target_force_error) continue;
     }
     std::vector<AdviceCandidate> here;
-    for (Method m : o.methods)
+    for (const std::string& m : o.methods)
       for (double cutoff : o.cutoffs)
         for (int budget : o.budgets) {
           const TimedSweep t = TimeSweep(WithSolver(sc, m, cutoff, budget), path, o.repetitions, o.min_time_s);
@@ -146,7 +146,7 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
       std::ostringstream msg;
       msg << "smallest model meeting the force target: "
           << (chain ? "n = " + std::to_string(n) : std::string("the scene's model")) << "; fastest configuration "
-          << "meeting both targets: " << ToString(a.choice.method) << ", cutoff " << Sci(a.choice.cutoff, 0)
+          << "meeting both targets: " << a.choice.method << ", cutoff " << Sci(a.choice.cutoff, 0)
           << ", budget " << BudgetText(a.choice.budget) << " (" << Sci(a.choice.rate_hz) << " updates/s, force error "
           << Sci(a.choice.force_error) << ")";
       a.message = msg.str();
@@ -202,7 +202,7 @@ void PrintAdvice(const Advice& a, std::ostream& out) {
                r = c.MeetsRate(a.target_rate_hz);
     const bool chosen = a.found && c.n == a.choice.n && c.method == a.choice.method && c.cutoff == a.choice.cutoff &&
                         c.budget == a.choice.budget;
-    std::snprintf(buf, sizeof buf, "  %5d %-12s %7.0e %6s %11.3e %10.3e %8d  %s%s\n", c.n, ToString(c.method),
+    std::snprintf(buf, sizeof buf, "  %5d %-12s %7.0e %6s %11.3e %10.3e %8d  %s%s\n", c.n, c.method.c_str(),
                   c.cutoff, BudgetText(c.budget).c_str(), c.rate_hz, c.force_error, c.spurious_reversals,
                   e && r ? "both" : (e ? "error only" : (r ? "rate only" : "neither")), chosen ? "   <== choice" : "");
     out << buf;

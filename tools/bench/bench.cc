@@ -36,21 +36,12 @@ double RelativeRmsForceError(const std::vector<SweepRow>& trace, const std::vect
 
 double ForceScaleOf(const Scene& scene) { return MakeModel(scene.params)->ForceScale(); }
 
-Scene WithSolver(const Scene& scene, Method method, double cutoff, int budget) {
+Scene WithSolver(const Scene& scene, const std::string& method, double cutoff, int budget) {
   Scene s = scene;
   s.solver.method = method;
   s.solver.cutoff = cutoff;
   s.solver.max_iterations = budget;
   return s;
-}
-
-const char* MethodColor(Method m) {
-  switch (m) {
-    case Method::kNewton: return "#1f77b4";
-    case Method::kNewtonLineSearch: return "#ff7f0e";
-    case Method::kHigherOrder: return "#2ca02c";
-  }
-  return "#000000";
 }
 
 // ---------------------------------------------------------------- statistics

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "solvers/registry.h"
 #include "stability.h"
 
 namespace snapthread {
@@ -71,7 +72,7 @@ TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int r
 
 struct AccuracyOptions {
   std::vector<std::string> sweeps = {"zeeman_folds", "cusp_folds", "curve2d_snap", "thread3d_loop"};
-  std::vector<Method> methods = {Method::kNewton, Method::kNewtonLineSearch, Method::kHigherOrder};
+  std::vector<std::string> methods = SolverRegistry::Global().Names();  // registered solver names
   std::vector<double> cutoffs = {1e-4, 1e-6, 1e-8, 1e-10};
   std::vector<int> budgets = {1, 2, 3, 5, 10, 0};  // 0 = unlimited
   int repetitions = 3;
@@ -81,7 +82,7 @@ struct AccuracyOptions {
 
 struct AccuracyRow {
   std::string sweep;
-  Method method = Method::kNewton;
+  std::string method;  // a registered solver name
   double cutoff = 0.0;
   int budget = 0;
   Spread rate_hz;
@@ -109,7 +110,7 @@ void PrintAccuracyTable(const std::vector<AccuracyRow>& rows, bool pareto_only, 
 
 struct ScalingOptions {
   std::vector<int> ns = {5, 10, 20, 50, 100, 200, 500, 1000, 2000};
-  std::vector<Method> methods = {Method::kNewton, Method::kNewtonLineSearch, Method::kHigherOrder};
+  std::vector<std::string> methods = SolverRegistry::Global().Names();  // registered solver names
   std::vector<std::string> backends = {"auto", "banded", "cholmod", "dense"};
   int repetitions = 3;
   double min_sample_s = 0.15;       // timed updates per repetition last at least this
@@ -125,7 +126,7 @@ struct ScalingOptions {
 };
 
 struct ScalingRow {
-  Method method = Method::kNewton;
+  std::string method;  // a registered solver name
   std::string backend;
   int n = 0;
   Spread rate_hz;
@@ -139,7 +140,7 @@ struct ScalingRow {
 // (fixed_length: n segments of the base scene's total length, see ResizeChain), no grip
 // direction, grasp at (0.9, 0.1, 0.05) x the total length, the given cutoff, unlimited
 // iterations (each update converges).
-Scene HandSpeedScene(const Scene& thread3d_base, int n, Method method, const std::string& backend, double cutoff,
+Scene HandSpeedScene(const Scene& thread3d_base, int n, const std::string& method, const std::string& backend, double cutoff,
                      bool fixed_length = false);
 // Control of hand-speed update i: y moves `step` per update (0: 0.002 L), back and forth
 // over +-0.05 x the total length (a triangle wave) so long runs stay near the start.
@@ -149,7 +150,7 @@ ScalingRow TimeHandSpeed(const Scene& scene, const ScalingOptions& options);
 std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const ScalingOptions& options,
                                         std::ostream* progress);
 struct ScalingFit {
-  Method method = Method::kNewton;
+  std::string method;  // a registered solver name
   std::string backend;
   PowerLawFit all;     // over every measured n
   PowerLawFit large;   // over n >= 100 (the asymptotic cost)
@@ -206,7 +207,7 @@ std::vector<Vec> HandSpeedPath(const Scene& scene);
 struct AdvisorOptions {
   std::vector<int> n_ladder = {5, 8, 10, 15, 20, 30, 50, 80};
   int reference_n = 0;  // 0: 2 x max(the scene's n, the ladder's largest); rungs >= it are dropped
-  std::vector<Method> methods = {Method::kNewton, Method::kNewtonLineSearch, Method::kHigherOrder};
+  std::vector<std::string> methods = SolverRegistry::Global().Names();  // registered solver names
   std::vector<double> cutoffs = {1e-4, 1e-6, 1e-8, 1e-10};
   std::vector<int> budgets = {1, 2, 3, 5, 10, 0};
   int repetitions = 3;
@@ -225,7 +226,7 @@ struct AdvisorOptions {
 
 struct AdviceCandidate {
   int n = 0;
-  Method method = Method::kNewton;
+  std::string method;  // a registered solver name
   double cutoff = 0.0;
   int budget = 0;
   double rate_hz = 0.0;       // median updates per second

@@ -25,9 +25,6 @@ double RelativeRmsForceError(const std::vector<SweepRow>& trace, const std::vect
 double ForceScaleOf(const Scene& scene);
 
 // The scene solved with `method`, `cutoff` and an iteration budget (0 = unlimited).
-Scene WithSolver(const Scene& scene, Method method, double cutoff, int budget);
-
-// Line colour of a method in the gnuplot charts.
-const char* MethodColor(Method m);
+Scene WithSolver(const Scene& scene, const std::string& method, double cutoff, int budget);
 
 }  // namespace snapthread

@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench.h"
+#include "solvers/registry.h"
 #include "tool_main.h"
 
 namespace fs = std::filesystem;
@@ -36,12 +37,12 @@ std::vector<double> ParseCutoffs(const std::string& s) {
                            [](const std::string& item, double* c) { return ParseWhole(item, c) && *c > 0; });
 }
 
-std::vector<Method> ParseMethods(const std::string& s) {
-  std::vector<Method> v;
+std::vector<std::string> ParseMethods(const std::string& s) {
+  std::vector<std::string> v;
   for (const auto& item : SplitList(s)) {
-    Method m;
-    if (!ParseMethod(item, &m)) throw std::invalid_argument("--methods: unknown method '" + item + "'");
-    v.push_back(m);
+    if (SolverRegistry::Global().Find(item) == nullptr)
+      throw std::invalid_argument("--methods: unknown method '" + item + "'");
+    v.push_back(item);
   }
   return v;
 }
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
   app.add_option("--bin-dir", bin_dir, "folder with snapthread-server and snapthread-device (service)");
   app.add_option("--repetitions", repetitions, "repetitions per measurement (default 3, quick 1)")
       ->check(CLI::Range(1, 100));
-  app.add_option("--methods", methods_text, "methods (default newton,newton-ls,higher-order)");
+  app.add_option("--methods", methods_text, "methods (default " + SolverRegistry::Global().NamesText(",", ",") + ")");
   app.add_option("--cutoffs", cutoffs_text, "accuracy/advise: cutoffs (default 1e-4,1e-6,1e-8,1e-10)");
   app.add_option("--budgets", budgets_text, "accuracy/advise: iteration budgets, inf = unlimited (default 1,2,3,5,10,inf)");
   app.add_option("--sweeps", sweeps_text, "accuracy: standard sweeps (default zeeman_folds,cusp_folds,curve2d_snap,thread3d_loop)");

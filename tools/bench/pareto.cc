@@ -73,7 +73,7 @@ std::vector<AccuracyRow> RunAccuracyBench(const std::string& scenes_dir, const A
                 << std::fixed << std::setprecision(1) << Seconds(t_ref, Clock::now()) << " s\n"
                 << std::defaultfloat << std::flush;
     const size_t first = out.size();
-    for (Method m : o.methods) {
+    for (const std::string& m : o.methods) {
       const auto t_m = Clock::now();
       for (double cutoff : o.cutoffs)
         for (int budget : o.budgets) {
@@ -94,7 +94,7 @@ std::vector<AccuracyRow> RunAccuracyBench(const std::string& scenes_dir, const A
           out.push_back(row);
         }
       if (progress)
-        *progress << "bench accuracy: " << name << " " << ToString(m) << " (" << o.cutoffs.size() * o.budgets.size()
+        *progress << "bench accuracy: " << name << " " << m << " (" << o.cutoffs.size() * o.budgets.size()
                   << " configurations x " << o.repetitions << ") in " << std::fixed << std::setprecision(1)
                   << Seconds(t_m, Clock::now()) << " s\n"
                   << std::defaultfloat << std::flush;
@@ -125,7 +125,7 @@ void WriteAccuracyCsv(const std::vector<AccuracyRow>& rows, std::ostream& out) {
   out << std::setprecision(6);
   for (const auto& r : rows) {
     const StabilityRow& s = r.stability;
-    out << r.sweep << ',' << ToString(r.method) << ',' << r.cutoff << ',' << r.budget << ',' << r.rate_hz.median << ','
+    out << r.sweep << ',' << r.method << ',' << r.cutoff << ',' << r.budget << ',' << r.rate_hz.median << ','
         << r.rate_hz.min << ',' << r.rate_hz.max << ',' << r.rate_hz.count << ',' << r.force_scale << ','
         << s.force_error_rms << ',' << s.force_error_max << ',' << r.RelativeForceErrorRms() << ','
         << s.state_error_max << ',' << s.spurious_reversals << ',' << s.reversals << ',' << s.reference_reversals
@@ -146,7 +146,7 @@ void PrintAccuracyTable(const std::vector<AccuracyRow>& rows, bool pareto_only, 
     const std::string snap = s.snap_error_steps < 0 ? "missed" : std::to_string(s.snap_error_steps);
     const std::string span = Sci(r.rate_hz.min, 1) + ".." + Sci(r.rate_hz.max, 1);
     std::snprintf(buf, sizeof buf, "%-14s %-12s %7.0e %6s %11.3e %17s %10.2e %10.2e %10.2e %8d %9s %7.2f %6s\n",
-                  r.sweep.c_str(), ToString(r.method), r.cutoff, BudgetText(r.budget).c_str(), r.rate_hz.median,
+                  r.sweep.c_str(), r.method.c_str(), r.cutoff, BudgetText(r.budget).c_str(), r.rate_hz.median,
                   span.c_str(), r.RelativeForceErrorRms(), r.force_error_rel_rms_regular, s.state_error_max,
                   s.spurious_reversals, snap.c_str(),
                   s.mean_gradients, r.pareto ? "*" : "");
@@ -156,15 +156,15 @@ void PrintAccuracyTable(const std::vector<AccuracyRow>& rows, bool pareto_only, 
 
 std::string ParetoGnuplot(const std::vector<AccuracyRow>& rows, const std::string& dir, const std::string& png) {
   std::vector<std::string> sweeps;
-  std::vector<Method> methods;
+  std::vector<std::string> methods;
   for (const auto& r : rows) {
     if (std::find(sweeps.begin(), sweeps.end(), r.sweep) == sweeps.end()) sweeps.push_back(r.sweep);
     if (std::find(methods.begin(), methods.end(), r.method) == methods.end()) methods.push_back(r.method);
   }
   // One small CSV per sweep and method (rate, errors), one for the front.
   for (const auto& s : sweeps) {
-    for (Method m : methods) {
-      std::ofstream f(dir + "/pareto_" + s + "_" + ToString(m) + ".csv");
+    for (const std::string& m : methods) {
+      std::ofstream f(dir + "/pareto_" + s + "_" + m + ".csv");
       f << "rate_hz,force_error_rel_rms,state_error_max,cutoff,budget,force_error_rel_rms_away_from_snaps\n"
         << std::setprecision(6);
       for (const auto& r : rows)
@@ -200,11 +200,11 @@ std::string ParetoGnuplot(const std::vector<AccuracyRow>& rows, const std::strin
          << "set ylabel '" << ylabels[panel] << "'\n"
          << "plot ";
       bool first = true;
-      for (Method m : methods) {
+      for (const std::string& m : methods) {
         if (!first) gp << ", ";
         first = false;
-        gp << "'" << dir << "/pareto_" << s << "_" << ToString(m) << ".csv' every ::1 using 1:" << columns[panel]
-           << " with points pt 7 ps 0.8 lc rgb '" << MethodColor(m) << "' title '" << ToString(m) << "'";
+        gp << "'" << dir << "/pareto_" << s << "_" << m << ".csv' every ::1 using 1:" << columns[panel]
+           << " with points pt 7 ps 0.8 lc rgb '" << MethodColor(m) << "' title '" << m << "'";
       }
       if (panel == 0)
         gp << ", '" << dir << "/pareto_" << s << "_front.csv' every ::1 using 1:2 with linespoints pt 6 ps 1.2 dt 2 lc rgb '#444444' "

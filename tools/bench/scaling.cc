@@ -57,7 +57,7 @@ PowerLawFit FitPowerLaw(const std::vector<double>& x, const std::vector<double>&
 
 // ---------------------------------------------------------------- scaling
 
-Scene HandSpeedScene(const Scene& base, int n, Method method, const std::string& backend, double cutoff,
+Scene HandSpeedScene(const Scene& base, int n, const std::string& method, const std::string& backend, double cutoff,
                      bool fixed_length) {
   if (base.params.model != "thread3d") throw std::invalid_argument("bench: the scaling scene must be a thread3d scene");
   Scene s = base;
@@ -147,12 +147,12 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
   std::vector<int> ns = o.ns;
   std::sort(ns.begin(), ns.end());
   // The last measured point per method/backend, for skipping sizes that would be too slow.
-  std::map<std::pair<Method, std::string>, std::pair<int, double>> last;  // n, us per update
+  std::map<std::pair<std::string, std::string>, std::pair<int, double>> last;  // n, us per update
   // n outermost, methods and backends interleaved: a change in the machine's load hits
   // every method alike instead of biasing one against another.
   for (int n : ns)
     for (const std::string& backend : o.backends)
-      for (Method m : o.methods) {
+      for (const std::string& m : o.methods) {
         const auto key = std::make_pair(m, backend);
         if (last.count(key)) {
           const auto [last_n, last_us] = last[key];
@@ -161,7 +161,7 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
           const double predicted = last_us * std::pow(static_cast<double>(n) / last_n, p);
           if (predicted > o.max_update_us) {
             if (progress)
-              *progress << "bench scaling: " << ToString(m) << "/" << backend << " n=" << n << " skipped (predicted "
+              *progress << "bench scaling: " << m << "/" << backend << " n=" << n << " skipped (predicted "
                         << Sci(predicted) << " us per update > " << o.max_update_us << ")\n";
             continue;
           }
@@ -171,7 +171,7 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
         rows.push_back(r);
         last[key] = {n, 1e6 / std::max(r.rate_hz.median, 1e-9)};
         if (progress)
-          *progress << "bench scaling: " << ToString(m) << "/" << backend << " n=" << n << ": "
+          *progress << "bench scaling: " << m << "/" << backend << " n=" << n << ": "
                     << Sci(r.rate_hz.median) << " updates/s (" << r.updates << " x " << r.rate_hz.count << ", "
                     << std::fixed << std::setprecision(2) << r.iterations_per_update << " it/update, "
                     << std::setprecision(1) << Seconds(t0, Clock::now()) << " s)\n"
@@ -179,7 +179,7 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
       }
   // Grouped per method and backend for the tables and charts.
   std::stable_sort(rows.begin(), rows.end(), [&](const ScalingRow& a, const ScalingRow& b) {
-    auto mi = [&](Method m) { return std::find(o.methods.begin(), o.methods.end(), m) - o.methods.begin(); };
+    auto mi = [&](const std::string& m) { return std::find(o.methods.begin(), o.methods.end(), m) - o.methods.begin(); };
     auto bi = [&](const std::string& x) { return std::find(o.backends.begin(), o.backends.end(), x) - o.backends.begin(); };
     if (mi(a.method) != mi(b.method)) return mi(a.method) < mi(b.method);
     if (bi(a.backend) != bi(b.backend)) return bi(a.backend) < bi(b.backend);
@@ -190,7 +190,7 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
 
 std::vector<ScalingFit> FitScaling(const std::vector<ScalingRow>& rows) {
   std::vector<ScalingFit> fits;
-  std::vector<std::pair<Method, std::string>> keys;
+  std::vector<std::pair<std::string, std::string>> keys;
   for (const auto& r : rows)
     if (std::find(keys.begin(), keys.end(), std::make_pair(r.method, r.backend)) == keys.end())
       keys.push_back({r.method, r.backend});
@@ -215,7 +215,7 @@ void WriteScalingCsv(const std::vector<ScalingRow>& rows, std::ostream& out) {
          "us_per_update_median,iterations_per_update,max_residual,snaps\n";
   out << std::setprecision(6);
   for (const auto& r : rows)
-    out << ToString(r.method) << ',' << r.backend << ',' << r.n << ',' << r.rate_hz.median << ',' << r.rate_hz.min
+    out << r.method << ',' << r.backend << ',' << r.n << ',' << r.rate_hz.median << ',' << r.rate_hz.min
         << ',' << r.rate_hz.max << ',' << r.rate_hz.count << ',' << r.updates << ','
         << 1e6 / std::max(r.rate_hz.median, 1e-12) << ',' << r.iterations_per_update << ',' << r.max_residual << ','
         << r.snaps << '\n';
@@ -228,14 +228,14 @@ void PrintScalingTable(const std::vector<ScalingRow>& rows, const std::vector<Sc
   out << buf;
   for (const auto& r : rows) {
     const std::string span = Sci(r.rate_hz.min) + ".." + Sci(r.rate_hz.max);
-    std::snprintf(buf, sizeof buf, "%-12s %-8s %6d %11.3e %21s %10.2f %8.2f %9.1e %5d\n", ToString(r.method),
+    std::snprintf(buf, sizeof buf, "%-12s %-8s %6d %11.3e %21s %10.2f %8.2f %9.1e %5d\n", r.method.c_str(),
                   r.backend.c_str(), r.n, r.rate_hz.median, span.c_str(), 1e6 / std::max(r.rate_hz.median, 1e-12),
                   r.iterations_per_update, r.max_residual, r.snaps);
     out << buf;
   }
   out << "fitted log-log slopes of rate against n (seed: -1.9):\n";
   for (const auto& f : fits) {
-    std::snprintf(buf, sizeof buf, "  %-12s %-8s all n: %6.3f (%d points, r2 %.3f)   n >= 100: ", ToString(f.method),
+    std::snprintf(buf, sizeof buf, "  %-12s %-8s all n: %6.3f (%d points, r2 %.3f)   n >= 100: ", f.method.c_str(),
                   f.backend.c_str(), f.all.slope, f.all.points, f.all.r2);
     out << buf;
     if (f.large.points >= 2) {
@@ -248,7 +248,7 @@ void PrintScalingTable(const std::vector<ScalingRow>& rows, const std::vector<Sc
 }
 
 void PrintScalingTargets(const std::vector<ScalingRow>& rows, const std::vector<ScalingFit>& fits, std::ostream& out) {
-  auto rate = [&](Method m, const std::string& b, int n) {
+  auto rate = [&](const std::string& m, const std::string& b, int n) {
     for (const auto& r : rows)
       if (r.method == m && r.backend == b && r.n == n) return r.rate_hz.median;
     return 0.0;
@@ -256,7 +256,7 @@ void PrintScalingTargets(const std::vector<ScalingRow>& rows, const std::vector<
   char buf[256];
   out << "issue-6 targets (higher-order, auto backend, cutoff 1e-6, hand-speed update):\n";
   for (const auto& [n, target] : std::vector<std::pair<int, double>>{{10, 1e5}, {100, 1e4}, {1000, 1e3}}) {
-    const double r = rate(Method::kHigherOrder, "auto", n);
+    const double r = rate("higher-order", "auto", n);
     if (r <= 0) {
       std::snprintf(buf, sizeof buf, "  n = %-5d >= %.0e /s: not measured\n", n, target);
     } else {
@@ -266,7 +266,7 @@ void PrintScalingTargets(const std::vector<ScalingRow>& rows, const std::vector<
     out << buf;
   }
   for (const auto& f : fits)
-    if (f.method == Method::kHigherOrder && f.backend == "auto" && f.all.points >= 2) {
+    if (f.method == "higher-order" && f.backend == "auto" && f.all.points >= 2) {
       std::snprintf(buf, sizeof buf, "  log-log slope >= -1.05: measured %.3f over all n (%.3f for n >= 100) -> %s\n",
                     f.all.slope, f.large.points >= 2 ? f.large.slope : f.all.slope,
                     f.all.slope >= -1.05 ? "met" : "NOT met");
@@ -277,8 +277,8 @@ void PrintScalingTargets(const std::vector<ScalingRow>& rows, const std::vector<
     std::string line;
     double worst = 0.0;
     for (const auto& r : rows) {
-      if (r.method != Method::kHigherOrder || r.backend != b) continue;
-      const double rn = rate(Method::kNewton, b, r.n);
+      if (r.method != "higher-order" || r.backend != b) continue;
+      const double rn = rate("newton", b, r.n);
       if (rn <= 0 || r.rate_hz.median <= 0) continue;
       const double ratio = rn / r.rate_hz.median;  // us(higher-order) / us(newton)
       worst = std::max(worst, ratio);
@@ -294,13 +294,13 @@ void PrintScalingTargets(const std::vector<ScalingRow>& rows, const std::vector<
 
 std::string ScalingGnuplot(const std::vector<ScalingRow>& rows, const std::vector<ScalingFit>& fits,
                            const std::string& dir, const std::string& png, bool fixed_length) {
-  std::vector<Method> methods;
+  std::vector<std::string> methods;
   for (const auto& r : rows)
     if (std::find(methods.begin(), methods.end(), r.method) == methods.end()) methods.push_back(r.method);
   const std::map<std::string, std::string> colors = {
       {"auto", "#2ca02c"}, {"banded", "#1f77b4"}, {"cholmod", "#ff7f0e"}, {"dense", "#9467bd"}};
   for (const auto& f : fits) {
-    std::ofstream out(dir + "/scaling_" + ToString(f.method) + "_" + f.backend + ".csv");
+    std::ofstream out(dir + "/scaling_" + f.method + "_" + f.backend + ".csv");
     out << "n,rate_hz_median,rate_hz_min,rate_hz_max\n" << std::setprecision(6);
     for (const auto& r : rows)
       if (r.method == f.method && r.backend == f.backend)
@@ -316,15 +316,15 @@ std::string ScalingGnuplot(const std::vector<ScalingRow>& rows, const std::vecto
      << "set multiplot layout 1," << n << " title 'thread3d equilibrium-update rate against n (cutoff 1e-6, "
      << (fixed_length ? "fixed total length 10 L, 0.002 L per update in y" : "n segments of length L, 0.002 L per update in y")
      << "); error bars: min..max over repetitions'\n";
-  for (Method m : methods) {
-    gp << "set title '" << ToString(m) << "'\nplot ";
+  for (const std::string& m : methods) {
+    gp << "set title '" << m << "'\nplot ";
     bool first = true;
     double anchor_n = 0, anchor_rate = 0;
     for (const auto& f : fits) {
       if (f.method != m) continue;
       if (!first) gp << ", ";
       first = false;
-      const std::string file = dir + "/scaling_" + ToString(m) + "_" + f.backend + ".csv";
+      const std::string file = dir + "/scaling_" + m + "_" + f.backend + ".csv";
       const std::string c = colors.count(f.backend) ? colors.at(f.backend) : "#000000";
       char slope[64];
       std::snprintf(slope, sizeof slope, "%.2f", f.all.slope);

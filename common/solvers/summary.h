@@ -1,0 +1,69 @@
+// What one solve reports (after Ceres' Solver::Summary), and the one function that
+// decides an update's equilibrium status from it.
+#pragma once
+
+#include <string>
+
+namespace snapthread {
+
+enum class Termination {
+  kConverged,           // ||E_x|| < cutoff
+  kBudgetSpent,         // iteration or time budget spent first
+  kLinearSolverFailed,  // factorisation failed and no fallback could proceed
+  kNonFinite,           // a NaN/Inf appeared; the state was restored
+  kInvalidInput,        // the state or the controls had the wrong size or were not finite
+};
+const char* ToString(Termination t);
+
+// What the equilibrium looks like to a user of the force: regular, near a fold
+// (E_xx nearly singular: stiffness from the reduction), or the state just snapped.
+enum class EquilibriumStatus { kRegular = 0, kNearFold = 1, kSnapped = 2 };
+const char* ToString(EquilibriumStatus s);
+
+struct SolverSummary {
+  Termination termination = Termination::kBudgetSpent;
+  EquilibriumStatus status = EquilibriumStatus::kRegular;  // set by DecideStatus only
+  int iterations = 0;
+  int gradient_evaluations = 0;
+  int hessian_evaluations = 0;
+  int factorizations = 0;
+  double residual = 0.0;     // ||E_x||_2 at the returned state
+  double energy = 0.0;
+  double lambda_min = 0.0;   // smallest eigenvalue estimate of E_xx at the returned state
+  // The reference lambda_0 (of the last regular converged state) the status was judged
+  // against (DESIGN.md #1); <= 0 before the first regular state.
+  double lambda_ref = -1.0;
+  int negative_pivots = 0;   // inertia of E_xx at the returned state (-1: not factorised)
+  // higher-order: the reduction found that the followed minimum had vanished and the
+  // snap minimiser ran (whether the state really changed branch is the tracker's call).
+  bool snapped = false;
+  bool used_reduction = false;  // higher-order: the one-direction reduction was used
+  double solve_us = 0.0;
+  std::string message;
+
+  bool IsConverged() const { return termination == Termination::kConverged; }
+  // False when the returned state is no usable equilibrium (the linear solver failed,
+  // a NaN appeared, the input was invalid): its force must not be rendered. A spent
+  // budget is usable: the state is the last accepted one.
+  bool IsSolutionUsable() const;
+  std::string BriefReport() const;
+};
+
+// The degeneracy test of DESIGN.md #1: E_xx is near a fold when it is indefinite or not
+// factorised (negative_pivots != 0) or its lowest eigenvalue is at most tau times the
+// reference lambda_0 of the last regular state (lambda_ref <= 0: none yet, judge
+// against lambda_min itself) — never against the largest diagonal entry (stretching
+// sets the diagonal).
+bool NearFold(double lambda_min, int negative_pivots, double lambda_ref, double degeneracy_ratio);
+
+// The one decision of an update's equilibrium status. Every solver calls it on its
+// summary at the end of a solve with left_branch = false (a solver cannot tell a change
+// of branch); the tracker calls it again with left_branch = whether the state jumped to
+// another branch, and everything downstream (sweep CSV, server messages) reads
+// summary.status:
+//   snapped    left_branch (it outranks a near-fold verdict at the new state);
+//   near-fold  NearFold(summary.lambda_min, .negative_pivots, .lambda_ref, ratio);
+//   regular    otherwise.
+EquilibriumStatus DecideStatus(const SolverSummary& summary, double degeneracy_ratio, bool left_branch);
+
+}  // namespace snapthread
