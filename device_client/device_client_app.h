@@ -1,12 +1,6 @@
-// snapthread-device as a library: options, argument parsing and the process that wires
-// a backend, the servo loop, LCM and the statistics together (shared/DESIGN.md). Threads:
-//   servo   ServoLoop: 1 kHz ticks, never touches LCM, logs or allocates
-//   lcm     handleTimeout loop: force_model_t -> DecodeAndValidate -> PrepareModel ->
-//           LatestValue (wait-free for the servo)
-//   io      drains the pose / trace / lateness rings: publishes device_state_t, writes
-//           the trace CSV, publishes device_status_t at 2 Hz and logs a summary
-//   main    waits for --duration or SIGINT/SIGTERM, then stops everything, writes the
-//           summary JSON
+// snapthread-device as a library entry point: command-line options and the process
+// wiring (scene, backend, LcmDeviceTransport, DeviceClient, signals, summary). The
+// client itself - servo loop, model receiver, io - is DeviceClient (device_client.h).
 #pragma once
 
 #include <string>

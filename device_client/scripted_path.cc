@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "messages/pose_mapping.h"
+
 namespace snapthread::device {
 
 ScriptedPath::ScriptedPath(std::vector<std::array<double, 3>> waypoints_m, double speed_m_per_s)
@@ -33,12 +35,8 @@ ScriptedPath::ScriptedPath(std::vector<std::array<double, 3>> waypoints_m, doubl
 ScriptedPath ScriptedPath::FromScene(const Scene& scene, double speed_m_per_s) {
   std::vector<std::array<double, 3>> pts;
   auto add = [&](const Vec& control) {
-    // Controls: (X, Y) for planar models, (X, Y, Z) for thread3d (+ a grip direction).
-    double model[3] = {scene.device.model_origin[0], scene.device.model_origin[1],
-                       scene.device.model_origin[2]};
-    const int dim = control.size() >= 6 || control.size() == 3 ? 3 : 2;
-    for (int k = 0; k < dim && k < control.size(); ++k) model[k] = control[k];
-    pts.push_back(ModelToDevice(scene.device, model));
+    const Eigen::Vector3d p = messages::ControlsToPosition(scene.device, scene.grasp_layout, control);
+    pts.push_back({p[0], p[1], p[2]});
   };
   if (scene.path.empty()) {
     add(scene.grasp_start);
@@ -118,22 +116,6 @@ double ScriptedPath::max_radius_m() const {
     r = std::max(r, std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]));
   }
   return r;
-}
-
-std::array<double, 3> DeviceToModel(const DeviceMapping& mapping, const double device_m[3]) {
-  std::array<double, 3> m;
-  for (int k = 0; k < 3; ++k) {
-    m[k] = mapping.model_origin[k] + mapping.model_units_per_metre * device_m[k];
-  }
-  return m;
-}
-
-std::array<double, 3> ModelToDevice(const DeviceMapping& mapping, const double model[3]) {
-  std::array<double, 3> d;
-  for (int k = 0; k < 3; ++k) {
-    d[k] = (model[k] - mapping.model_origin[k]) / mapping.model_units_per_metre;
-  }
-  return d;
 }
 
 }  // namespace snapthread::device

@@ -17,7 +17,7 @@ class ScriptedPath {
   ScriptedPath(std::vector<std::array<double, 3>> waypoints_m, double speed_m_per_s);
 
   // The scene's grasp.path (or grasp.start when it has no path), model units, mapped to
-  // device metres with the inverse of model = model_origin + model_units_per_metre * u.
+  // device metres with messages::ControlsToPosition (planar scenes: on the model plane).
   static ScriptedPath FromScene(const Scene& scene, double speed_m_per_s);
   // A CSV file of positions in metres, one "x,y,z" (or "x,y") per line; lines starting
   // with '#' and a non-numeric header line are skipped. Throws std::runtime_error with the
@@ -39,9 +39,5 @@ class ScriptedPath {
   double total_length_m_ = 0.0;
   double speed_m_per_s_;
 };
-
-// Device metres -> model units (DeviceMapping), and back.
-std::array<double, 3> DeviceToModel(const DeviceMapping& mapping, const double device_m[3]);
-std::array<double, 3> ModelToDevice(const DeviceMapping& mapping, const double model[3]);
 
 }  // namespace snapthread::device

@@ -105,7 +105,13 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
                      std::string(session->tracker->model().Name()) + " has " +
                      std::to_string(session->tracker->model().NumControls()) + " controls");
   }
-  session->rest_direction = RestGripDirection(scene, session->tracker->model());
+  if (scene.grasp_layout.NumControls() != session->tracker->model().NumControls()) {
+    throw SceneError(scene.file + ": the scene's grasp layout has " +
+                     std::to_string(scene.grasp_layout.NumControls()) + " controls, model " +
+                     std::string(session->tracker->model().Name()) + " has " +
+                     std::to_string(session->tracker->model().NumControls()));
+  }
+  session->rest_direction = messages::RestGripDirection(scene);
   session->tracker->Reset(scene.grasp_start);
   return session;
 }
@@ -232,12 +238,13 @@ void Server::SolveLoop() {
 void Server::SolveAndPublish(const PoseSample& pose) {
   EquilibriumTracker& tracker = *session_->tracker;
   const Model& model = tracker.model();
-  const DeviceMapping& mapping = session_->scene.device;
+  const Scene& scene = session_->scene;
   const Eigen::Vector3d position(pose.state.position[0], pose.state.position[1],
                                  pose.state.position[2]);
   const Eigen::Vector4d quaternion(pose.state.orientation[0], pose.state.orientation[1],
                                    pose.state.orientation[2], pose.state.orientation[3]);
-  const Vec u = PoseToControls(mapping, model, position, quaternion, session_->rest_direction);
+  const Vec u = messages::PoseToControls(scene.device, scene.grasp_layout, position, quaternion,
+                                         session_->rest_direction);
 
   if (hooks_.before_update) hooks_.before_update();
   const TrackResult* result = nullptr;
@@ -252,7 +259,7 @@ void Server::SolveAndPublish(const PoseSample& pose) {
   const double solve_us = std::chrono::duration<double, std::micro>(SteadyClock::now() - t0).count();
 
   ForceModelInputs in;
-  in.mapping = &mapping;
+  in.mapping = &scene.device;
   in.model = &model;
   in.u = u;
   in.position_m = position;

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "messages/pose_mapping.h"
+#include "messages/validate.h"
 
 namespace snapthread::server {
 namespace {
@@ -92,7 +93,7 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
     // headroom for the device client's stiffness clamp, latency and the 1 kHz sample
     // rate (a spring at the stability limit would buzz).
     const double k_plane = PlanarStiffness(map);
-    m.f0[2] = -k_plane * (m.u0[2] - PlanarZ0(map));
+    m.f0[2] = -k_plane * (m.u0[2] - messages::PlanarZ0(map));
     m.K[2][2] = -k_plane;
   }
   if (nu >= dim + 3 && dim == 3) {
@@ -106,21 +107,12 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
     m.has_torque = 1;
   }
   m.status = ClassifyStatus(&r);
-  if (!IsFinite(m)) {
+  // The one force-model check (messages/validate.cc); on failure the device renders zero.
+  if (!transport::Validate(m, nullptr)) {
     ZeroForceModel(&m);
     m.status = force_model_t::STATUS_INVALID;
   }
   return m;
-}
-
-bool IsFinite(const force_model_t& m) {
-  for (int i = 0; i < 3; ++i) {
-    if (!Finite(m.u0[i]) || !Finite(m.f0[i]) || !Finite(m.torque0[i])) return false;
-    for (int j = 0; j < 3; ++j) {
-      if (!Finite(m.K[i][j])) return false;
-    }
-  }
-  return Finite(m.residual);
 }
 
 thread_shape_t BuildShape(const ShapeInputs& in) {

@@ -48,9 +48,6 @@ struct ForceModelInputs {
 };
 force_model_t BuildForceModel(const ForceModelInputs& in);
 
-// True when every floating-point field is finite.
-bool IsFinite(const force_model_t& msg);
-
 struct ShapeInputs {
   std::string scene;
   const DeviceMapping* mapping = nullptr;

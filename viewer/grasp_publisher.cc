@@ -2,20 +2,11 @@
 
 #include "snapthread/device_state_t.hpp"
 #include "messages/channels.h"
+#include "messages/pose_mapping.h"
 #include "realtime/clock.h"
 #include "messages/validate.h"
 
 namespace snapthread::viewer {
-
-Eigen::Vector3d ModelToDeviceMetres(const DeviceMapping& m, const Eigen::Vector3d& model) {
-  const Eigen::Vector3d origin(m.model_origin[0], m.model_origin[1], m.model_origin[2]);
-  return (model - origin) / m.model_units_per_metre;
-}
-
-Eigen::Vector3d DeviceMetresToModel(const DeviceMapping& m, const Eigen::Vector3d& device_m) {
-  const Eigen::Vector3d origin(m.model_origin[0], m.model_origin[1], m.model_origin[2]);
-  return origin + m.model_units_per_metre * device_m;
-}
 
 GraspPublisher::GraspPublisher(lcm::LCM* lcm, const std::string& session,
                                const DeviceMapping& mapping)
@@ -26,7 +17,7 @@ bool GraspPublisher::Publish(const Eigen::Vector3d& model_position, bool held) {
   msg.utime = transport::MonotonicMicros();  // device poses carry CLOCK_MONOTONIC
   msg.seq = ++seq_;
   msg.device_id = "viewer-mouse";
-  const Eigen::Vector3d p = ModelToDeviceMetres(mapping_, model_position);
+  const Eigen::Vector3d p = messages::ModelPointToDevice(mapping_, model_position);
   for (int i = 0; i < 3; ++i) msg.position[i] = p[i];
   msg.orientation[0] = 1.0;  // identity: grip direction +x
   msg.orientation[1] = msg.orientation[2] = msg.orientation[3] = 0.0;

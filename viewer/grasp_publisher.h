@@ -1,6 +1,6 @@
 // Mouse grasp mode: the viewer drives a session like a device would, publishing
 // device_state_t on <SESSION>_DEVICE_STATE. Positions in the message are device metres, so the
-// scene's DeviceMapping (device -> model) is inverted here.
+// scene's DeviceMapping (device -> model) is inverted (messages::ModelPointToDevice).
 #pragma once
 
 #include <chrono>
@@ -13,10 +13,6 @@
 #include "scene/scene.h"
 
 namespace snapthread::viewer {
-
-// Inverse of the scene mapping model = model_origin + model_units_per_metre * device_m.
-Eigen::Vector3d ModelToDeviceMetres(const DeviceMapping& mapping, const Eigen::Vector3d& model);
-Eigen::Vector3d DeviceMetresToModel(const DeviceMapping& mapping, const Eigen::Vector3d& device_m);
 
 class GraspPublisher {
  public:

@@ -1,10 +1,30 @@
 #include "messages/pose_mapping.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Geometry>
 
-namespace snapthread::server {
+namespace snapthread::messages {
+namespace {
+
+Eigen::Vector3d Origin(const DeviceMapping& m) {
+  return Eigen::Vector3d(m.model_origin[0], m.model_origin[1], m.model_origin[2]);
+}
+
+int PositionalControls(const GraspLayout& layout) {
+  return std::clamp(layout.spatial_dimension, 0, 3);
+}
+
+}  // namespace
+
+Eigen::Vector3d DeviceToModelPoint(const DeviceMapping& mapping, const Eigen::Vector3d& position_m) {
+  return Origin(mapping) + mapping.model_units_per_metre * position_m;
+}
+
+Eigen::Vector3d ModelPointToDevice(const DeviceMapping& mapping, const Eigen::Vector3d& model_point) {
+  return (model_point - Origin(mapping)) / mapping.model_units_per_metre;
+}
 
 Eigen::Vector3d GripDirection(const Eigen::Vector4d& quaternion_wxyz,
                               const Eigen::Vector3d& rest) {
@@ -19,39 +39,41 @@ Eigen::Vector3d GripDirection(const Eigen::Vector4d& quaternion_wxyz,
   return q * r;
 }
 
-Eigen::Vector3d RestGripDirection(const Scene& scene, const Model& model) {
-  const int dim = model.SpatialDimension();
-  if (model.NumControls() >= dim + 3 && scene.grasp_start.size() >= dim + 3) {
+Eigen::Vector3d RestGripDirection(const Scene& scene) {
+  const GraspLayout& layout = scene.grasp_layout;
+  const int dim = layout.spatial_dimension;
+  if (layout.grip_direction && scene.grasp_start.size() >= dim + 3) {
     const Eigen::Vector3d d = scene.grasp_start.segment<3>(dim);
     if (d.norm() > 0.0 && d.allFinite()) return d.normalized();
   }
   return Eigen::Vector3d::UnitX();
 }
 
-Vec PoseToControls(const DeviceMapping& mapping, const Model& model,
+Vec PoseToControls(const DeviceMapping& mapping, const GraspLayout& layout,
                    const Eigen::Vector3d& position_m, const Eigen::Vector4d& quaternion_wxyz,
                    const Eigen::Vector3d& rest_direction) {
-  const int dim = model.SpatialDimension();
-  Vec u = Vec::Zero(model.NumControls());
-  for (int i = 0; i < dim && i < u.size(); ++i) {
-    u[i] = mapping.model_origin[i] + mapping.model_units_per_metre * position_m[i];
+  const int dim = PositionalControls(layout);
+  Vec u = Vec::Zero(layout.NumControls());
+  const Eigen::Vector3d model_point = DeviceToModelPoint(mapping, position_m);
+  for (int i = 0; i < dim && i < u.size(); ++i) u[i] = model_point[i];
+  // A grip direction: u = (X, Y, Z, dx, dy, dz).
+  if (layout.grip_direction && u.size() >= dim + 3) {
+    u.segment<3>(dim) = GripDirection(quaternion_wxyz, rest_direction);
   }
-  // thread3d with a grip direction: u = (X, Y, Z, dx, dy, dz).
-  if (u.size() >= dim + 3) u.segment<3>(dim) = GripDirection(quaternion_wxyz, rest_direction);
   return u;
 }
 
-Eigen::Vector3d ControlsToPosition(const DeviceMapping& mapping, const Model& model, const Vec& u) {
-  const int dim = model.SpatialDimension();
-  Eigen::Vector3d p(0.0, 0.0, PlanarZ0(mapping));
-  for (int i = 0; i < dim && i < 3 && i < u.size(); ++i) {
-    p[i] = (u[i] - mapping.model_origin[i]) / mapping.model_units_per_metre;
-  }
-  return p;
+Eigen::Vector3d ControlsToPosition(const DeviceMapping& mapping, const GraspLayout& layout,
+                                   const Vec& u) {
+  const int dim = PositionalControls(layout);
+  Eigen::Vector3d model_point = Origin(mapping);
+  model_point[2] = 0.0;  // planar layouts: the model plane z_model = 0 (PlanarZ0)
+  for (int i = 0; i < dim && i < u.size(); ++i) model_point[i] = u[i];
+  return ModelPointToDevice(mapping, model_point);
 }
 
 double PlanarZ0(const DeviceMapping& mapping) {
   return -mapping.model_origin[2] / mapping.model_units_per_metre;
 }
 
-}  // namespace snapthread::server
+}  // namespace snapthread::messages

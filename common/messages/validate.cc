@@ -2,158 +2,34 @@
 
 #include <cmath>
 #include <cstdint>
-#include <cstring>
+#include <limits>
+#include <span>
 
 namespace snapthread::transport {
 namespace {
+
+constexpr int64_t kInt32Max = std::numeric_limits<int32_t>::max();
 
 bool Fail(std::string* why, const std::string& text) {
   if (why) *why = text;
   return false;
 }
 
-bool Finite(const double* v, int n) {
-  for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(v[i])) return false;
-  }
-  return true;
-}
+// ---- rules of their own --------------------------------------------------------------------
 
-bool CheckFinite(const double* v, int n, const char* field, std::string* why) {
-  if (Finite(v, n)) return true;
-  return Fail(why, std::string(field) + " is not finite");
-}
-
-bool CheckString(const std::string& s, const char* field, std::string* why) {
-  if (s.size() <= kMaxStringBytes) return true;
-  return Fail(why, std::string(field) + " longer than " + std::to_string(kMaxStringBytes) +
-                       " bytes");
-}
-
-bool CheckStatus(int8_t status, std::string* why) {
-  if (status >= force_model_t::STATUS_REGULAR && status <= force_model_t::STATUS_INVALID) {
-    return true;
-  }
-  return Fail(why, "status " + std::to_string(status) + " is not one of STATUS_*");
-}
-
-// Big-endian reads of LCM's wire format (lcm_coretypes.h).
-bool ReadI32(const uint8_t* p, int size, int* pos, int32_t* out) {
-  if (*pos < 0 || size - *pos < 4) return false;
-  uint32_t v = 0;
-  for (int i = 0; i < 4; ++i) v = (v << 8) | p[*pos + i];
-  *pos += 4;
-  std::memcpy(out, &v, 4);
-  return true;
-}
-
-bool SkipString(const uint8_t* p, int size, int* pos) {
-  int32_t len = 0;
-  if (!ReadI32(p, size, pos, &len)) return false;
-  if (len < 1 || len > size - *pos) return false;  // includes the terminating NUL
-  *pos += len;
-  return true;
-}
-
-// Checks `count` consecutive strings starting at byte `pos`; advances pos past them.
-bool CheckStrings(const void* data, int size, int* pos, int count, const char* type,
-                  std::string* why) {
-  const auto* p = static_cast<const uint8_t*>(data);
-  if (size < *pos) return Fail(why, std::string(type) + " truncated");
-  for (int i = 0; i < count; ++i) {
-    if (!SkipString(p, size, pos)) {
-      return Fail(why, std::string(type) + ": malformed string length");
-    }
-  }
-  return true;
-}
-
-}  // namespace
-
-// Offsets: 8-byte type hash, then the fields in .lcm order (lcmtypes/*.lcm).
-template <>
-bool PreDecodeCheck<force_model_t>(const void*, int, std::string*) {
-  return true;  // fixed size: the generated decoder checks every read against the length
-}
-
-template <>
-bool PreDecodeCheck<device_state_t>(const void* data, int size, std::string* why) {
-  int pos = 24;  // hash, utime, seq | device_id
-  return CheckStrings(data, size, &pos, 1, "device_state_t", why);
-}
-
-template <>
-bool PreDecodeCheck<solver_status_t>(const void* data, int size, std::string* why) {
-  int pos = 24;  // hash, utime, seq | scene, method
-  return CheckStrings(data, size, &pos, 2, "solver_status_t", why);
-}
-
-template <>
-bool PreDecodeCheck<device_status_t>(const void* data, int size, std::string* why) {
-  int pos = 24;  // hash, utime, seq | device_id
-  return CheckStrings(data, size, &pos, 1, "device_status_t", why);
-}
-
-template <>
-bool PreDecodeCheck<command_t>(const void* data, int size, std::string* why) {
-  int pos = 17;  // hash, utime, command (int8) | argument
-  return CheckStrings(data, size, &pos, 1, "command_t", why);
-}
-
-template <>
-bool PreDecodeCheck<thread_shape_t>(const void* data, int size, std::string* why) {
-  int pos = 24;  // hash, utime, seq | scene, model | num_nodes, positions...
-  if (!CheckStrings(data, size, &pos, 2, "thread_shape_t", why)) return false;
-  const auto* p = static_cast<const uint8_t*>(data);
-  int32_t num_nodes = 0;
-  if (!ReadI32(p, size, &pos, &num_nodes)) return Fail(why, "thread_shape_t truncated");
-  if (num_nodes < 0 || num_nodes > kMaxShapeNodes) {
-    return Fail(why, "thread_shape_t: num_nodes " + std::to_string(num_nodes) +
-                         " outside [0, " + std::to_string(kMaxShapeNodes) + "]");
-  }
-  if (static_cast<int64_t>(num_nodes) * 24 > size - pos) {
-    return Fail(why, "thread_shape_t: buffer too short for num_nodes " +
-                         std::to_string(num_nodes));
-  }
-  return true;
-}
-
-bool Validate(const device_state_t& msg, std::string* why) {
-  if (!CheckString(msg.device_id, "device_id", why)) return false;
-  if (!CheckFinite(msg.position, 3, "position", why)) return false;
-  if (!CheckFinite(msg.orientation, 4, "orientation", why)) return false;
+bool QuaternionNorm(const device_state_t& msg, std::string* why) {
   double n2 = 0.0;
   for (double q : msg.orientation) n2 += q * q;
   const double n = std::sqrt(n2);
   if (n < kMinQuaternionNorm || n > kMaxQuaternionNorm) {
-    return Fail(why, "orientation quaternion norm " + std::to_string(n) + " outside [0.5, 2]");
+    return Fail(why, "orientation quaternion norm " + std::to_string(n) + " outside [" +
+                         std::to_string(kMinQuaternionNorm) + ", " +
+                         std::to_string(kMaxQuaternionNorm) + "]");
   }
   return true;
 }
 
-bool Validate(const force_model_t& msg, std::string* why) {
-  if (!CheckStatus(msg.status, why)) return false;
-  if (!CheckFinite(msg.u0, 3, "u0", why)) return false;
-  if (!CheckFinite(msg.f0, 3, "f0", why)) return false;
-  if (!CheckFinite(&msg.K[0][0], 9, "K", why)) return false;
-  if (msg.has_torque != 0 && msg.has_torque != 1) {
-    return Fail(why, "has_torque must be 0 or 1");
-  }
-  if (!CheckFinite(msg.torque0, 3, "torque0", why)) return false;
-  if (!CheckFinite(&msg.residual, 1, "residual", why)) return false;
-  if (msg.iterations < 0) return Fail(why, "iterations negative");
-  if (msg.solve_us < 0) return Fail(why, "solve_us negative");
-  return true;
-}
-
-bool Validate(const thread_shape_t& msg, std::string* why) {
-  if (!CheckString(msg.scene, "scene", why) || !CheckString(msg.model, "model", why)) {
-    return false;
-  }
-  if (msg.num_nodes < 0 || msg.num_nodes > kMaxShapeNodes) {
-    return Fail(why, "num_nodes " + std::to_string(msg.num_nodes) + " outside [0, " +
-                         std::to_string(kMaxShapeNodes) + "]");
-  }
+bool ShapePositions(const thread_shape_t& msg, std::string* why) {
   if (msg.positions.size() != static_cast<size_t>(msg.num_nodes)) {
     return Fail(why, "positions has " + std::to_string(msg.positions.size()) +
                          " rows, num_nodes says " + std::to_string(msg.num_nodes));
@@ -164,47 +40,160 @@ bool Validate(const thread_shape_t& msg, std::string* why) {
       return Fail(why, "positions row " + std::to_string(i) + " has " +
                            std::to_string(row.size()) + " entries, expected 3");
     }
-    if (!Finite(row.data(), 3)) {
-      return Fail(why, "positions row " + std::to_string(i) + " is not finite");
+    for (double v : row) {
+      if (!std::isfinite(v)) return Fail(why, "positions row " + std::to_string(i) + " is not finite");
     }
   }
-  if (!CheckFinite(msg.grasp, 3, "grasp", why)) return false;
-  if (!CheckFinite(msg.grip_direction, 3, "grip_direction", why)) return false;
-  if (!CheckFinite(msg.force, 3, "force", why)) return false;
-  if (!CheckFinite(msg.force_newtons, 3, "force_newtons", why)) return false;
-  if (!CheckStatus(msg.status, why)) return false;
   return true;
 }
 
-bool Validate(const solver_status_t& msg, std::string* why) {
-  if (!CheckString(msg.scene, "scene", why) || !CheckString(msg.method, "method", why)) {
-    return false;
-  }
-  if (!CheckFinite(&msg.residual, 1, "residual", why)) return false;
-  if (!CheckFinite(&msg.lambda_min, 1, "lambda_min", why)) return false;
-  if (!CheckFinite(&msg.update_rate_hz, 1, "update_rate_hz", why)) return false;
-  if (!CheckFinite(&msg.solve_us_p50, 1, "solve_us_p50", why)) return false;
-  if (!CheckFinite(&msg.solve_us_p99, 1, "solve_us_p99", why)) return false;
-  if (!CheckStatus(msg.status, why)) return false;
-  return true;
+// ---- one table per message type: its fields in .lcm order (lcmtypes/*.lcm) -----------------
+// Every double must be finite and every string at most kMaxStringBytes (Member's default);
+// the ranges below are the rest. The authentication fields (epoch, auth_seq, mac) are
+// checked by the receiver's auth layer (common/auth), not here.
+
+using D = device_state_t;
+const Field<D> kDeviceState[] = {
+    Member<&D::utime>("utime"),
+    Member<&D::seq>("seq"),
+    Member<&D::device_id>("device_id"),
+    Member<&D::position>("position"),
+    With(Member<&D::orientation>("orientation"), &QuaternionNorm),
+    Member<&D::buttons>("buttons"),
+    Member<&D::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&D::auth_seq>("auth_seq"),
+    Member<&D::mac>("mac"),
+};
+
+using F = force_model_t;
+const Field<F> kForceModel[] = {
+    Member<&F::utime>("utime"),
+    Member<&F::seq>("seq"),
+    Member<&F::device_seq>("device_seq"),
+    Member<&F::device_utime>("device_utime"),
+    Member<&F::server_receive_utime>("server_receive_utime"),
+    Member<&F::solve_us>("solve_us", 0, kInt32Max),
+    Member<&F::status>("status", F::STATUS_REGULAR, F::STATUS_INVALID),
+    Member<&F::u0>("u0"),
+    Member<&F::f0>("f0"),
+    Member<&F::K>("K"),
+    Member<&F::has_torque>("has_torque", 0, 1),
+    Member<&F::torque0>("torque0"),
+    Member<&F::iterations>("iterations", 0, kInt32Max),
+    Member<&F::residual>("residual"),
+    Member<&F::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&F::auth_seq>("auth_seq"),
+    Member<&F::mac>("mac"),
+};
+
+using S = thread_shape_t;
+const Field<S> kThreadShape[] = {
+    Member<&S::utime>("utime"),
+    Member<&S::seq>("seq"),
+    Member<&S::scene>("scene"),
+    Member<&S::model>("model"),
+    Count<&S::num_nodes>("num_nodes", 0, kMaxShapeNodes),
+    CountedRows<S>("positions", 3, &ShapePositions),
+    Member<&S::grasp>("grasp"),
+    Member<&S::grip_direction>("grip_direction"),
+    Member<&S::force>("force"),
+    Member<&S::force_newtons>("force_newtons"),
+    Member<&S::status>("status", F::STATUS_REGULAR, F::STATUS_INVALID),
+    Member<&S::snaps>("snaps"),
+    Member<&S::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&S::auth_seq>("auth_seq"),
+    Member<&S::mac>("mac"),
+};
+
+using V = solver_status_t;
+const Field<V> kSolverStatus[] = {
+    Member<&V::utime>("utime"),
+    Member<&V::seq>("seq"),
+    Member<&V::scene>("scene"),
+    Member<&V::method>("method"),
+    Member<&V::iterations>("iterations"),
+    Member<&V::residual>("residual"),
+    Member<&V::lambda_min>("lambda_min"),
+    Member<&V::negative_pivots>("negative_pivots"),
+    Member<&V::status>("status", F::STATUS_REGULAR, F::STATUS_INVALID),
+    Member<&V::update_rate_hz>("update_rate_hz"),
+    Member<&V::solve_us_p50>("solve_us_p50"),
+    Member<&V::solve_us_p99>("solve_us_p99"),
+    Member<&V::updates>("updates"),
+    Member<&V::snaps>("snaps"),
+    Member<&V::dropped_poses>("dropped_poses"),
+    Member<&V::rejected_messages>("rejected_messages"),
+    Member<&V::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&V::auth_seq>("auth_seq"),
+    Member<&V::mac>("mac"),
+};
+
+using T = device_status_t;
+const Field<T> kDeviceStatus[] = {
+    Member<&T::utime>("utime"),
+    Member<&T::seq>("seq"),
+    Member<&T::device_id>("device_id"),
+    Member<&T::tick_rate_hz>("tick_rate_hz"),
+    Member<&T::lateness_us_p50>("lateness_us_p50"),
+    Member<&T::lateness_us_p99>("lateness_us_p99"),
+    Member<&T::lateness_us_max>("lateness_us_max"),
+    Member<&T::model_age_ms>("model_age_ms"),
+    Member<&T::round_trip_us_p50>("round_trip_us_p50"),
+    Member<&T::round_trip_us_p99>("round_trip_us_p99"),
+    Member<&T::force_norm_n>("force_norm_n"),
+    Member<&T::ticks>("ticks"),
+    Member<&T::models_received>("models_received"),
+    Member<&T::models_rejected>("models_rejected"),
+    Member<&T::force_clamps>("force_clamps"),
+    Member<&T::stiffness_clamps>("stiffness_clamps"),
+    Member<&T::slew_limits>("slew_limits"),
+    Member<&T::fades>("fades"),
+    Member<&T::snaps_felt>("snaps_felt"),
+    Member<&T::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&T::auth_seq>("auth_seq"),
+    Member<&T::mac>("mac"),
+};
+
+using C = command_t;
+const Field<C> kCommand[] = {
+    Member<&C::utime>("utime"),
+    Member<&C::command>("command", C::RESET, C::SET_METHOD),
+    Member<&C::argument>("argument"),
+    Member<&C::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&C::auth_seq>("auth_seq"),
+    Member<&C::mac>("mac"),
+};
+
+std::span<const Field<D>> TableOf(const D*) { return kDeviceState; }
+std::span<const Field<F>> TableOf(const F*) { return kForceModel; }
+std::span<const Field<S>> TableOf(const S*) { return kThreadShape; }
+std::span<const Field<V>> TableOf(const V*) { return kSolverStatus; }
+std::span<const Field<T>> TableOf(const T*) { return kDeviceStatus; }
+std::span<const Field<C>> TableOf(const C*) { return kCommand; }
+
+template <class M>
+bool ValidateByTable(const M& msg, std::string* why) {
+  return CheckFields(TableOf(static_cast<const M*>(nullptr)), msg, why);
 }
 
-bool Validate(const device_status_t& msg, std::string* why) {
-  if (!CheckString(msg.device_id, "device_id", why)) return false;
-  const double values[] = {msg.tick_rate_hz,     msg.lateness_us_p50,   msg.lateness_us_p99,
-                           msg.lateness_us_max,  msg.model_age_ms,      msg.round_trip_us_p50,
-                           msg.round_trip_us_p99, msg.force_norm_n};
-  if (!CheckFinite(values, 8, "a statistic", why)) return false;
-  return true;
-}
+}  // namespace
 
-bool Validate(const command_t& msg, std::string* why) {
-  if (msg.command != command_t::RESET && msg.command != command_t::LOAD_SCENE &&
-      msg.command != command_t::SET_METHOD) {
-    return Fail(why, "unknown command " + std::to_string(msg.command));
-  }
-  if (!CheckString(msg.argument, "argument", why)) return false;
-  return true;
+template <class M>
+bool PreDecodeCheck(const void* data, int size, std::string* why) {
+  return CheckWire(TableOf(static_cast<const M*>(nullptr)), data, size, why);
 }
+template bool PreDecodeCheck<device_state_t>(const void*, int, std::string*);
+template bool PreDecodeCheck<force_model_t>(const void*, int, std::string*);
+template bool PreDecodeCheck<thread_shape_t>(const void*, int, std::string*);
+template bool PreDecodeCheck<solver_status_t>(const void*, int, std::string*);
+template bool PreDecodeCheck<device_status_t>(const void*, int, std::string*);
+template bool PreDecodeCheck<command_t>(const void*, int, std::string*);
+
+bool Validate(const device_state_t& msg, std::string* why) { return ValidateByTable(msg, why); }
+bool Validate(const force_model_t& msg, std::string* why) { return ValidateByTable(msg, why); }
+bool Validate(const thread_shape_t& msg, std::string* why) { return ValidateByTable(msg, why); }
+bool Validate(const solver_status_t& msg, std::string* why) { return ValidateByTable(msg, why); }
+bool Validate(const device_status_t& msg, std::string* why) { return ValidateByTable(msg, why); }
+bool Validate(const command_t& msg, std::string* why) { return ValidateByTable(msg, why); }
 
 }  // namespace snapthread::transport

@@ -9,6 +9,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "messages/field_table.h"
 #include "snapthread/command_t.hpp"
 #include "snapthread/device_state_t.hpp"
 #include "snapthread/device_status_t.hpp"
@@ -20,15 +21,14 @@ namespace snapthread::transport {
 
 // Largest thread_shape_t the service accepts (positions are 24 bytes per node).
 inline constexpr int kMaxShapeNodes = 100000;
-// Largest string accepted in any message field, bytes.
-inline constexpr size_t kMaxStringBytes = 4096;
 // Accepted range of a quaternion's norm: clients send unit quaternions; anything far off
 // is a corrupted message, not a rounding error.
 inline constexpr double kMinQuaternionNorm = 0.5;
 inline constexpr double kMaxQuaternionNorm = 2.0;
 
 // Each returns true when the message is usable; otherwise false with the reason in
-// *why (if why is non-null). Never throws.
+// *why (if why is non-null). Never throws. The rules are the message's field table
+// (validate.cc, one per type); a force model is checked here and nowhere else.
 bool Validate(const device_state_t& msg, std::string* why);
 bool Validate(const force_model_t& msg, std::string* why);
 bool Validate(const thread_shape_t& msg, std::string* why);
@@ -36,26 +36,12 @@ bool Validate(const solver_status_t& msg, std::string* why);
 bool Validate(const device_status_t& msg, std::string* why);
 bool Validate(const command_t& msg, std::string* why);
 
-// Checks an encoded buffer before handing it to the generated decoder. lcm-gen 1.3.1's
-// decoders trust the wire: a string length of INT32_MIN makes them read 2 GB past the
-// buffer, and a corrupted num_nodes makes thread_shape_t allocate whatever it says. So
-// every type with a string or a variable array has its length fields checked here
-// first (each string length in [1, bytes left], num_nodes in [0, kMaxShapeNodes] and
-// within the buffer). force_model_t has neither and needs no check.
+// Checks an encoded buffer before handing it to the generated decoder: every string
+// length and array count of T against the bytes there, and that T's fields fill the
+// buffer exactly (field_table.h: CheckWire).
+// Defined for the six message types above.
 template <class T>
 bool PreDecodeCheck(const void* data, int size, std::string* why);
-template <>
-bool PreDecodeCheck<force_model_t>(const void* data, int size, std::string* why);
-template <>
-bool PreDecodeCheck<device_state_t>(const void* data, int size, std::string* why);
-template <>
-bool PreDecodeCheck<thread_shape_t>(const void* data, int size, std::string* why);
-template <>
-bool PreDecodeCheck<solver_status_t>(const void* data, int size, std::string* why);
-template <>
-bool PreDecodeCheck<device_status_t>(const void* data, int size, std::string* why);
-template <>
-bool PreDecodeCheck<command_t>(const void* data, int size, std::string* why);
 
 // Decodes `data` into *out and validates it. False (with *why) for a malformed buffer
 // (wrong hash, truncated, trailing bytes, absurd counts) or an invalid message.

@@ -12,6 +12,7 @@
 #include "safety.h"
 #include "scripted_path.h"
 #include "sim_path_device.h"
+#include "messages/pose_mapping.h"
 #include "scene/scene.h"
 #include "virtual_hand_device.h"
 
@@ -446,8 +447,8 @@ TEST(DeviceScriptedPathTest, SceneWaypointsAreMappedToMetres) {
   EXPECT_NEAR(p.waypoints_m()[1][0], 0.02, 1e-15);
   EXPECT_NEAR(p.waypoints_m()[1][1], -0.01, 1e-15);
   // And back: model = origin + scale * device.
-  const double dev[3] = {-0.02, 0.005, 0.0};
-  const auto model = DeviceToModel(scene.device, dev);
+  const Eigen::Vector3d model =
+      snapthread::messages::DeviceToModelPoint(scene.device, Eigen::Vector3d(-0.02, 0.005, 0.0));
   EXPECT_NEAR(model[0], -2.0, 1e-12);
   EXPECT_NEAR(model[1], 3.0, 1e-12);
 }

@@ -2,7 +2,8 @@
 // never allocates: global operator new/delete are replaced by counting versions (after
 // Drake's iiwa_command_sender_test.cc malloc guard), one warm-up tick runs, then 10,000
 // ticks must allocate nothing, through fresh models, stale-model fades, out-of-workspace
-// poses, full rings and both simulated backends.
+// poses, full rings and both simulated backends; and the same through DeviceClient::Tick
+// (the production path) with its receive and io steps run between the ticks.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -11,6 +12,8 @@
 #include <new>
 #include <vector>
 
+#include "device_client.h"
+#include "device_fakes.h"
 #include "safety.h"
 #include "realtime/percentiles.h"
 #include "servo_loop.h"
@@ -157,6 +160,44 @@ TEST(DeviceServoTickAllocationTest, SimPathTickNeverAllocatesIncludingOutOfWorks
   // The path leaves the 5 cm workspace: poses are rejected (zero force, not published).
   SimPathDevice sim(ScriptedPath({{-0.04, 0.0, 0.0}, {0.08, 0.0, 0.0}}, 0.05), &TestClock);
   EXPECT_GT(RunTicks(&sim, 10000), 1000u);
+}
+
+TEST(DeviceServoTickAllocationTest, DeviceClientTickNeverAllocates) {
+  g_now_us += 1000000;
+  VirtualHandDevice hand(ScriptedPath({{-0.02, 0.0, 0.0}, {0.02, 0.01, 0.0}}, 0.05), {},
+                         &TestClock);
+  ASSERT_TRUE(hand.Open(nullptr));
+  testing::InMemoryTransport transport;
+  testing::SpringServer server(&transport, 300.0);
+  DeviceClientConfig config;
+  config.loop.realtime = false;
+  config.log_period_us = 0;
+  config.clock = &TestClock;
+  DeviceClient client(&hand, &transport, config);
+  g_now_us += 1000;
+  client.Tick(g_now_us, 3);  // warm-up
+  long allocations = 0;
+  for (int i = 0; i < 10000; ++i) {
+    // Off the servo thread, not counted: the io step publishes poses, the fake server
+    // answers (silent for 300 ms every 3 s, to exercise the fade), the receive step
+    // decodes and hands the models over.
+    client.Service(g_now_us);
+    if ((i / 1000) % 3 == 2 && (i % 1000) < 300) {
+      server.TakeNewPoses();
+    } else {
+      server.AnswerAll();
+    }
+    client.Receive(0);
+    g_now_us += 1000;
+    AllocationGuard guard;
+    client.Tick(g_now_us, i % 37);
+    allocations += guard.count();
+  }
+  EXPECT_EQ(allocations, 0);
+  EXPECT_GT(client.receiver().received(), 5000u);
+  EXPECT_GT(client.safety().counters().fade_ticks.load(), 0u);
+  EXPECT_EQ(client.safety().counters().nonfinite_outputs.load(), 0u);
+  hand.Close();
 }
 
 TEST(DeviceMallocGuardTest, SampleWindowPushAndComputeNeverAllocate) {

@@ -123,13 +123,12 @@ class ProcessTest : public ::testing::Test {
   // y = 3.8 (the bent-up branch ends at y ~ 3.42 and the strip snaps to bent down), and
   // back. Written as device metres for the device's --path-csv.
   std::string WriteSnapPath() {
-    auto model = MakeModel(scene_.params);
     const Vec a = scene_.grasp_start;
     const Vec b = (Vec(2) << a[0], 3.8).finished();
     const std::string path = dir_ + "/path.csv";
     std::ofstream out(path);
     for (const Vec& u : {a, b}) {
-      const Eigen::Vector3d p = ControlsToPosition(scene_.device, *model, u);
+      const Eigen::Vector3d p = messages::ControlsToPosition(scene_.device, scene_.grasp_layout, u);
       out << p[0] << "," << p[1] << "," << p[2] << "\n";
     }
     return path;
@@ -180,8 +179,8 @@ class ProcessTest : public ::testing::Test {
     std::vector<Eigen::Vector2d> ref;
     *snaps = 0;
     for (const TraceRow& r : rows) {
-      const Vec u = PoseToControls(scene_.device, tracker.model(), Eigen::Vector3d(r.x, r.y, r.z),
-                                   Eigen::Vector4d(1, 0, 0, 0));
+      const Vec u = messages::PoseToControls(scene_.device, scene_.grasp_layout,
+                                             Eigen::Vector3d(r.x, r.y, r.z), Eigen::Vector4d(1, 0, 0, 0));
       const TrackResult& t = tracker.Update(u);
       if (t.snapped) ++*snaps;
       ref.emplace_back(scene_.device.newtons_per_model_force * t.force[0],

@@ -35,60 +35,58 @@ TrackResult FakeResult(int nu, double scale) {
 
 TEST(PoseMappingTest, PlanarAndSpatialControls) {
   const DeviceMapping map = TestMapping();
-  ModelParams p;
-  p.model = "curve2d";
-  auto curve = MakeModel(p);
+  // The layouts a scene carries (Scene::grasp_layout): no model is built.
+  const GraspLayout curve{2, false};
   const Eigen::Vector3d pos(0.01, -0.02, 0.3);
   const Eigen::Vector4d q(1, 0, 0, 0);
-  const Vec u = PoseToControls(map, *curve, pos, q);
+  const Vec u = messages::PoseToControls(map, curve, pos, q);
   ASSERT_EQ(u.size(), 2);
   EXPECT_DOUBLE_EQ(u[0], 9.0 + 50.0 * 0.01);
   EXPECT_DOUBLE_EQ(u[1], 1.0 - 50.0 * 0.02);
   // Inverse: x, y back, z on the model plane.
-  const Eigen::Vector3d back = ControlsToPosition(map, *curve, u);
+  const Eigen::Vector3d back = messages::ControlsToPosition(map, curve, u);
   EXPECT_NEAR(back[0], 0.01, 1e-15);
   EXPECT_NEAR(back[1], -0.02, 1e-15);
-  EXPECT_DOUBLE_EQ(back[2], PlanarZ0(map));
-  EXPECT_DOUBLE_EQ(PlanarZ0(map), -0.25 / 50.0);
+  EXPECT_DOUBLE_EQ(back[2], messages::PlanarZ0(map));
+  EXPECT_DOUBLE_EQ(messages::PlanarZ0(map), -0.25 / 50.0);
 
-  p.model = "thread3d";
-  p.grip_direction = true;
-  auto thread = MakeModel(p);
-  ASSERT_EQ(thread->NumControls(), 6);
+  const GraspLayout thread{3, true};
+  ASSERT_EQ(thread.NumControls(), 6);
   // 90 degrees about z: (1,0,0) -> (0,1,0).
   const double h = std::sqrt(0.5);
-  const Vec u3 = PoseToControls(map, *thread, pos, Eigen::Vector4d(h, 0, 0, h));
+  const Vec u3 = messages::PoseToControls(map, thread, pos, Eigen::Vector4d(h, 0, 0, h));
   EXPECT_DOUBLE_EQ(u3[2], 0.25 + 50.0 * 0.3);
   EXPECT_NEAR(u3[3], 0.0, 1e-15);
   EXPECT_NEAR(u3[4], 1.0, 1e-15);
   EXPECT_NEAR(u3[5], 0.0, 1e-15);
   // A non-unit quaternion is normalised; 180 degrees about z gives -x.
-  const Eigen::Vector3d d = GripDirection(Eigen::Vector4d(0, 0, 0, 1.7));
+  const Eigen::Vector3d d = messages::GripDirection(Eigen::Vector4d(0, 0, 0, 1.7));
   EXPECT_NEAR(d[0], -1.0, 1e-15);
   EXPECT_NEAR(d.norm(), 1.0, 1e-15);
 
   // A scene that starts with the grip along -x: the device at rest holds it so, and
   // turning the device 90 degrees about z turns the grip with it, to -y.
   const Eigen::Vector3d rest(-2.0, 0.0, 0.0);
-  const Vec at_rest = PoseToControls(map, *thread, pos, Eigen::Vector4d(1, 0, 0, 0), rest);
+  const Vec at_rest = messages::PoseToControls(map, thread, pos, Eigen::Vector4d(1, 0, 0, 0), rest);
   EXPECT_NEAR(at_rest[3], -1.0, 1e-15);
   EXPECT_NEAR(at_rest[4], 0.0, 1e-15);
-  const Vec turned = PoseToControls(map, *thread, pos, Eigen::Vector4d(h, 0, 0, h), rest);
+  const Vec turned = messages::PoseToControls(map, thread, pos, Eigen::Vector4d(h, 0, 0, h), rest);
   EXPECT_NEAR(turned[3], 0.0, 1e-15);
   EXPECT_NEAR(turned[4], -1.0, 1e-15);
   EXPECT_NEAR(turned[5], 0.0, 1e-15);
   // About x the -x grip does not move.
-  const Vec rolled = PoseToControls(map, *thread, pos, Eigen::Vector4d(h, h, 0, 0), rest);
+  const Vec rolled = messages::PoseToControls(map, thread, pos, Eigen::Vector4d(h, h, 0, 0), rest);
   EXPECT_NEAR(rolled[3], -1.0, 1e-15);
 
   Scene scene;
-  scene.params = p;
+  scene.grasp_layout = thread;
   scene.grasp_start = (Vec(6) << 1, 2, 3, 0, 0, 5).finished();
-  const Eigen::Vector3d r = RestGripDirection(scene, *thread);
+  const Eigen::Vector3d r = messages::RestGripDirection(scene);
   EXPECT_NEAR(r[2], 1.0, 1e-15);
   EXPECT_NEAR(r.norm(), 1.0, 1e-15);
+  scene.grasp_layout = curve;
   scene.grasp_start = (Vec(2) << 1, 2).finished();
-  EXPECT_EQ(RestGripDirection(scene, *curve), Eigen::Vector3d::UnitX());
+  EXPECT_EQ(messages::RestGripDirection(scene), Eigen::Vector3d::UnitX());
 }
 
 TEST(ServerMessagesTest, PlanarForceModelUnitsAndPlane) {
@@ -125,7 +123,7 @@ TEST(ServerMessagesTest, PlanarForceModelUnitsAndPlane) {
   // Planar constraint: f_z = -k (z - z0), k = max stiffness / 2.
   const double k = 400.0;
   EXPECT_DOUBLE_EQ(m.K[2][2], -k);
-  EXPECT_NEAR(m.f0[2], -k * (0.003 - PlanarZ0(map)), 1e-12);
+  EXPECT_NEAR(m.f0[2], -k * (0.003 - messages::PlanarZ0(map)), 1e-12);
   EXPECT_EQ(m.has_torque, 0);
   for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(m.u0[i], in.position_m[i]);
   std::string why;
@@ -198,7 +196,7 @@ TEST(ServerMessagesTest, NonFiniteResultBecomesInvalidZeroModel) {
     in.position_m = Eigen::Vector3d(0.01, 0.0, 0.0);
     in.result = &r;
     const force_model_t m = BuildForceModel(in);
-    EXPECT_TRUE(IsFinite(m)) << "variant " << variant;
+    EXPECT_TRUE(transport::Validate(m, nullptr)) << "variant " << variant;
     std::string why;
     EXPECT_TRUE(transport::Validate(m, &why)) << why;
     if (variant < 3) {

@@ -51,7 +51,7 @@ class Probe {
   }
 
   void OnModel(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    Keep<force_model_t>(rbuf, &models_, IsFinite);
+    Keep<force_model_t>(rbuf, &models_);  // DecodeAndValidate: the one force-model check
   }
   void OnShape(const lcm::ReceiveBuffer* rbuf, const std::string&) { Keep<thread_shape_t>(rbuf, &shapes_); }
   void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string&) { Keep<solver_status_t>(rbuf, &statuses_); }
@@ -88,14 +88,14 @@ class Probe {
   }
 
  private:
-  // Decodes and validates a message into *kept (and `accept` when given); counts the rest.
+  // Decodes and validates a message into *kept; counts the rest.
   template <typename T>
-  void Keep(const lcm::ReceiveBuffer* rbuf, std::vector<T>* kept, bool (*accept)(const T&) = nullptr) {
+  void Keep(const lcm::ReceiveBuffer* rbuf, std::vector<T>* kept) {
     T msg;
     std::string why;
     const bool ok = transport::DecodeAndValidate(rbuf, &msg, &why);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!ok || (accept != nullptr && !accept(msg))) {
+    if (!ok) {
       ++invalid_;
       return;
     }
@@ -198,14 +198,14 @@ class ServerTest : public ::testing::Test {
 
 // Poses from a to b (model controls) in device metres, with a small z offset so the
 // planar constraint acts.
-std::vector<Eigen::Vector3d> PosesBetween(const Scene& scene, const Model& model, const Vec& a,
+std::vector<Eigen::Vector3d> PosesBetween(const Scene& scene, const Vec& a,
                                           const Vec& b, int steps, double z_offset_m) {
   std::vector<Eigen::Vector3d> poses;
   for (int i = 1; i <= steps; ++i) {
     const Vec u = a + (b - a) * (static_cast<double>(i) / steps);
     Vec full = scene.grasp_start;
     full.head(u.size()) = u;
-    Eigen::Vector3d p = ControlsToPosition(scene.device, model, full);
+    Eigen::Vector3d p = messages::ControlsToPosition(scene.device, scene.grasp_layout, full);
     p[2] += z_offset_m;
     poses.push_back(p);
   }
@@ -213,9 +213,9 @@ std::vector<Eigen::Vector3d> PosesBetween(const Scene& scene, const Model& model
 }
 
 // Along the first leg of the scene's path.
-std::vector<Eigen::Vector3d> PathPoses(const Scene& scene, const Model& model, int steps,
+std::vector<Eigen::Vector3d> PathPoses(const Scene& scene, int steps,
                                        double z_offset_m) {
-  return PosesBetween(scene, model, scene.path.at(0), scene.path.at(1), steps, z_offset_m);
+  return PosesBetween(scene, scene.path.at(0), scene.path.at(1), steps, z_offset_m);
 }
 
 TEST_F(ServerTest, ForceModelsMatchDirectTrackerInDeviceUnits) {
@@ -229,7 +229,7 @@ TEST_F(ServerTest, ForceModelsMatchDirectTrackerInDeviceUnits) {
   // fold and the strip snaps to bent down (the seed's Fig 2.1 strip, n = 10, X = 9).
   const Vec a = scene.grasp_start;
   const Vec b = (Vec(2) << a[0], 3.8).finished();
-  const auto poses = PosesBetween(scene, model, a, b, 150, z_offset);
+  const auto poses = PosesBetween(scene, a, b, 150, z_offset);
 
   int direct_snaps = 0, server_snaps = 0;
   double max_force_n = 0.0;
@@ -237,7 +237,7 @@ TEST_F(ServerTest, ForceModelsMatchDirectTrackerInDeviceUnits) {
     Publish(MakePose(static_cast<int64_t>(i), poses[i]));
     force_model_t m;
     ASSERT_TRUE(probe_->WaitModel(static_cast<int64_t>(i), &m)) << "no answer to pose " << i;
-    const Vec u = PoseToControls(map, model, poses[i], Eigen::Vector4d(1, 0, 0, 0));
+    const Vec u = messages::PoseToControls(map, scene.grasp_layout, poses[i], Eigen::Vector4d(1, 0, 0, 0));
     const TrackResult& r = direct.Update(u);
     if (r.snapped) ++direct_snaps;
     if (m.status == force_model_t::STATUS_SNAPPED) ++server_snaps;
@@ -295,20 +295,20 @@ TEST_F(ServerTest, ThreadGripDirectionFromOrientation) {
   direct.Reset(scene.grasp_start);
   const Model& model = direct.model();
   ASSERT_EQ(model.NumControls(), 6);
-  const Eigen::Vector3d rest = RestGripDirection(scene, model);
+  const Eigen::Vector3d rest = messages::RestGripDirection(scene);
   EXPECT_NEAR((rest - scene.grasp_start.segment<3>(3).normalized()).norm(), 0.0, 1e-15);
   // A device at rest (identity) holds the scene's grip; the last poses turn it by 20
   // degrees about z.
   const double half = 0.5 * 20.0 * M_PI / 180.0;
   const Eigen::Vector4d turned(std::cos(half), 0, 0, std::sin(half));
-  const auto poses = PathPoses(scene, model, 30, 0.0);
+  const auto poses = PathPoses(scene, 30, 0.0);
   int direct_snaps = 0;
   for (size_t i = 0; i < poses.size(); ++i) {
     const Eigen::Vector4d q = i < 20 ? Eigen::Vector4d(1, 0, 0, 0) : turned;
     Publish(MakePose(static_cast<int64_t>(i), poses[i], q));
     force_model_t m;
     ASSERT_TRUE(probe_->WaitModel(static_cast<int64_t>(i), &m));
-    const Vec u = PoseToControls(scene.device, model, poses[i], q, rest);
+    const Vec u = messages::PoseToControls(scene.device, scene.grasp_layout, poses[i], q, rest);
     if (i < 20) {
       EXPECT_NEAR((u.segment<3>(3) - rest).norm(), 0.0, 1e-15);
     }
@@ -347,7 +347,7 @@ TEST_F(ServerTest, LatestWinsUnderABurst) {
   StartServer("curve2d_snap.yaml", hooks);
   const Scene scene = LoadScene(ScenePath("curve2d_snap.yaml"));
   auto model = MakeModel(scene.params);
-  const auto poses = PathPoses(scene, *model, 50, 0.0);
+  const auto poses = PathPoses(scene, 50, 0.0);
   Publish(MakePose(0, poses[0]));
   entered.wait();
   for (int i = 1; i < 50; ++i) Publish(MakePose(i, poses[i]));
@@ -374,7 +374,7 @@ TEST_F(ServerTest, LatestWinsWithoutHelp) {
   StartServer("curve2d_snap.yaml");
   const Scene scene = LoadScene(ScenePath("curve2d_snap.yaml"));
   auto model = MakeModel(scene.params);
-  const auto poses = PathPoses(scene, *model, 50, 0.0);
+  const auto poses = PathPoses(scene, 50, 0.0);
   for (int i = 0; i < 50; ++i) Publish(MakePose(i, poses[i]));
   ASSERT_TRUE(probe_->WaitModel(49, nullptr));
   ASSERT_TRUE(WaitFor([&] {
@@ -392,7 +392,7 @@ TEST_F(ServerTest, CommandsResetSetMethodLoadScene) {
   StartServer("curve2d_snap.yaml");
   const Scene curve = LoadScene(ScenePath("curve2d_snap.yaml"));
   auto model = MakeModel(curve.params);
-  const auto poses = PathPoses(curve, *model, 40, 0.0);
+  const auto poses = PathPoses(curve, 40, 0.0);
   for (int i = 0; i < 40; ++i) {
     Publish(MakePose(i, poses[i]));
     ASSERT_TRUE(probe_->WaitModel(i, nullptr));
@@ -414,7 +414,8 @@ TEST_F(ServerTest, CommandsResetSetMethodLoadScene) {
     Publish(MakePose(100, poses[0]));
     ASSERT_TRUE(probe_->WaitModel(100, &m));
     const TrackResult& r =
-        fresh.Update(PoseToControls(curve.device, fresh.model(), poses[0], Eigen::Vector4d(1, 0, 0, 0)));
+        fresh.Update(messages::PoseToControls(curve.device, curve.grasp_layout, poses[0],
+                                               Eigen::Vector4d(1, 0, 0, 0)));
     EXPECT_NEAR(m.f0[0], curve.device.newtons_per_model_force * r.force[0], 1e-9);
     EXPECT_NEAR(m.f0[1], curve.device.newtons_per_model_force * r.force[1], 1e-9);
   }
@@ -468,13 +469,14 @@ TEST_F(ServerTest, CommandsResetSetMethodLoadScene) {
   options.method = "newton";
   EquilibriumTracker direct(MakeModel(zeeman.params), options);
   direct.Reset(zeeman.grasp_start);
-  const auto zposes = PathPoses(zeeman, direct.model(), 30, 0.0);
+  const auto zposes = PathPoses(zeeman, 30, 0.0);
   for (int i = 0; i < 30; ++i) {
     Publish(MakePose(200 + i, zposes[i]));
     force_model_t m;
     ASSERT_TRUE(probe_->WaitModel(200 + i, &m));
     const TrackResult& r =
-        direct.Update(PoseToControls(zeeman.device, direct.model(), zposes[i], Eigen::Vector4d(1, 0, 0, 0)));
+        direct.Update(messages::PoseToControls(zeeman.device, zeeman.grasp_layout, zposes[i],
+                                                Eigen::Vector4d(1, 0, 0, 0)));
     for (int a = 0; a < 2; ++a) {
       EXPECT_NEAR(m.f0[a], zeeman.device.newtons_per_model_force * r.force[a], 1e-9) << i;
     }
@@ -587,7 +589,7 @@ TEST_F(ServerTest, FarPosesNeverPublishNaN) {
   }
   EXPECT_EQ(probe_->models().size(), static_cast<size_t>(seq));
   EXPECT_EQ(probe_->invalid(), 0);
-  for (const auto& m : probe_->models()) EXPECT_TRUE(IsFinite(m));
+  for (const auto& m : probe_->models()) EXPECT_TRUE(transport::Validate(m, nullptr));
 }
 
 }  // namespace

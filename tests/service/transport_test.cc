@@ -410,6 +410,19 @@ TEST(TransportDecodeTest, CorruptStringLengthDoesNotThrow) {
   }
 }
 
+TEST(TransportDecodeTest, StringWithoutItsNulIsRefused) {
+  // lcm-gen's decoder skips a string's last byte without looking at it.
+  auto m = SampleDeviceState();
+  auto bytes = Encode(m);
+  const size_t nul = 24 + 4 + m.device_id.size();
+  ASSERT_EQ(bytes[nul], 0);
+  bytes[nul] = 0xF9;
+  device_state_t out;
+  std::string why;
+  EXPECT_FALSE(DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &out, &why));
+  EXPECT_NE(why.find("NUL"), std::string::npos) << why;
+}
+
 // Random garbage, and valid messages with random byte flips: never a crash, a throw or
 // an accepted message with non-finite content.
 template <class T>

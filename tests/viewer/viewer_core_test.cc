@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "messages/pose_mapping.h"
 #include "snapthread/device_state_t.hpp"
 
 #include "grasp_publisher.h"
@@ -61,9 +62,9 @@ TEST(GraspMappingTest, ModelToDeviceInvertsTheSceneMapping) {
   m.model_units_per_metre = 50.0;
   m.model_origin = {1.0, -2.0, 0.5};
   const Eigen::Vector3d model(3.0, 0.25, -1.0);
-  const Eigen::Vector3d dev = ModelToDeviceMetres(m, model);
+  const Eigen::Vector3d dev = messages::ModelPointToDevice(m, model);
   EXPECT_NEAR(dev.x(), 2.0 / 50.0, 1e-15);
-  EXPECT_LT((DeviceMetresToModel(m, dev) - model).norm(), 1e-12);
+  EXPECT_LT((messages::DeviceToModelPoint(m, dev) - model).norm(), 1e-12);
 }
 
 // Receives device_state_t on one channel (memq: same process, synchronous handle()).

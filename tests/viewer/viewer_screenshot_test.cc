@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "messages/pose_mapping.h"
 #include "grasp_publisher.h"
 #include "hud_layout.h"
 #include "snapthread/device_state_t.hpp"
@@ -414,7 +415,7 @@ TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
   Eigen::Vector3d origin, direction;
   camera.PixelRay(target_px.x(), target_px.y(), kWidth, kHeight, &origin, &direction);
   const Eigen::Vector3d target_model = origin - origin.z() / direction.z() * direction;  // z = 0
-  const Eigen::Vector3d expected_m = viewer::ModelToDeviceMetres(scene.device, target_model);
+  const Eigen::Vector3d expected_m = messages::ModelPointToDevice(scene.device, target_model);
 
   ShapePublisher publisher(session, /*with_garbage=*/false);
   ASSERT_TRUE(publisher.Start());
@@ -456,7 +457,7 @@ TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
   EXPECT_NEAR(last.position[1], expected_m.y(), 5e-4);
   EXPECT_NEAR(last.position[2], expected_m.z(), 1e-9);  // planar model: on the plane z = 0
   // The drag moved it: far from the grasp's own position.
-  const Eigen::Vector3d grasp_m = viewer::ModelToDeviceMetres(scene.device, ArcNodes().back());
+  const Eigen::Vector3d grasp_m = messages::ModelPointToDevice(scene.device, ArcNodes().back());
   EXPECT_GT(std::hypot(last.position[0] - grasp_m.x(), last.position[1] - grasp_m.y()), 5e-3);
 }
 
