@@ -73,6 +73,9 @@ struct ServerStats {
 struct ServerTestHooks {
   // Just before each tracker update (a test blocks here to pile up poses).
   std::function<void()> before_update;
+  // Just after each tracker update, with the controls and the tracker (its state and
+  // last result): a test compares the server's path with a sweep of the same scene.
+  std::function<void(const Vec& u, const EquilibriumTracker& tracker)> after_update;
 };
 
 class Server {
