@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "auth/key_file.h"
 #include "models/models.h"
 
 extern char** environ;
@@ -101,11 +103,25 @@ ServiceRun RunServiceOnce(const ServiceOptions& o, const std::string& scene, int
   const std::string session = "BENCH_" + std::to_string(getpid()) + "_" + std::to_string(index);
   fs::create_directories(o.work_dir);
   const std::string base = o.work_dir + "/" + session;
+  // The session key both binaries sign with: $SNAPTHREAD_KEY_FILE when set, else a new
+  // one for this run (mode 0600) next to its logs.
+  std::string key_path;
+  if (const char* env = std::getenv(auth::kKeyFileEnv); env != nullptr && *env != '\0') {
+    key_path = env;
+  } else {
+    key_path = base + ".key";
+    try {
+      auth::WriteNewKey(auth::KeyLocation{key_path, "bench"}, /*overwrite=*/true);
+    } catch (const std::exception& e) {
+      run.error = std::string("cannot make a session key: ") + e.what();
+      return run;
+    }
+  }
   char duration[32], safety[32];
   std::snprintf(duration, sizeof duration, "%g", o.duration_s);
   std::snprintf(safety, sizeof safety, "%g", o.duration_s + 60.0);  // a safety net only
   const pid_t server =
-      Spawn({server_bin, "--scene", scene_file, "--session", session, "--lcm-url", o.lcm_url, "--duration", safety,
+      Spawn({server_bin, "--key", key_path, "--scene", scene_file, "--session", session, "--lcm-url", o.lcm_url, "--duration", safety,
              "--log-level", "info", "--summary", base + "_server.json"},
             base + "_server.log");
   if (server < 0) {
@@ -130,7 +146,7 @@ ServiceRun RunServiceOnce(const ServiceOptions& o, const std::string& scene, int
     return run;
   }
   const pid_t device =
-      Spawn({device_bin, "--backend", "virtual-hand", "--scene", scene_file, "--session", session, "--lcm-url",
+      Spawn({device_bin, "--key", key_path, "--backend", "virtual-hand", "--scene", scene_file, "--session", session, "--lcm-url",
              o.lcm_url, "--duration", duration, "--rate-hz", "1000", "--publish-divisor", "1", "--no-rt",
              "--summary", base + "_device.json"},
             base + "_device.log");
