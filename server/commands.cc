@@ -36,6 +36,16 @@ void Server::ApplyCommand(const command_t& command) {
       break;
     }
     case command_t::LOAD_SCENE: {
+      // A name that is not one (a path, "..") is refused here at once; the file itself is
+      // opened and checked on the loader thread.
+      try {
+        SceneFileName(command.argument);
+      } catch (const SceneNameError& e) {
+        ok = false;
+        rejected = true;
+        message = std::string(e.what()) + "; keeping scene '" + session_->scene.name + "'";
+        break;
+      }
       if (load_.busy()) {
         ok = false;
         message = "LOAD_SCENE '" + command.argument + "' refused: LOAD_SCENE '" + load_name_ +
