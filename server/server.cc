@@ -14,7 +14,7 @@
 #include "scene_dir.h"
 #include "server_messages.h"
 #include "server_session.h"
-#include "models/models.h"
+#include "tracking/make_tracker.h"
 #include "realtime/clock.h"
 #include "messages/lcm_url.h"
 #include "messages/validate.h"
@@ -99,14 +99,8 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
     options.method = method_override_;
   }
   session->scene.solver = options;
-  // MakeModel / the tracker throw std::invalid_argument for invalid parameters.
-  session->tracker = std::make_unique<EquilibriumTracker>(MakeModel(scene.params), options);
-  if (scene.grasp_start.size() != session->tracker->model().NumControls()) {
-    throw SceneError(scene.file + ": grasp_start has " +
-                     std::to_string(scene.grasp_start.size()) + " entries, model " +
-                     std::string(session->tracker->model().Name()) + " has " +
-                     std::to_string(session->tracker->model().NumControls()) + " controls");
-  }
+  // The one scene -> tracker path (SceneError for invalid parameters or options).
+  session->tracker = MakeTracker(session->scene);
   if (scene.grasp_layout.NumControls() != session->tracker->model().NumControls()) {
     throw SceneError(scene.file + ": the scene's grasp layout has " +
                      std::to_string(scene.grasp_layout.NumControls()) + " controls, model " +
@@ -261,6 +255,7 @@ void Server::SolveAndPublish(const PoseSample& pose) {
     }
   }
   const double solve_us = std::chrono::duration<double, std::micro>(SteadyClock::now() - t0).count();
+  if (hooks_.after_update && result != nullptr) hooks_.after_update(u, tracker);
 
   ForceModelInputs in;
   in.mapping = &scene.device;

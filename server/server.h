@@ -70,6 +70,9 @@ struct ServerTestHooks {
   std::function<void()> before_update;
   // On the loader thread, before a LOAD_SCENE reads its file (a test makes loads slow).
   std::function<void()> before_load;
+  // Just after each tracker update, with the controls and the tracker (its state and
+  // last result): a test compares the server's path with a sweep of the same scene.
+  std::function<void(const Vec& u, const EquilibriumTracker& tracker)> after_update;
 };
 
 class Server {

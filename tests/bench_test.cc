@@ -92,19 +92,19 @@ TEST(BenchPareto, MarkParetoFrontsIsPerSweep) {
 
 TEST(BenchChains, ResizeKeepsLengthAndContinuumStiffness) {
   const Scene s = testing::SceneFile("curve2d_snap.yaml");
-  const double total = s.params.n * s.params.segment_length;
+  const double total = s.params.Integer("n") * s.params.Number("segment_length");
   const double force_scale = MakeModel(s.params)->ForceScale();
   for (int n : {5, 20, 37}) {
     const Scene r = ResizeChain(s, n);
-    EXPECT_EQ(r.params.n, n);
-    EXPECT_NEAR(r.params.n * r.params.segment_length, total, 1e-12);
-    EXPECT_NEAR(r.params.bending * r.params.segment_length, s.params.bending * s.params.segment_length, 1e-12);
-    EXPECT_NEAR(r.params.stretching * r.params.segment_length, s.params.stretching * s.params.segment_length, 1e-9);
+    EXPECT_EQ(r.params.Integer("n"), n);
+    EXPECT_NEAR(r.params.Integer("n") * r.params.Number("segment_length"), total, 1e-12);
+    EXPECT_NEAR(r.params.Number("bending") * r.params.Number("segment_length"), s.params.Number("bending") * s.params.Number("segment_length"), 1e-12);
+    EXPECT_NEAR(r.params.Number("stretching") * r.params.Number("segment_length"), s.params.Number("stretching") * s.params.Number("segment_length"), 1e-9);
     // Forces stay comparable across n.
     EXPECT_NEAR(MakeModel(r.params)->ForceScale(), force_scale, 1e-12 * force_scale);
   }
   const Scene z = testing::SceneFile("zeeman.yaml");
-  EXPECT_EQ(ResizeChain(z, 40).params.n, z.params.n);
+  EXPECT_EQ(ResizeChain(z, 40).params.values, z.params.values);  // not a chain: unchanged
   EXPECT_FALSE(IsChain(z));
   EXPECT_TRUE(IsChain(s));
 }
@@ -122,9 +122,9 @@ TEST(BenchPaths, HandSpeedPathMatchesTheStandardSweeps) {
 TEST(BenchPaths, HandSpeedControlMovesSlowlyAndStaysNearTheStart) {
   const Scene base = testing::SceneFile("thread3d_loop.yaml");
   const Scene s = HandSpeedScene(base, 40, "higher-order", "banded", 1e-6);
-  EXPECT_FALSE(s.params.grip_direction);
+  EXPECT_FALSE(s.params.Bool("grip_direction"));
   ASSERT_EQ(s.grasp_start.size(), 3);
-  const double total = 40 * base.params.segment_length;
+  const double total = 40 * base.params.Number("segment_length");
   EXPECT_NEAR(s.grasp_start[0], 0.9 * total, 1e-12);
   Vec u, prev;
   HandSpeedControl(s, 0, &prev);
@@ -132,7 +132,7 @@ TEST(BenchPaths, HandSpeedControlMovesSlowlyAndStaysNearTheStart) {
   double lo = prev[1], hi = prev[1];
   for (long i = 1; i < 20000; ++i) {
     HandSpeedControl(s, i, &u);
-    EXPECT_LE((u - prev).norm(), 0.002 * base.params.segment_length + 1e-9);
+    EXPECT_LE((u - prev).norm(), 0.002 * base.params.Number("segment_length") + 1e-9);
     lo = std::min(lo, u[1]);
     hi = std::max(hi, u[1]);
     prev = u;
@@ -143,18 +143,18 @@ TEST(BenchPaths, HandSpeedControlMovesSlowlyAndStaysNearTheStart) {
 
 TEST(BenchPaths, FixedLengthHandSpeedSceneKeepsTheThread) {
   const Scene base = testing::SceneFile("thread3d_loop.yaml");
-  const double total = base.params.n * base.params.segment_length;
+  const double total = base.params.Integer("n") * base.params.Number("segment_length");
   for (int n : {5, 40, 400}) {
     const Scene s = HandSpeedScene(base, n, "newton", "auto", 1e-6, true);
-    EXPECT_EQ(s.params.n, n);
-    EXPECT_FALSE(s.params.grip_direction);
-    EXPECT_NEAR(s.params.n * s.params.segment_length, total, 1e-12);
-    EXPECT_NEAR(s.params.bending * s.params.segment_length, base.params.bending * base.params.segment_length, 1e-9);
+    EXPECT_EQ(s.params.Integer("n"), n);
+    EXPECT_FALSE(s.params.Bool("grip_direction"));
+    EXPECT_NEAR(s.params.Integer("n") * s.params.Number("segment_length"), total, 1e-12);
+    EXPECT_NEAR(s.params.Number("bending") * s.params.Number("segment_length"), base.params.Number("bending") * base.params.Number("segment_length"), 1e-9);
     EXPECT_NEAR(s.grasp_start[0], 0.9 * total, 1e-12);
     Vec u0, u1;
-    HandSpeedControl(s, 0, &u0, 0.002 * base.params.segment_length);
-    HandSpeedControl(s, 1, &u1, 0.002 * base.params.segment_length);
-    EXPECT_NEAR((u1 - u0).norm(), 0.002 * base.params.segment_length, 1e-12);  // the hand's step, not l's
+    HandSpeedControl(s, 0, &u0, 0.002 * base.params.Number("segment_length"));
+    HandSpeedControl(s, 1, &u1, 0.002 * base.params.Number("segment_length"));
+    EXPECT_NEAR((u1 - u0).norm(), 0.002 * base.params.Number("segment_length"), 1e-12);  // the hand's step, not l's
   }
 }
 

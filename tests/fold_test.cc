@@ -16,7 +16,7 @@ namespace {
 // = 0 in (theta, X), derivatives by the model's analytic gradient/Hessian and central
 // differences in X and theta of those.
 double ZeemanFoldX(double y, double x0, double theta0) {
-  auto model = MakeZeemanModel();
+  auto model = MakeModel({.model = "zeeman"});
   Vec th(1), u(2), g;
   SparseMatrix h = model->HessianPattern();
   auto f = [&](double t, double x, double* e1, double* e2) {

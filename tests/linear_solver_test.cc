@@ -298,11 +298,11 @@ TEST_P(LinearSolverTest, Thread3dHessians) {
       for (double compression : {1.0, 0.9, 0.6}) {
         ModelParams p;
         p.model = "thread3d";
-        p.n = segments;
-        p.grip_direction = grip;
+        p.Set("n", segments);
+        p.Set("grip_direction", grip);
         const auto model = MakeModel(p);
         Vec u = Vec::Zero(model->NumControls());
-        u[0] = compression * segments * p.segment_length;
+        u[0] = compression * segments * p.Number("segment_length");
         if (grip) u[3] = 1.0;
         Vec x = model->InitialState(u);
         for (int i = 0; i < x.size(); ++i) x[i] += noise(rng);
@@ -513,7 +513,7 @@ TEST_P(LinearSolverTest, RepeatedFactorizeAndSolveDoNotAllocate) {
 TEST_P(LinearSolverTest, EquilibriumSolvesAfterTheFirstDoNotAllocate) {
   ModelParams p;
   p.model = "thread3d";
-  p.n = 12;
+  p.Set("n", 12);
   auto model = MakeModel(p);
   for (const char* method : {"newton", "newton-ls", "higher-order"}) {
     SolverOptions o;
@@ -521,7 +521,7 @@ TEST_P(LinearSolverTest, EquilibriumSolvesAfterTheFirstDoNotAllocate) {
     o.linear_solver = GetParam();
     auto solver = MakeSolver(*model, o);
     Vec u = Vec::Zero(model->NumControls());
-    u[0] = 0.8 * p.n;
+    u[0] = 0.8 * p.Integer("n");
     u[1] = 0.5;
     Vec x = model->InitialState(u);
     SolverOptions strict = o;

@@ -87,10 +87,10 @@ std::vector<Case> AllCases() {
   for (int n : {2, 3, 5, 10, 23}) {
     ModelParams p;
     p.model = "curve2d";
-    p.n = n;
-    p.segment_length = 0.7;
-    p.bending = 1.3;
-    p.stretching = 40.0;
+    p.Set("n", n);
+    p.Set("segment_length", 0.7);
+    p.Set("bending", 1.3);
+    p.Set("stretching", 40.0);
     cases.push_back({"curve2d_n" + std::to_string(n), p});
   }
   for (bool grip : {false, true}) {
@@ -98,12 +98,12 @@ std::vector<Case> AllCases() {
       if (grip && n < 3) continue;
       ModelParams p;
       p.model = "thread3d";
-      p.n = n;
-      p.segment_length = 0.8;
-      p.bending = 2.1;
-      p.stretching = 60.0;
-      p.reference_bend = 0.3;
-      p.grip_direction = grip;
+      p.Set("n", n);
+      p.Set("segment_length", 0.8);
+      p.Set("bending", 2.1);
+      p.Set("stretching", 60.0);
+      p.Set("reference_bend", 0.3);
+      p.Set("grip_direction", grip);
       cases.push_back({"thread3d_n" + std::to_string(n) + (grip ? "_grip" : ""), p});
     }
   }
@@ -134,19 +134,19 @@ std::vector<Point> RandomPoints(const Model& model, const ModelParams& p, int co
       pt.u << 2.0 * unit(rng), 2.0 * unit(rng);
       pt.x = Vec::Constant(1, 2.0 * unit(rng));
     } else {
-      const double total = p.n * p.segment_length;
+      const double total = p.Integer("n") * p.Number("segment_length");
       Eigen::Vector3d dir(1.0, 0.4 * unit(rng), 0.4 * unit(rng));
       if (p.model == "curve2d") dir.z() = 0.0;
       dir.normalize();
       const Eigen::Vector3d chord = 0.8 * total * dir;
       pt.u.head(model.SpatialDimension()) = chord.head(model.SpatialDimension());
-      if (p.grip_direction) {
+      if (GraspLayoutOf(p).grip_direction) {
         const Eigen::Vector3d d =
             1.7 * dir + 0.3 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
         pt.u.tail<3>() = d;
       }
       pt.x = model.InitialState(pt.u);
-      for (int i = 0; i < pt.x.size(); ++i) pt.x[i] += 0.1 * p.segment_length * unit(rng);
+      for (int i = 0; i < pt.x.size(); ++i) pt.x[i] += 0.1 * p.Number("segment_length") * unit(rng);
     }
     points.push_back(pt);
   }
@@ -226,11 +226,11 @@ TEST_P(ModelDerivativeTest, SizesAndPatternAreConsistent) {
   const Model& m = *model_;
   const ModelParams& p = GetParam().params;
   if (p.model == "curve2d") {
-    EXPECT_EQ(m.NumStates(), 2 * p.n - 3);
+    EXPECT_EQ(m.NumStates(), 2 * p.Integer("n") - 3);
     EXPECT_EQ(m.NumControls(), 2);
   } else if (p.model == "thread3d") {
-    EXPECT_EQ(m.NumStates(), p.grip_direction ? 3 * p.n - 7 : 3 * p.n - 5);
-    EXPECT_EQ(m.NumControls(), p.grip_direction ? 6 : 3);
+    EXPECT_EQ(m.NumStates(), GraspLayoutOf(p).grip_direction ? 3 * p.Integer("n") - 7 : 3 * p.Integer("n") - 5);
+    EXPECT_EQ(m.NumControls(), GraspLayoutOf(p).grip_direction ? 6 : 3);
   } else {
     EXPECT_EQ(m.NumStates(), 1);
     EXPECT_EQ(m.NumControls(), 2);
@@ -297,7 +297,7 @@ TEST_P(ModelDerivativeTest, DerivativesMatchFiniteDifferences) {
     ASSERT_EQ(euu.cols(), m.NumControls());
     EXPECT_TRUE(RelClose(euu, FdControlGradientU(m, x, u), 1e-6)) << "E_uu";
 
-    if (p.grip_direction) {
+    if (GraspLayoutOf(p).grip_direction) {
       // Only d/|d| enters: scaling d changes nothing, so E_d is orthogonal to d.
       const Eigen::Vector3d d = u.tail<3>();
       EXPECT_LE(std::abs(eu.tail<3>().dot(d)), 1e-9 * (eu.norm() + 1.0) * d.norm());
@@ -384,16 +384,16 @@ TEST_P(ModelDerivativeTest, NodesProbeAndInitialStateAreConsistent) {
   EXPECT_TRUE(nodes.allFinite());
   EXPECT_GT(m.ForceScale(), 0.0);
   if (p.model == "curve2d" || p.model == "thread3d") {
-    ASSERT_EQ(nodes.cols(), p.n + 1);
+    ASSERT_EQ(nodes.cols(), p.Integer("n") + 1);
     EXPECT_EQ(nodes.col(0).norm(), 0.0);                       // p_0 clamped at 0
     EXPECT_EQ(nodes.col(1).tail<2>().norm(), 0.0);             // y_1 = z_1 = 0
     const int dim = m.SpatialDimension();
-    EXPECT_EQ((nodes.col(p.n).head(dim) - pt.u.head(dim)).norm(), 0.0);  // p_n is the grasp
-    EXPECT_EQ(m.Probe(pt.x, pt.u), nodes(1, p.n / 2));
-    if (p.grip_direction) {
+    EXPECT_EQ((nodes.col(p.Integer("n")).head(dim) - pt.u.head(dim)).norm(), 0.0);  // p_n is the grasp
+    EXPECT_EQ(m.Probe(pt.x, pt.u), nodes(1, p.Integer("n") / 2));
+    if (GraspLayoutOf(p).grip_direction) {
       // Node N-1 sits on the grip line at distance s behind p_N.
       const Eigen::Vector3d d = pt.u.tail<3>().normalized();
-      const Eigen::Vector3d back = nodes.col(p.n) - nodes.col(p.n - 1);
+      const Eigen::Vector3d back = nodes.col(p.Integer("n")) - nodes.col(p.Integer("n") - 1);
       EXPECT_NEAR(back.dot(d), pt.x[m.NumStates() - 1], 1e-12);
       EXPECT_LE((back - back.dot(d) * d).norm(), 1e-12);
     }
@@ -403,11 +403,11 @@ TEST_P(ModelDerivativeTest, NodesProbeAndInitialStateAreConsistent) {
     ASSERT_EQ(x0.size(), m.NumStates());
     Eigen::Matrix3Xd n0;
     m.NodePositions(x0, pt.u, &n0);
-    const Eigen::Vector3d chord = n0.col(p.n);
-    for (int i = 1; i < p.n; ++i) {
-      if (p.grip_direction && i == p.n - 1) continue;
-      const Eigen::Vector3d expected = chord * (static_cast<double>(i) / p.n);
-      const double tol = 1e-3 * p.segment_length + 1e-12;
+    const Eigen::Vector3d chord = n0.col(p.Integer("n"));
+    for (int i = 1; i < p.Integer("n"); ++i) {
+      if (GraspLayoutOf(p).grip_direction && i == p.Integer("n") - 1) continue;
+      const Eigen::Vector3d expected = chord * (static_cast<double>(i) / p.Integer("n"));
+      const double tol = 1e-3 * p.Number("segment_length") + 1e-12;
       if (i == 1) {
         EXPECT_LE(std::abs(n0(0, 1) - expected.x()), tol);  // its y, z are clamped to 0
       } else {
@@ -424,19 +424,21 @@ TEST_P(ModelDerivativeTest, NodesProbeAndInitialStateAreConsistent) {
 }
 
 TEST(ModelFactoryTest, ConstructorsValidateParams) {
-  ModelParams p;
-  p.n = 1;
-  EXPECT_THROW(MakeCurve2dModel(p), std::invalid_argument);
-  EXPECT_THROW(MakeThread3dModel(p), std::invalid_argument);
-  p.n = 2;
-  p.grip_direction = true;  // a grip needs N >= 3 (node N-1 must not be the clamped node 1)
-  EXPECT_THROW(MakeThread3dModel(p), std::invalid_argument);
-  p.n = 3;
-  EXPECT_EQ(MakeThread3dModel(p)->NumStates(), 2);  // x_1 and s
-  p.grip_direction = false;
-  p.stretching = -1.0;
-  EXPECT_THROW(MakeCurve2dModel(p), std::invalid_argument);
-  EXPECT_EQ(MakeZeemanModel()->Name(), "zeeman");
+  ModelParams curve{.model = "curve2d"};
+  ModelParams thread{.model = "thread3d"};
+  curve.Set("n", 1);
+  thread.Set("n", 1);
+  EXPECT_THROW(MakeModel(curve), std::invalid_argument);
+  EXPECT_THROW(MakeModel(thread), std::invalid_argument);
+  thread.Set("n", 2);
+  thread.Set("grip_direction", true);  // a grip needs N >= 3 (node N-1 must not be the clamped node 1)
+  EXPECT_THROW(MakeModel(thread), std::invalid_argument);
+  thread.Set("n", 3);
+  EXPECT_EQ(MakeModel(thread)->NumStates(), 2);  // x_1 and s
+  curve.Set("n", 3);
+  curve.Set("stretching", -1.0);
+  EXPECT_THROW(MakeModel(curve), std::invalid_argument);
+  EXPECT_EQ(MakeModel({.model = "zeeman"})->Name(), "zeeman");
 }
 
 INSTANTIATE_TEST_SUITE_P(AllModels, ModelDerivativeTest, ::testing::ValuesIn(AllCases()),

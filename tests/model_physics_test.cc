@@ -20,10 +20,10 @@ namespace {
 ModelParams ChainParams(const std::string& model, int n, double l, double beta, double gamma) {
   ModelParams p;
   p.model = model;
-  p.n = n;
-  p.segment_length = l;
-  p.bending = beta;
-  p.stretching = gamma;
+  p.Set("n", n);
+  p.Set("segment_length", l);
+  p.Set("bending", beta);
+  p.Set("stretching", gamma);
   return p;
 }
 
@@ -44,8 +44,8 @@ TEST(ModelPhysicsTest, PlanarThread3dEqualsCurve2dWithHalvedStiffness) {
   std::mt19937 rng(2024);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int n : {2, 3, 5, 10}) {
-    const auto curve = MakeCurve2dModel(Curve2dParams(n, l, beta / 2.0, gamma / 2.0));
-    const auto thread = MakeThread3dModel(Thread3dParams(n, l, beta, gamma));
+    const auto curve = MakeModel(Curve2dParams(n, l, beta / 2.0, gamma / 2.0));
+    const auto thread = MakeModel(Thread3dParams(n, l, beta, gamma));
     for (int trial = 0; trial < 5; ++trial) {
       Vec u2(2);
       u2 << 0.8 * n * l, 0.3 * n * l * unit(rng);
@@ -106,9 +106,9 @@ TEST(ModelPhysicsTest, PlanarThread3dEqualsCurve2dWithHalvedStiffness) {
 // B (3.9) only shifts the energy, by -N β B / 2.
 TEST(ModelPhysicsTest, ReferenceBendShiftsEnergyOnly) {
   ModelParams p = Thread3dParams(6, 1.0, 2.0, 50.0);
-  const auto plain = MakeThread3dModel(p);
-  p.reference_bend = 0.25;
-  const auto shifted = MakeThread3dModel(p);
+  const auto plain = MakeModel(p);
+  p.Set("reference_bend", 0.25);
+  const auto shifted = MakeModel(p);
   Vec u(3);
   u << 4.0, 1.0, -0.5;
   Vec x = plain->InitialState(u);
@@ -125,9 +125,9 @@ TEST(ModelPhysicsTest, ReferenceBendShiftsEnergyOnly) {
 TEST(ModelPhysicsTest, GripDirectionAlongLastSegmentMatchesFreeThread) {
   for (int n : {3, 4, 8}) {
     ModelParams p = Thread3dParams(n, 0.6, 1.2, 70.0);
-    const auto free_thread = MakeThread3dModel(p);
-    p.grip_direction = true;
-    const auto gripped = MakeThread3dModel(p);
+    const auto free_thread = MakeModel(p);
+    p.Set("grip_direction", true);
+    const auto gripped = MakeModel(p);
     Vec u(3);
     u << 0.7 * n * 0.6, 0.5, 0.4;
     Vec x = free_thread->InitialState(u);
@@ -185,7 +185,7 @@ StraightStrip EvaluateStraight(const Model& m, int n, double big_x) {
 // 20.19 EI / L², EI = β l, L = n l.
 double BucklingLoadRelativeError(int n) {
   const double l = 1.0, beta = 1.0, gamma = 100.0;
-  const auto m = MakeCurve2dModel(Curve2dParams(n, l, beta, gamma));
+  const auto m = MakeModel(Curve2dParams(n, l, beta, gamma));
   const double total = n * l;
   const double p_elastica = 20.19 * beta * l / (total * total);
   EXPECT_NEAR(m->ForceScale(), p_elastica, 1e-12 * p_elastica);
@@ -232,7 +232,7 @@ double ZeemanEtt(const Model& m, double theta, double big_y) {
 }
 
 TEST(ModelPhysicsTest, ZeemanCuspAtAnalyticPoint) {
-  const auto m = MakeZeemanModel();
+  const auto m = MakeModel({.model = "zeeman"});
   const double y0 = (3.0 + std::sqrt(33.0)) / 4.0;
   Vec g;
   for (double y : {0.5, 1.5, y0, 3.0, 4.0}) {
@@ -258,7 +258,7 @@ TEST(ModelPhysicsTest, ZeemanCuspAtAnalyticPoint) {
 // InitialState is the global minimum: θ = 0 below the cusp, a symmetric pair of
 // off-axis minima above it.
 TEST(ModelPhysicsTest, ZeemanInitialStateIsGlobalMinimum) {
-  const auto m = MakeZeemanModel();
+  const auto m = MakeModel({.model = "zeeman"});
   const double y0 = (3.0 + std::sqrt(33.0)) / 4.0;
   Vec u(2), g;
   u << 0.0, y0 - 0.5;

@@ -18,14 +18,14 @@ TEST(Scenes, ShippedScenesLoad) {
     EXPECT_EQ(s.grasp_start.size(), model->NumControls()) << f;
   }
   const Scene t = testing::SceneFile("thread3d_loop.yaml");
-  EXPECT_TRUE(t.params.grip_direction);
+  EXPECT_TRUE(t.params.Bool("grip_direction"));
   EXPECT_NEAR(t.grasp_start.tail(3).norm(), 1.0, 1e-12);
 }
 
 TEST(Scenes, OverridesApply) {
   const Scene s = testing::SceneFile("curve2d_snap.yaml", {ParseOverride("params.n=20"),
                                                           ParseOverride("solver.method=newton")});
-  EXPECT_EQ(s.params.n, 20);
+  EXPECT_EQ(s.params.Integer("n"), 20);
   EXPECT_EQ(s.solver.method, "newton");
   EXPECT_THROW(ParseOverride("params.n"), SceneError);
   EXPECT_THROW(ParseOverride("=3"), SceneError);

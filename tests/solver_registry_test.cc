@@ -89,7 +89,7 @@ TEST(SolverRegistry, RejectsDuplicateAndIncompleteEntries) {
 }
 
 TEST(SolverRegistry, UnknownMethodOrLinearSolverNamesTheFieldAndTheChoices) {
-  auto model = MakeCuspModel();
+  auto model = MakeModel({.model = "cusp"});
   SolverOptions o;
   o.method = "magic";
   try {
@@ -115,7 +115,7 @@ TEST(SolverRegistry, UnknownMethodOrLinearSolverNamesTheFieldAndTheChoices) {
 
 TEST(SolverRegistry, ToySolverRunsThroughMakeSolverAndTheTracker) {
   RegisterToyOnce();
-  auto model = MakeCuspModel();
+  auto model = MakeModel({.model = "cusp"});
   SolverOptions o;
   o.method = "test-gradient-descent";
   o.max_iterations = 0;
@@ -140,7 +140,7 @@ TEST(SolverRegistry, ToySolverRunsThroughMakeSolverAndTheTracker) {
 
   // Through the tracker as well: forces come out finite, K is floored (no factorisation).
   o.max_iterations = 2000;
-  EquilibriumTracker tracker(MakeCuspModel(), o);
+  EquilibriumTracker tracker(MakeModel({.model = "cusp"}), o);
   tracker.Reset(u);
   for (int i = 1; i <= 5; ++i) {
     u[0] = -1.0 + 0.05 * i;

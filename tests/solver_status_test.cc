@@ -46,7 +46,7 @@ TEST(DecideStatus, ReferenceEigenvalueInertiaAndBranchJump) {
 TEST(DecideStatus, SolversReportTheDecidedStatus) {
   // The summary a solver returns carries the evidence, and its status is the decision
   // on that evidence, for every method.
-  auto model = MakeCuspModel();
+  auto model = MakeModel({.model = "cusp"});
   for (const char* method : {"newton", "newton-ls", "higher-order"}) {
     SolverOptions o;
     o.method = method;
@@ -65,7 +65,7 @@ TEST(SolverInput, BadSizesAndNonFiniteInputAreReportedInTheSummary) {
   auto model = MakeModel([] {
     ModelParams p;
     p.model = "curve2d";
-    p.n = 6;
+    p.Set("n", 6);
     return p;
   }());
   for (const char* method : {"newton", "newton-ls", "higher-order"}) {

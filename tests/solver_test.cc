@@ -13,7 +13,7 @@ namespace {
 ModelParams Curve(int n) {
   ModelParams p;
   p.model = "curve2d";
-  p.n = n;
+  p.Set("n", n);
   return p;
 }
 
@@ -28,7 +28,7 @@ TEST(SolverOptions, IsValidNamesTheField) {
   o = SolverOptions{};
   o.linear_solver = "magic";
   try {
-    MakeSolver(*MakeCuspModel(), o);
+    MakeSolver(*MakeModel({.model = "cusp"}), o);
     ADD_FAILURE() << "an unknown linear solver was accepted";
   } catch (const std::invalid_argument& ex) {
     EXPECT_NE(std::string(ex.what()).find("linear_solver"), std::string::npos) << ex.what();
@@ -38,7 +38,7 @@ TEST(SolverOptions, IsValidNamesTheField) {
   o.max_iterations = -3;
   EXPECT_FALSE(o.IsValid(&e));
   EXPECT_NE(e.find("max_iterations"), std::string::npos);
-  EXPECT_THROW(MakeSolver(*MakeCuspModel(), o), std::invalid_argument);
+  EXPECT_THROW(MakeSolver(*MakeModel({.model = "cusp"}), o), std::invalid_argument);
 }
 
 TEST(Newton, ConvergesQuadraticallyNearARegularMinimum) {
@@ -82,7 +82,7 @@ TEST_P(MethodAgreement, SameEquilibriumAtRegularPoints) {
   for (const std::string name : {"curve2d", "thread3d"}) {
     ModelParams p;
     p.model = name;
-    p.n = 8;
+    p.Set("n", 8);
     auto model = MakeModel(p);
     Vec u = Vec::Zero(model->NumControls());
     u[0] = 7.5;
@@ -174,7 +174,7 @@ TEST(FollowedMinimum, CapsFarMinima) {
 TEST(HigherOrder, CuspStepIsTheExactQuarticMinimum) {
   // For the standard cusp the 4th-order Taylor step (§2.3.5) is exact: one reduction
   // step from the degenerate point lands on the equilibrium T^3 + Y T + X = 0.
-  auto model = MakeCuspModel();
+  auto model = MakeModel({.model = "cusp"});
   SolverOptions o;
   o.method = "higher-order";
   o.cutoff = 1e-12;

@@ -26,11 +26,11 @@ std::vector<Case> RegularCases() {
   add("zeeman", z, {0.3, 2.0});
   ModelParams c; c.model = "cusp";
   add("cusp", c, {0.2, 0.5});
-  ModelParams c2; c2.model = "curve2d"; c2.n = 10;
+  ModelParams c2; c2.model = "curve2d"; c2.Set("n", 10);
   add("curve2d", c2, {8.5, 2.0});
-  ModelParams t; t.model = "thread3d"; t.n = 8;
+  ModelParams t; t.model = "thread3d"; t.Set("n", 8);
   add("thread3d", t, {6.5, 2.0, 1.0});
-  ModelParams tg = t; tg.grip_direction = true;
+  ModelParams tg = t; tg.Set("grip_direction", true);
   add("thread3d_grip", tg, {6.0, 2.0, 1.0, 0.6, 0.8, 0.0});
   return cases;
 }
@@ -92,8 +92,8 @@ TEST(PlanarThread, EqualsCurve2dWithHalvedCoefficients) {
   // vanishes there) and must give the same state, energy and force. (In 3D a planar
   // buckled state can be a saddle, so a minimiser may leave the plane: that is not
   // this equivalence.)
-  ModelParams t; t.model = "thread3d"; t.n = 10; t.bending = 2.0; t.stretching = 200.0;
-  ModelParams c; c.model = "curve2d"; c.n = 10; c.bending = 1.0; c.stretching = 100.0;
+  ModelParams t; t.model = "thread3d"; t.Set("n", 10); t.Set("bending", 2.0); t.Set("stretching", 200.0);
+  ModelParams c; c.model = "curve2d"; c.Set("n", 10); c.Set("bending", 1.0); c.Set("stretching", 100.0);
   auto m3 = MakeModel(t);
   SolverOptions o;
   o.cutoff = 1e-11;
@@ -129,7 +129,7 @@ TEST(PlanarThread, EqualsCurve2dWithHalvedCoefficients) {
 
 TEST(Tracker, StiffnessStaysFiniteThroughSnaps) {
   for (const char* m : {"newton", "newton-ls", "higher-order"}) {
-    ModelParams c; c.model = "curve2d"; c.n = 10;
+    ModelParams c; c.model = "curve2d"; c.Set("n", 10);
     SolverOptions o;
     o.method = m;
     o.max_iterations = 3;

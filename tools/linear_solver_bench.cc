@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -54,15 +55,27 @@ SparseMatrix RandomSpdBand(int n, int b, bool ring, std::mt19937* rng) {
   return a;
 }
 
+// The registry's chain in three dimensions (thread3d), with its default parameters
+// and `segments` segments.
+ModelParams SpatialChain(int segments) {
+  for (const ModelRegistration& m : Models()) {
+    const ModelParams defaults{.model = m.name};
+    if (m.capabilities.chain && m.capabilities.grasp_layout(defaults).spatial_dimension == 3) {
+      ModelParams p = defaults;
+      p.Set(m.capabilities.chain->segments, segments);
+      return p;
+    }
+  }
+  throw std::logic_error("no chain model in three dimensions is registered");
+}
+
 // thread3d Hessian at a compressed, slightly perturbed state; *bandwidth as the model
 // reports it.
 SparseMatrix Thread3dHessian(int segments, std::mt19937* rng, int* bandwidth) {
-  ModelParams p;
-  p.model = "thread3d";
-  p.n = segments;
+  ModelParams p = SpatialChain(segments);
   const auto model = MakeModel(p);
   Vec u = Vec::Zero(model->NumControls());
-  u[0] = 0.8 * segments * p.segment_length;
+  u[0] = 0.8 * segments * ChainSegmentLength(p);
   Vec x = model->InitialState(u);
   std::normal_distribution<double> noise(0.0, 0.01);
   for (int i = 0; i < x.size(); ++i) x[i] += noise(*rng);

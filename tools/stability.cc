@@ -80,7 +80,7 @@ std::vector<SweepRow> ReferenceTrace(const Scene& scene_in, const std::vector<Ve
   for (size_t i = 1; i < controls.size(); ++i)
     for (int k = 1; k <= substeps; ++k) {
       Vec u = controls[i - 1] + (static_cast<double>(k) / substeps) * (controls[i] - controls[i - 1]);
-      if (scene.params.grip_direction) u.tail(3).normalize();
+      if (scene.grasp_layout.grip_direction) u.tail(3).normalize();
       if (k == substeps) u = controls[i];
       fine.push_back(u);
     }

@@ -5,16 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "models/models.h"
 
 namespace snapthread {
-
-std::unique_ptr<EquilibriumTracker> MakeTracker(const Scene& scene) {
-  auto t = std::make_unique<EquilibriumTracker>(MakeModel(scene.params), scene.solver);
-  const bool chain = scene.params.model == "curve2d" || scene.params.model == "thread3d";
-  t->SetSnapThreshold(chain ? 0.1 * scene.params.segment_length : 0.1);
-  return t;
-}
 
 std::vector<Vec> SweepControls(const Scene& scene, const SweepSpec& spec) {
   const int m = static_cast<int>(scene.grasp_start.size());
@@ -36,7 +28,7 @@ std::vector<Vec> SweepControls(const Scene& scene, const SweepSpec& spec) {
 std::vector<Vec> PathControls(const Scene& scene, int steps_per_leg) {
   if (scene.path.size() < 2) throw std::invalid_argument("sweep: the scene has no grasp.path with two or more points");
   if (steps_per_leg < 1) throw std::invalid_argument("sweep: --steps must be >= 1");
-  const bool grip = scene.params.grip_direction;
+  const bool grip = scene.grasp_layout.grip_direction;
   std::vector<Vec> us{scene.path.front()};
   for (size_t k = 1; k < scene.path.size(); ++k) {
     const Vec& a = scene.path[k - 1];
@@ -60,6 +52,7 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
     row.step = static_cast<int>(i);
     row.u = controls[i];
     row.force = r.force;
+    row.state = tracker->state();
     row.probe = r.probe;
     row.energy = r.energy;
     row.residual = r.summary.residual;

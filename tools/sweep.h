@@ -9,6 +9,7 @@
 
 #include "scene/scene.h"
 #include "solvers/registry.h"
+#include "tracking/make_tracker.h"
 #include "tracking/tracker.h"
 
 namespace snapthread {
@@ -23,6 +24,7 @@ struct SweepRow {
   int step = 0;
   Vec u;                 // full controls
   Vec force;             // F = -E_u
+  Vec state;             // the equilibrium x
   double probe = 0.0, energy = 0.0, residual = 0.0, lambda_min = 0.0, solve_us = 0.0;
   int iterations = 0, gradient_evaluations = 0, hessian_evaluations = 0;
   bool snapped = false;
@@ -41,9 +43,6 @@ std::vector<Vec> PathControls(const Scene& scene, int steps_per_leg);
 // Resets a tracker at the first control (solved to the cutoff) and updates it along
 // the path. Row 0 is the reset state.
 std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls);
-
-// A tracker for the scene (model from its params, its solver options).
-std::unique_ptr<EquilibriumTracker> MakeTracker(const Scene& scene);
 
 // The CSV of snapthread-sweep: header, then one line per row. The first columns are
 // step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,solve_us

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "models/registry.h"
 #include "solvers/registry.h"
 #include "sweep.h"
 #include "tool_main.h"
@@ -32,6 +33,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-iterations", max_iterations, "iteration budget per step, 0 = unlimited");
   app.add_option("--set", sets, "override a scene key, e.g. --set params.n=20 (repeatable)");
   app.add_option("--out", out_file, "CSV output file (default: standard output)");
+  // The models a scene may name, with their parameters (--set params.<name>=...).
+  app.footer("Models (scene key `model:`):\n" + ModelHelp());
   const auto run = [&]() -> int {
     std::vector<SceneOverride> overrides;
     for (const auto& s : sets) overrides.push_back(ParseOverride(s));
@@ -57,7 +60,7 @@ int main(int argc, char** argv) {
       controls = PathControls(scene, steps);
     } else {
       if (from.empty()) throw std::invalid_argument("--from/--to or --path: one of them is required");
-      const int dim = scene.params.model == "thread3d" ? 3 : 2;
+      const int dim = scene.grasp_layout.spatial_dimension;
       SweepSpec spec;
       spec.from = ParsePoint(from, dim, "--from");
       spec.to = ParsePoint(to, dim, "--to");

@@ -9,6 +9,7 @@
 
 #include "hud_layout.h"
 #include "spline.h"
+#include "models/registry.h"
 
 namespace snapthread::viewer {
 namespace {
@@ -233,9 +234,10 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
     }
     const double extent = std::max((hi - lo).norm(), 1e-3);
     const double radius = 0.012 * extent;
-    // Threads (curve2d, thread3d) are smooth curves through their nodes; the Zeeman and cusp
-    // "shapes" are linkages (rods between joints), drawn straight.
-    const bool smooth = shape.model == "curve2d" || shape.model == "thread3d";
+    // Threads (the registry's chains) are smooth curves through their nodes; the Zeeman
+    // and cusp "shapes" are linkages (rods between joints), drawn straight.
+    const ModelRegistration* model = FindModel(shape.model);
+    const bool smooth = model != nullptr && model->capabilities.chain.has_value();
     scene_.AppendTube(CatmullRomCurve(nodes, smooth ? kSplineSamplesPerSegment : 1), radius,
                       kTubeSides, StatusColor(shape.status));
     scene_.AppendSphere(nodes.front(), 2.2 * radius, {0.6f, 0.6f, 0.62f});  // clamp

@@ -19,6 +19,7 @@
 #include "session_receiver.h"
 #include "stop_signals.h"
 #include "scene/scene.h"
+#include "models/registry.h"
 #include "messages/lcm_url.h"
 
 namespace snapthread::viewer {
@@ -106,7 +107,11 @@ void FitToShape(const thread_shape_t& shape, int width, int height, OrbitCamera*
   camera->Fit(lo, hi, double(width) / height);
 }
 
-bool IsPlanarModel(const std::string& model) { return model != "thread3d"; }
+// A model whose grasp (with default parameters) lies in the plane; unknown names too.
+bool IsPlanarModel(const std::string& model) {
+  const ModelRegistration* reg = FindModel(model);
+  return reg == nullptr || reg->capabilities.grasp_layout(ModelParams{.model = reg->name}).spatial_dimension == 2;
+}
 
 // Where the mouse ray meets the drag plane: z = 0 for planar models, else the plane through
 // the current grasp facing the camera.

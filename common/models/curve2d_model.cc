@@ -11,38 +11,36 @@
 #include <string>
 #include <vector>
 
-#include "models/hessian_assembly.h"
-#include "models/models.h"
+#include "models/chain_model.h"
+#include "models/registry.h"
 
 namespace snapthread {
 namespace {
 
 using internal::BendTerm;
-using internal::HessianAssembly;
+using internal::ChainModel;
+using internal::ChainParamSpecs;
 using internal::StretchTerm;
 using V2 = Eigen::Vector2d;
 
-class Curve2dModel final : public Model {
+constexpr char kName[] = "curve2d";
+
+class Curve2dModel final : public ChainModel<Curve2dModel> {
  public:
   explicit Curve2dModel(const ModelParams& params)
-      : n_(params.n),
-        l_(params.segment_length),
-        beta_(params.bending),
-        gamma_(params.stretching),
-        nx_(2 * params.n - 3),
-        assembly_(2 * params.n - 3, 2) {
+      : ChainModel(2 * params.Integer("n") - 3, 2),
+        n_(params.Integer("n")),
+        l_(params.Number("segment_length")),
+        beta_(params.Number("bending")),
+        gamma_(params.Number("stretching")),
+        nx_(2 * n_ - 3) {
     // Term order: stretching of segments 1..n, then bending at joints 1..n-1.
     for (int i = 1; i <= n_; ++i) AddTerm(false, i - 1);
     for (int j = 1; j <= n_ - 1; ++j) AddTerm(true, j - 1);
-    assembly_.Finalize();
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
-      if (assembly_.TouchesControls(t)) control_terms_.push_back(t);
-    }
+    FinishTerms();
   }
 
-  std::string_view Name() const override { return "curve2d"; }
-  int NumStates() const override { return nx_; }
-  int NumControls() const override { return 2; }
+  std::string_view Name() const override { return kName; }
   int SpatialDimension() const override { return 2; }
 
   double Energy(const Vec& x, const Vec& u) const override {
@@ -55,62 +53,6 @@ class Curve2dModel final : public Model {
                                       nullptr);
     }
     return e;
-  }
-
-  void Gradient(const Vec& x, const Vec& u, Vec* g) const override {
-    if (g->size() != nx_) g->resize(nx_);
-    g->setZero();
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
-      Local(t, x, u, /*want_h=*/false,
-            [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
-    }
-  }
-
-  const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
-
-  void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
-    const SparseMatrix& pattern = assembly_.Pattern();
-    if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
-        !h->isCompressed()) {
-      *h = pattern;
-    }
-    double* values = h->valuePtr();
-    std::fill(values, values + pattern.nonZeros(), 0.0);
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
-      Local(t, x, u, /*want_h=*/true, [&](const double*, const double* lh, int ld) {
-        assembly_.AddHessian(t, lh, ld, values);
-      });
-    }
-  }
-
-  void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override {
-    if (eu->size() != 2) eu->resize(2);
-    eu->setZero();
-    for (int t : control_terms_) {
-      Local(t, x, u, false, [&](const double* lg, const double*, int) {
-        assembly_.AddControlGradient(t, lg, eu->data());
-      });
-    }
-  }
-
-  void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override {
-    if (exu->rows() != nx_ || exu->cols() != 2) exu->resize(nx_, 2);
-    exu->setZero();
-    for (int t : control_terms_) {
-      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
-        assembly_.AddMixedHessian(t, lh, ld, exu);
-      });
-    }
-  }
-
-  void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override {
-    if (euu->rows() != 2 || euu->cols() != 2) euu->resize(2, 2);
-    euu->setZero();
-    for (int t : control_terms_) {
-      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
-        assembly_.AddControlHessian(t, lh, ld, euu);
-      });
-    }
   }
 
   // Nodes evenly spaced on the chord from (0, 0) to u, plus a bump 1e-3 l sin(π i / n)
@@ -145,15 +87,11 @@ class Curve2dModel final : public Model {
     }
   }
   double Probe(const Vec& x, const Vec& u) const override { return Node(n_ / 2, x, u).y(); }
-  // Clamped–pinned Euler buckling load 20.19 EI / L² with EI = β l (β (1 - cos φ) ≈
-  // β φ²/2 = (β l) κ² l / 2 per joint) and L = n l.
-  double ForceScale() const override {
-    const double total = n_ * l_;
-    return 20.19 * beta_ * l_ / (total * total);
-  }
-  int HessianBandwidth() const override { return assembly_.Bandwidth(); }
+  // Clamped–pinned Euler buckling load with EI = β l (see chain_model.h).
+  double ForceScale() const override { return EulerLoad(n_, l_, beta_); }
 
  private:
+  friend class ChainModel<Curve2dModel>;
   struct Term {
     bool bend;
     int first_node;
@@ -204,19 +142,17 @@ class Curve2dModel final : public Model {
   const double beta_;
   const double gamma_;
   const int nx_;
-  HessianAssembly assembly_;
   std::vector<Term> terms_;
-  std::vector<int> control_terms_;
 };
 
 }  // namespace
 
-std::unique_ptr<Model> MakeCurve2dModel(const ModelParams& params) {
-  ModelParams p = params;
-  p.model = "curve2d";
-  std::string error;
-  if (!p.IsValid(&error)) throw std::invalid_argument(error);
-  return std::make_unique<Curve2dModel>(p);
+ModelRegistration Curve2dRegistration() {
+  return {.name = kName,
+          .doc = "planar elastic strip of n segments, clamped at the origin, held at its end (2.1-2.2)",
+          .params = ChainParamSpecs("beta in beta (1 - t_i . t_{i+1}) (2.1)", "gamma in gamma (|v_i| - l)^2 (2.1)"),
+          .factory = [](const ModelParams& p) -> std::unique_ptr<Model> { return std::make_unique<Curve2dModel>(p); },
+          .capabilities = {.grasp_layout = PlanarGrasp, .chain = ChainSpec{.per_length = {"bending", "stretching"}}}};
 }
 
 }  // namespace snapthread

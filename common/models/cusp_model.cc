@@ -2,20 +2,17 @@
 // Equilibria satisfy (2.13) T^3 + Y T + X = 0; folds lie on 27 X^2 = -4 Y^3.
 #include <cmath>
 
-#include "models/models.h"
+#include "models/one_state_model.h"
+#include "models/registry.h"
 
 namespace snapthread {
 namespace {
 
-class CuspModel final : public Model {
+constexpr char kName[] = "cusp";
+
+class CuspModel final : public internal::OneStateModel {
  public:
-  CuspModel() {
-    pattern_.resize(1, 1);
-    pattern_.insert(0, 0) = 0.0;
-    pattern_.makeCompressed();
-  }
-  std::string_view Name() const override { return "cusp"; }
-  int NumStates() const override { return 1; }
+  std::string_view Name() const override { return kName; }
   int NumControls() const override { return 2; }
   int SpatialDimension() const override { return 2; }
 
@@ -28,9 +25,8 @@ class CuspModel final : public Model {
     if (g->size() != 1) g->resize(1);
     (*g)[0] = t * t * t + u[1] * t + u[0];  // (2.13)
   }
-  const SparseMatrix& HessianPattern() const override { return pattern_; }
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
-    if (h->rows() != 1 || h->nonZeros() != 1) *h = pattern_;
+    ShapeHessian(h);
     h->valuePtr()[0] = 3.0 * x[0] * x[0] + u[1];
   }
   void ControlGradient(const Vec& x, const Vec&, Vec* eu) const override {
@@ -57,16 +53,16 @@ class CuspModel final : public Model {
     nodes->resize(3, 1);
     nodes->col(0) << x[0], 0.0, 0.0;
   }
-  double Probe(const Vec& x, const Vec&) const override { return x[0]; }
   double ForceScale() const override { return 1.0; }
-  int HessianBandwidth() const override { return 0; }
-
- private:
-  SparseMatrix pattern_;
 };
 
 }  // namespace
 
-std::unique_ptr<Model> MakeCuspModel() { return std::make_unique<CuspModel>(); }
+ModelRegistration CuspRegistration() {
+  return {.name = kName,
+          .doc = "the standard cusp E = T^4/4 + Y T^2/2 + X T (2.9)",
+          .factory = [](const ModelParams&) -> std::unique_ptr<Model> { return std::make_unique<CuspModel>(); },
+          .capabilities = {.grasp_layout = PlanarGrasp}};
+}
 
 }  // namespace snapthread

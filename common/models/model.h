@@ -37,7 +37,7 @@ class Model {
  public:
   virtual ~Model() = default;
 
-  // "zeeman", "cusp", "curve2d", "thread3d".
+  // The name the model is registered under (models/registry.h).
   virtual std::string_view Name() const = 0;
   virtual int NumStates() const = 0;
   virtual int NumControls() const = 0;
@@ -69,6 +69,13 @@ class Model {
   virtual double ForceScale() const = 0;
   // Half-bandwidth of E_xx in the variable ordering (for banded factorisations).
   virtual int HessianBandwidth() const = 0;
+
+  // Called by the tracker after it accepted the equilibrium x at controls u (after the
+  // force and stiffness of that update were computed). A model whose energy is written
+  // against lagged data (the rod's time-parallel reference frames, docs/models-rod.md)
+  // moves that data to the accepted state here; at x itself E and the equilibrium do not
+  // change. Models without history (zeeman, cusp, curve2d, thread3d) have nothing to do.
+  virtual void AcceptState(const Vec& /*x*/, const Vec& /*u*/) {}
 };
 
 }  // namespace snapthread

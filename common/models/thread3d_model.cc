@@ -20,43 +20,49 @@
 #include <string>
 #include <vector>
 
-#include "models/hessian_assembly.h"
-#include "models/models.h"
+#include "models/chain_model.h"
+#include "models/registry.h"
 
 namespace snapthread {
 namespace {
 
 using internal::BendTerm;
+using internal::ChainModel;
+using internal::ChainParamSpecs;
 using internal::HessianAssembly;
 using internal::StretchTerm;
 using V3 = Eigen::Vector3d;
+
+constexpr char kName[] = "thread3d";
 constexpr int kMaxVars = HessianAssembly::kMaxTermVars;
 using LocalVec = Eigen::Matrix<double, kMaxVars, 1>;
 using LocalMat = Eigen::Matrix<double, kMaxVars, kMaxVars>;
 
-class Thread3dModel final : public Model {
+// State and control counts: 3N - 5 states and (X, Y, Z), or with a grip 3N - 7 states
+// (node N-1's three coordinates become s) and (X, Y, Z, dx, dy, dz).
+int NumStatesFor(const ModelParams& p) {
+  return p.Bool("grip_direction") ? 3 * p.Integer("n") - 7 : 3 * p.Integer("n") - 5;
+}
+int NumControlsFor(const ModelParams& p) { return p.Bool("grip_direction") ? 6 : 3; }
+
+class Thread3dModel final : public ChainModel<Thread3dModel> {
  public:
   explicit Thread3dModel(const ModelParams& params)
-      : n_(params.n),
-        rest_(params.segment_length),
-        half_beta_(0.5 * params.bending),
-        half_gamma_(0.5 * params.stretching),
-        energy_shift_(-params.n * params.bending * params.reference_bend / 2.0),
-        grip_(params.grip_direction),
-        nx_(params.grip_direction ? 3 * params.n - 7 : 3 * params.n - 5),
-        nu_(params.grip_direction ? 6 : 3),
-        assembly_(nx_, nu_) {
+      : ChainModel(NumStatesFor(params), NumControlsFor(params)),
+        n_(params.Integer("n")),
+        rest_(params.Number("segment_length")),
+        half_beta_(0.5 * params.Number("bending")),
+        half_gamma_(0.5 * params.Number("stretching")),
+        energy_shift_(-n_ * params.Number("bending") * params.Number("reference_bend") / 2.0),
+        grip_(params.Bool("grip_direction")),
+        nx_(NumStatesFor(params)),
+        nu_(NumControlsFor(params)) {
     for (int i = 1; i <= n_; ++i) AddTerm(false, i - 1);
     for (int j = 1; j <= n_ - 1; ++j) AddTerm(true, j - 1);
-    assembly_.Finalize();
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
-      if (assembly_.TouchesControls(t)) control_terms_.push_back(t);
-    }
+    FinishTerms();
   }
 
-  std::string_view Name() const override { return "thread3d"; }
-  int NumStates() const override { return nx_; }
-  int NumControls() const override { return nu_; }
+  std::string_view Name() const override { return kName; }
   int SpatialDimension() const override { return 3; }
 
   double Energy(const Vec& x, const Vec& u) const override {
@@ -69,62 +75,6 @@ class Thread3dModel final : public Model {
                                       nullptr, nullptr);
     }
     return e;
-  }
-
-  void Gradient(const Vec& x, const Vec& u, Vec* g) const override {
-    if (g->size() != nx_) g->resize(nx_);
-    g->setZero();
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
-      Local(t, x, u, false,
-            [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
-    }
-  }
-
-  const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
-
-  void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
-    const SparseMatrix& pattern = assembly_.Pattern();
-    if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
-        !h->isCompressed()) {
-      *h = pattern;
-    }
-    double* values = h->valuePtr();
-    std::fill(values, values + pattern.nonZeros(), 0.0);
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
-      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
-        assembly_.AddHessian(t, lh, ld, values);
-      });
-    }
-  }
-
-  void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override {
-    if (eu->size() != nu_) eu->resize(nu_);
-    eu->setZero();
-    for (int t : control_terms_) {
-      Local(t, x, u, false, [&](const double* lg, const double*, int) {
-        assembly_.AddControlGradient(t, lg, eu->data());
-      });
-    }
-  }
-
-  void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override {
-    if (exu->rows() != nx_ || exu->cols() != nu_) exu->resize(nx_, nu_);
-    exu->setZero();
-    for (int t : control_terms_) {
-      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
-        assembly_.AddMixedHessian(t, lh, ld, exu);
-      });
-    }
-  }
-
-  void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override {
-    if (euu->rows() != nu_ || euu->cols() != nu_) euu->resize(nu_, nu_);
-    euu->setZero();
-    for (int t : control_terms_) {
-      Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
-        assembly_.AddControlHessian(t, lh, ld, euu);
-      });
-    }
   }
 
   // Nodes evenly spaced on the chord from 0 to p_N, plus a bump 1e-3 L sin(π i / N) in a
@@ -159,14 +109,11 @@ class Thread3dModel final : public Model {
     for (int i = 0; i <= n_; ++i) nodes->col(i) = Node(i, x, u);
   }
   double Probe(const Vec& x, const Vec& u) const override { return Node(n_ / 2, x, u).y(); }
-  // Clamped–pinned Euler load 20.19 EI / L_total² with EI = (β/2) L (see curve2d).
-  double ForceScale() const override {
-    const double total = n_ * rest_;
-    return 20.19 * half_beta_ * rest_ / (total * total);
-  }
-  int HessianBandwidth() const override { return assembly_.Bandwidth(); }
+  // Clamped–pinned Euler load with EI = (β/2) L (see chain_model.h).
+  double ForceScale() const override { return EulerLoad(n_, rest_, half_beta_); }
 
  private:
+  friend class ChainModel<Thread3dModel>;
   struct Term {
     bool bend = false;
     int first_node = 0;
@@ -341,19 +288,31 @@ class Thread3dModel final : public Model {
   const bool grip_;
   const int nx_;
   const int nu_;
-  HessianAssembly assembly_;
   std::vector<Term> terms_;
-  std::vector<int> control_terms_;
 };
 
 }  // namespace
 
-std::unique_ptr<Model> MakeThread3dModel(const ModelParams& params) {
-  ModelParams p = params;
-  p.model = "thread3d";
-  std::string error;
-  if (!p.IsValid(&error)) throw std::invalid_argument(error);
-  return std::make_unique<Thread3dModel>(p);
+ModelRegistration Thread3dRegistration() {
+  ModelRegistration r;
+  r.name = kName;
+  r.doc = "3D elastic thread of N segments, clamped at the origin, held at its end (3.1-3.10, 3.15)";
+  r.params = ChainParamSpecs("beta in beta/2 (b_i - B) (3.9)", "gamma in gamma/2 (l_i - L)^2 (3.7)");
+  r.params.push_back({.name = "reference_bend", .default_value = 0.0, .doc = "B (3.9); shifts the energy only"});
+  r.params.push_back({.name = "grip_direction", .kind = ParamKind::kBool, .default_value = 0.0,
+                      .doc = "the grip also holds the last segment's direction: u = (X, Y, Z, dx, dy, dz)"});
+  // A grip needs N >= 3: node N-1 must not be the clamped node 1.
+  r.check = [](const ModelParams& p, std::string* error) {
+    if (!p.Bool("grip_direction") || p.Integer("n") >= 3) return true;
+    if (error) *error = "params.n: expected an integer >= 3, got " + std::to_string(p.Integer("n"));
+    return false;
+  };
+  r.factory = [](const ModelParams& p) -> std::unique_ptr<Model> { return std::make_unique<Thread3dModel>(p); };
+  r.capabilities.grasp_layout = [](const ModelParams& p) {
+    return GraspLayout{.spatial_dimension = 3, .grip_direction = p.Bool("grip_direction")};
+  };
+  r.capabilities.chain = ChainSpec{.per_length = {"bending", "stretching"}};
+  return r;
 }
 
 }  // namespace snapthread

@@ -11,10 +11,13 @@
 #include <cmath>
 #include <numbers>
 
-#include "models/models.h"
+#include "models/one_state_model.h"
+#include "models/registry.h"
 
 namespace snapthread {
 namespace {
+
+constexpr char kName[] = "zeeman";
 
 struct StringTerms {
   double e = 0.0;     // energy
@@ -65,15 +68,9 @@ StringTerms Evaluate(double theta, double big_x, double big_y) {
   return out;
 }
 
-class ZeemanModel final : public Model {
+class ZeemanModel final : public internal::OneStateModel {
  public:
-  ZeemanModel() {
-    pattern_.resize(1, 1);
-    pattern_.insert(0, 0) = 0.0;
-    pattern_.makeCompressed();
-  }
-  std::string_view Name() const override { return "zeeman"; }
-  int NumStates() const override { return 1; }
+  std::string_view Name() const override { return kName; }
   int NumControls() const override { return 2; }
   int SpatialDimension() const override { return 2; }
 
@@ -88,9 +85,8 @@ class ZeemanModel final : public Model {
     if (g->size() != 1) g->resize(1);
     (*g)[0] = Evaluate(x[0], u[0], u[1]).et;
   }
-  const SparseMatrix& HessianPattern() const override { return pattern_; }
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
-    if (h->rows() != 1 || h->cols() != 1 || h->nonZeros() != 1) *h = pattern_;
+    ShapeHessian(h);
     h->valuePtr()[0] = Evaluate(x[0], u[0], u[1]).ett;
   }
   void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override {
@@ -152,16 +148,16 @@ class ZeemanModel final : public Model {
     nodes->col(2) << 0.0, -3.0, 0.0;                                // fixed anchor
     nodes->col(3) << u[0], u[1], 0.0;                               // grasp (X, Y)
   }
-  double Probe(const Vec& x, const Vec&) const override { return x[0]; }
   double ForceScale() const override { return 1.0; }
-  int HessianBandwidth() const override { return 0; }
-
- private:
-  SparseMatrix pattern_;
 };
 
 }  // namespace
 
-std::unique_ptr<Model> MakeZeemanModel() { return std::make_unique<ZeemanModel>(); }
+ModelRegistration ZeemanRegistration() {
+  return {.name = kName,
+          .doc = "the Zeeman catastrophe machine: a wheel held by two elastic strings (2.4)",
+          .factory = [](const ModelParams&) -> std::unique_ptr<Model> { return std::make_unique<ZeemanModel>(); },
+          .capabilities = {.grasp_layout = PlanarGrasp}};
+}
 
 }  // namespace snapthread

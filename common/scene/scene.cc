@@ -82,6 +82,40 @@ class Reader {
   std::string file_;
 };
 
+// The model's parameters, as its schema says: kinds, ranges, allowed keys.
+void ReadParams(const YAML::Node& p, const ModelRegistration& model, const Reader& rd, ModelParams* params) {
+  if (model.params.empty()) {
+    if (!p.IsMap() && !p.IsNull()) rd.Fail("params", "expected a mapping, got '" + Reader::Dump(p) + "'");
+    if (p.size() > 0) rd.Fail("params", model.name + " takes no parameters");
+    return;
+  }
+  std::set<std::string> allowed;
+  for (const ParamSpec& spec : model.params) allowed.insert(spec.name);
+  rd.CheckKeys(p, "params", allowed);
+  for (const ParamSpec& spec : model.params) {
+    const YAML::Node v = p[spec.name];
+    if (!v) continue;
+    const std::string key = "params." + spec.name;
+    switch (spec.kind) {
+      case ParamKind::kBool:
+        params->Set(spec.name, rd.Get<bool>(v, key, "true or false"));
+        continue;
+      case ParamKind::kInteger: {
+        const int n = rd.Get<int>(v, key, "an integer");
+        if (!spec.InRange(n)) rd.Fail(key, "expected " + spec.Expected() + ", got " + std::to_string(n));
+        params->Set(spec.name, n);
+        continue;
+      }
+      case ParamKind::kNumber: {
+        const double x = rd.Number(p, spec.name, key, spec.default_value);
+        if (!spec.InRange(x)) rd.Fail(key, "expected " + spec.Expected() + ", got " + Reader::Num(x));
+        params->Set(spec.name, x);
+        continue;
+      }
+    }
+  }
+}
+
 void ApplyOverrides(YAML::Node root, const std::vector<SceneOverride>& overrides, const Reader& rd) {
   for (const auto& o : overrides) {
     YAML::Node value;
@@ -135,44 +169,37 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
 
   Scene sc;
   sc.file = file_label;
-  if (!root["model"]) rd.Fail("model", "missing (expected one of zeeman, cusp, curve2d, thread3d)");
+  if (!root["model"]) rd.Fail("model", "missing (expected one of " + ModelNameList() + ")");
   sc.params.model = rd.Get<std::string>(root["model"], "model", "a model name");
-  if (sc.params.model != "zeeman" && sc.params.model != "cusp" && sc.params.model != "curve2d" &&
-      sc.params.model != "thread3d")
-    rd.Fail("model", "expected one of zeeman, cusp, curve2d, thread3d, got '" + sc.params.model + "'");
+  const ModelRegistration* model = FindModel(sc.params.model);
+  if (model == nullptr)
+    rd.Fail("model", "expected one of " + ModelNameList() + ", got '" + sc.params.model + "'");
   sc.name = root["name"] ? rd.Get<std::string>(root["name"], "name", "a string") : sc.params.model;
   if (root["description"]) sc.description = rd.Get<std::string>(root["description"], "description", "a string");
 
-  const bool chain = sc.params.model == "curve2d" || sc.params.model == "thread3d";
   if (root["params"]) {
-    const YAML::Node p = root["params"];
-    rd.CheckKeys(p, "params", {"n", "segment_length", "bending", "stretching", "reference_bend", "grip_direction"});
-    if (!chain && p.size() > 0) rd.Fail("params", sc.params.model + " takes no parameters");
-    if (p["n"]) {
-      sc.params.n = rd.Get<int>(p["n"], "params.n", "an integer");
-    }
-    sc.params.segment_length = rd.Positive(p, "segment_length", "params.segment_length", sc.params.segment_length);
-    sc.params.bending = rd.Positive(p, "bending", "params.bending", sc.params.bending);
-    sc.params.stretching = rd.Positive(p, "stretching", "params.stretching", sc.params.stretching);
-    sc.params.reference_bend = rd.Number(p, "reference_bend", "params.reference_bend", 0.0);
-    if (p["grip_direction"])
-      sc.params.grip_direction = rd.Get<bool>(p["grip_direction"], "params.grip_direction", "true or false");
-  } else if (chain) {
-    rd.Fail("params", "missing (expected n, segment_length, bending, stretching)");
+    ReadParams(root["params"], *model, rd, &sc.params);
+  } else if (!model->params.empty()) {
+    std::string names;
+    for (const ParamSpec& spec : model->params) names += (names.empty() ? "" : ", ") + spec.name;
+    rd.Fail("params", "missing (expected " + names + ")");
   }
   std::string error;
   if (!sc.params.IsValid(&error)) throw SceneError(file_label + ": " + error);
 
-  // Controls: (X, Y) for planar models, (X, Y, Z) for thread3d (+ direction with a grip).
-  const int pos_dim = sc.params.model == "thread3d" ? 3 : 2;
-  const int m = sc.params.grip_direction ? 6 : pos_dim;
+  // Controls: the grasp position (2 or 3 numbers), then a unit grip direction if the
+  // model holds one (see GraspLayout).
+  sc.grasp_layout = model->capabilities.grasp_layout(sc.params);
+  const int pos_dim = sc.grasp_layout.spatial_dimension;
+  const bool grip = sc.grasp_layout.grip_direction;
+  const int m = sc.grasp_layout.NumControls();
   if (!root["grasp"]) rd.Fail("grasp", "missing (expected start and path)");
   const YAML::Node g = root["grasp"];
   rd.CheckKeys(g, "grasp", {"start", "direction", "path"});
   if (!g["start"]) rd.Fail("grasp.start", "missing (expected a list of " + std::to_string(pos_dim) + " numbers)");
   Vec start = rd.Vector(g["start"], "grasp.start", pos_dim);
   Vec dir;
-  if (sc.params.grip_direction) {
+  if (grip) {
     if (!g["direction"]) rd.Fail("grasp.direction", "missing: params.grip_direction needs a list of 3 numbers");
     dir = rd.Vector(g["direction"], "grasp.direction", 3);
     if (!(dir.norm() > 1e-9)) rd.Fail("grasp.direction", "expected a non-zero vector");
@@ -180,11 +207,9 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
   } else if (g["direction"]) {
     rd.Fail("grasp.direction", "only allowed with params.grip_direction: true");
   }
-  sc.grasp_layout.spatial_dimension = pos_dim;
-  sc.grasp_layout.grip_direction = sc.params.grip_direction;
   sc.grasp_start.resize(m);
   sc.grasp_start.head(pos_dim) = start;
-  if (sc.params.grip_direction) sc.grasp_start.tail(3) = dir;
+  if (grip) sc.grasp_start.tail(3) = dir;
   if (g["path"]) {
     const YAML::Node path = g["path"];
     if (!path.IsSequence() || path.size() < 1) rd.Fail("grasp.path", "expected a list of points");
@@ -192,13 +217,13 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
       const std::string key = "grasp.path[" + std::to_string(i) + "]";
       Vec p(m);
       // With a grip direction a waypoint may also turn the grip: X,Y,Z,dx,dy,dz.
-      if (sc.params.grip_direction && path[i].IsSequence() && path[i].size() == 6) {
+      if (grip && path[i].IsSequence() && path[i].size() == 6) {
         p = rd.Vector(path[i], key, 6);
         if (!(p.tail(3).norm() > 1e-9)) rd.Fail(key, "expected a non-zero grip direction");
         p.tail(3).normalize();
       } else {
         p.head(pos_dim) = rd.Vector(path[i], key, pos_dim);
-        if (sc.params.grip_direction) p.tail(3) = dir;
+        if (grip) p.tail(3) = dir;
       }
       sc.path.push_back(p);
     }

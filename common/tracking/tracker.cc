@@ -61,6 +61,9 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   x_prev_ = x_;
   u_prev_ = u_;
   ComputeForces();
+  // After the force and K of this state (they use its factorisation): models with lagged
+  // data (the rod's reference frames) move it to the accepted state.
+  model_->AcceptState(x_, u_);
   return result_;
 }
 
@@ -103,6 +106,7 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   // After a snap the secant would point along the jump: restart it.
   have_prev_ = !result_.snapped;
   ComputeForces();
+  model_->AcceptState(x_, u_);
   return result_;
 }
 

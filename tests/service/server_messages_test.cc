@@ -134,7 +134,7 @@ TEST(ServerMessagesTest, GripTorque) {
   const DeviceMapping map = TestMapping();
   ModelParams p;
   p.model = "thread3d";
-  p.grip_direction = true;
+  p.Set("grip_direction", true);
   auto model = MakeModel(p);
   TrackResult r = FakeResult(6, 1.0);
   r.force.segment<3>(3) = Eigen::Vector3d(0.0, 3.0, 0.0);  // F_d
@@ -226,7 +226,7 @@ TEST(ServerMessagesTest, ShapeCountsMatchAndValidate) {
   const DeviceMapping map = TestMapping();
   ModelParams p;
   p.model = "curve2d";
-  p.n = 7;
+  p.Set("n", 7);
   auto model = MakeModel(p);
   const Vec u = (Vec(2) << 6.0, 0.5).finished();
   ShapeInputs in;

@@ -281,7 +281,7 @@ TEST_F(ServerTest, ForceModelsMatchDirectTrackerInDeviceUnits) {
   const size_t since = probe_->num_shapes();
   ASSERT_TRUE(probe_->WaitShape(since, [](const thread_shape_t&) { return true; }, &shape));
   EXPECT_EQ(shape.model, "curve2d");
-  EXPECT_EQ(shape.num_nodes, scene.params.n + 1);
+  EXPECT_EQ(shape.num_nodes, scene.params.Integer("n") + 1);
   EXPECT_NEAR(shape.grasp[0], direct.control()[0], 1e-12);
   EXPECT_NEAR(shape.grasp[1], direct.control()[1], 1e-12);
   EXPECT_EQ(shape.snaps, direct_snaps);

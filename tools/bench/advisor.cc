@@ -22,31 +22,26 @@ namespace fs = std::filesystem;
 
 // ---------------------------------------------------------------- advisor
 
-bool IsChain(const Scene& s) { return s.params.model == "curve2d" || s.params.model == "thread3d"; }
+bool IsChain(const Scene& s) { return IsChain(s.params); }
 
 Scene ResizeChain(const Scene& scene, int n) {
   if (!IsChain(scene)) return scene;
   Scene s = scene;
-  const double l_old = scene.params.segment_length;
-  const double l_new = scene.params.n * l_old / n;
-  s.params.n = n;
-  s.params.segment_length = l_new;
   // EI = beta l and EA ~ 2 gamma l are the continuum constants: keep beta l, gamma l.
-  s.params.bending = scene.params.bending * l_old / l_new;
-  s.params.stretching = scene.params.stretching * l_old / l_new;
+  s.params = ResizeChain(scene.params, n);
   return s;
 }
 
 std::vector<Vec> HandSpeedPath(const Scene& scene) {
   constexpr double kStep = 0.002;                          // model units per update
   constexpr double kTurn = 0.5 * std::numbers::pi / 180;   // grip turn per update, rad
-  const int pos = scene.params.model == "thread3d" ? 3 : 2;
+  const int pos = scene.grasp_layout.spatial_dimension;
   int steps = 1;
   for (size_t k = 1; k < scene.path.size(); ++k) {
     const Vec& a = scene.path[k - 1];
     const Vec& b = scene.path[k];
     double need = (b.head(pos) - a.head(pos)).norm() / kStep;
-    if (scene.params.grip_direction) {
+    if (scene.grasp_layout.grip_direction) {
       const double c = std::clamp(a.tail(3).normalized().dot(b.tail(3).normalized()), -1.0, 1.0);
       need = std::max(need, std::acos(c) / kTurn);
     }
@@ -90,11 +85,11 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
   std::vector<int> ladder = o.n_ladder;
   std::sort(ladder.begin(), ladder.end());
   ladder.erase(std::unique(ladder.begin(), ladder.end()), ladder.end());
-  if (!chain || ladder.empty()) ladder = {chain ? scene.params.n : 0};
+  if (!chain || ladder.empty()) ladder = {chain ? ChainSegments(scene.params) : 0};
 
   Scene ref_scene = scene;
   if (chain) {
-    a.reference_n = o.reference_n > 0 ? o.reference_n : 2 * std::max(scene.params.n, ladder.back());
+    a.reference_n = o.reference_n > 0 ? o.reference_n : 2 * std::max(ChainSegments(scene.params), ladder.back());
     ref_scene = ResizeChain(scene, a.reference_n);
     // A rung as fine as the reference would compare the reference with itself.
     std::erase_if(ladder, [&](int n) { return n >= a.reference_n; });

@@ -59,13 +59,16 @@ PowerLawFit FitPowerLaw(const std::vector<double>& x, const std::vector<double>&
 
 Scene HandSpeedScene(const Scene& base, int n, const std::string& method, const std::string& backend, double cutoff,
                      bool fixed_length) {
-  if (base.params.model != "thread3d") throw std::invalid_argument("bench: the scaling scene must be a thread3d scene");
+  if (!IsChain(base.params) || base.grasp_layout.spatial_dimension != 3)
+    throw std::invalid_argument("bench: the scaling scene must be a chain in three dimensions (" + base.file + ")");
   Scene s = base;
-  s.params.grip_direction = false;
+  // The timing runs without a grip direction: the plain (X, Y, Z) grasp.
+  if (FindModel(s.params.model)->FindParam("grip_direction") != nullptr) s.params.Set("grip_direction", false);
+  s.grasp_layout = GraspLayoutOf(s.params);
   if (fixed_length) s = ResizeChain(s, n);
   s.name = base.name + "_n" + std::to_string(n);
-  s.params.n = n;
-  const double total = n * s.params.segment_length;
+  s.params = SetChainSegments(s.params, n);
+  const double total = n * ChainSegmentLength(s.params);
   s.grasp_start = Vec(3);
   s.grasp_start << 0.9 * total, 0.1 * total, 0.05 * total;
   s.path = {s.grasp_start};
@@ -78,8 +81,8 @@ Scene HandSpeedScene(const Scene& base, int n, const std::string& method, const 
 
 void HandSpeedControl(const Scene& scene, long i, Vec* u, double step) {
   if (u->size() != 3) u->resize(3);
-  const double l = scene.params.segment_length;
-  const double total = scene.params.n * l;
+  const double l = ChainSegmentLength(scene.params);
+  const double total = ChainSegments(scene.params) * l;
   const double a = 0.05 * total;  // amplitude of the back-and-forth in y
   const double t = std::fmod(i * (step > 0 ? step : 0.002 * l), 4 * a);
   const double dy = t < a ? t : (t < 3 * a ? 2 * a - t : t - 4 * a);
@@ -92,7 +95,7 @@ ScalingRow TimeHandSpeed(const Scene& scene, const ScalingOptions& o) {
   ScalingRow row;
   row.method = scene.solver.method;
   row.backend = scene.solver.linear_solver;
-  row.n = scene.params.n;
+  row.n = ChainSegments(scene.params);
   auto tracker = MakeTracker(scene);
   Vec u = scene.grasp_start;
   tracker->Reset(u);
@@ -142,7 +145,7 @@ std::vector<ScalingRow> RunScalingBench(const std::string& scenes_dir, const Sca
   const Scene base = LoadScene(scenes_dir + "/thread3d_loop.yaml");
   ScalingOptions o = options;
   // Fixed length: the hand moves 0.002 L_base per update whatever the discretisation.
-  if (o.fixed_length && o.hand_step <= 0) o.hand_step = 0.002 * base.params.segment_length;
+  if (o.fixed_length && o.hand_step <= 0) o.hand_step = 0.002 * ChainSegmentLength(base.params);
   std::vector<ScalingRow> rows;
   std::vector<int> ns = o.ns;
   std::sort(ns.begin(), ns.end());

@@ -1,0 +1,427 @@
+#include "models/rod_model.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+namespace snapthread {
+
+using rod::FrameSource;
+using rod::Jet;
+using rod::JetVec;
+using V3 = Eigen::Vector3d;
+using M3 = Eigen::Matrix3d;
+constexpr int kMaxVars = internal::HessianAssembly::kMaxTermVars;
+
+bool RodParams::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& why) {
+    if (error != nullptr) *error = "rod: " + why;
+    return false;
+  };
+  if (n < 3) return fail("n must be at least 3 (the clamp and the grasp hold one edge each)");
+  if (!(length > 0.0) || !std::isfinite(length)) return fail("length must be positive");
+  const double stiffnesses[] = {stretch_stiffness, bend_stiffness, bend_stiffness_2,
+                                twist_stiffness};
+  for (double s : stiffnesses) {
+    if (!(s > 0.0) || !std::isfinite(s)) return fail("stiffnesses must be positive and finite");
+  }
+  if (!std::isfinite(natural_curvature) || !std::isfinite(natural_curvature_2))
+    return fail("natural curvature must be finite");
+  if (!(radius >= 0.0) || !std::isfinite(radius)) return fail("radius must be >= 0");
+  if (!clamp_position.allFinite()) return fail("clamp position must be finite");
+  for (const M3* r : {&clamp_rotation, &grasp_rotation}) {
+    if (!r->allFinite() || ((*r).transpose() * (*r) - M3::Identity()).norm() > 1e-9 ||
+        r->determinant() < 0.0) {
+      return fail("clamp and grasp rotations must be proper rotation matrices");
+    }
+  }
+  return true;
+}
+
+// u -> x_{n-1}, x_n, θ_{n-1}: values, Jacobian (7 x 6 over (p, φ)) and, for each of the
+// seven coordinates, the Hessian in φ (the map is linear in p).
+struct RodModel::GraspMap {
+  V3 xn1, xn;
+  double theta = 0.0;
+  Eigen::Matrix<double, 7, 6> jac;
+  std::array<M3, 7> hess_phi;
+};
+
+RodModel::RodModel(const RodParams& params) : p_(params) {
+  std::string error;
+  if (!p_.IsValid(&error)) throw std::invalid_argument(error);
+  n_ = p_.n;
+  nx_ = 4 * n_ - 11;
+  rest_ = p_.length / n_;
+  // Uniform rest edges: the Voronoi length ℓ̄ = ℓ at every interior vertex.
+  stiffness_.c1 = p_.bend_stiffness / rest_;
+  stiffness_.c2 = p_.bend_stiffness_2 / rest_;
+  stiffness_.ct = p_.twist_stiffness / rest_;
+  stiffness_.kappa1_bar = p_.natural_curvature * rest_;
+  stiffness_.kappa2_bar = p_.natural_curvature_2 * rest_;
+  assembly_ = internal::HessianAssembly(nx_, 6);
+  BuildTerms();
+  // Reference frames of the rest rod: straight along the clamp.
+  sources_.assign(n_, FrameSource{p_.clamp_rotation.col(0), p_.clamp_rotation.col(1)});
+  twist_near_.assign(n_, 0.0);
+  grasp_theta_near_ = 0.0;
+  grasp_theta_near_ = Grasp(Vec::Zero(6), false).theta;
+}
+
+int RodModel::NodeIndex(int k) const {
+  return (k >= 2 && k <= n_ - 2) ? 4 * k - 7 : -1;
+}
+int RodModel::ThetaIndex(int j) const {
+  if (j < 1 || j > n_ - 2) return -1;
+  return j == 1 ? 0 : 4 * j - 4;
+}
+
+void RodModel::BuildTerms() {
+  auto node_code = [&](int k, int c) {
+    if (k <= 1) return -1;
+    if (k == n_ - 1) return -2 - c;
+    if (k == n_) return -5 - c;
+    return NodeIndex(k) + c;
+  };
+  auto theta_code = [&](int j) {
+    if (j == 0) return -1;
+    if (j == n_ - 1) return -8;
+    return ThetaIndex(j);
+  };
+  auto add = [&](Term term) {
+    int vars[kMaxVars];
+    int count = 0;
+    for (int r = 0; r < term.nloc; ++r) term.grasp = term.grasp || term.code[r] <= -2;
+    if (!term.grasp) {
+      for (int r = 0; r < term.nloc; ++r) vars[count++] = term.code[r];
+    } else {
+      for (int r = 0; r < term.nloc; ++r) {
+        term.pos[r] = -1;
+        if (term.code[r] >= 0) {
+          term.pos[r] = count;
+          vars[count++] = term.code[r];
+        }
+      }
+      for (int c = 0; c < 6; ++c) vars[count++] = nx_ + c;
+    }
+    assembly_.AddTerm(vars, count);
+    terms_.push_back(term);
+  };
+  // Stretching of the edges between the clamp and the grasp (edges 0 and n-1 keep ℓ).
+  for (int j = 1; j <= n_ - 2; ++j) {
+    Term term;
+    term.index = j;
+    term.nloc = 6;
+    for (int c = 0; c < 3; ++c) {
+      term.code[c] = node_code(j, c);
+      term.code[3 + c] = node_code(j + 1, c);
+    }
+    add(term);
+  }
+  for (int i = 1; i <= n_ - 1; ++i) {
+    Term term;
+    term.vertex = true;
+    term.index = i;
+    term.nloc = 11;
+    for (int a = 0; a < 3; ++a) {
+      for (int c = 0; c < 3; ++c) term.code[3 * a + c] = node_code(i - 1 + a, c);
+    }
+    term.code[9] = theta_code(i - 1);
+    term.code[10] = theta_code(i);
+    add(term);
+  }
+  assembly_.Finalize();
+  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+    if (assembly_.TouchesControls(t)) control_terms_.push_back(t);
+  }
+}
+
+RodModel::GraspMap RodModel::Grasp(const Vec& u, bool derivatives) const {
+  GraspMap gm;
+  const V3 pos = u.head<3>();
+  const V3 phi = u.segment<3>(3);
+  if (!derivatives) {
+    // Values only (Energy, line searches): the rotation and one angle.
+    const M3 r = rod::ExpMap(phi) * p_.grasp_rotation;
+    const V3 t = r.col(0);
+    gm.xn = pos;
+    gm.xn1 = pos - rest_ * t;
+    V3 a, b;
+    rod::ReferenceFrame(sources_[n_ - 1], t, &a, &b);
+    gm.theta = rod::AngleAbout(t, a, r.col(1), grasp_theta_near_);
+    return gm;
+  }
+  const JetVec t = rod::RotateJet(phi, p_.grasp_rotation.col(0));
+  const JetVec m1 = rod::RotateJet(phi, p_.grasp_rotation.col(1));
+  gm.xn = pos;
+  gm.xn1 = pos - rest_ * t.Value();
+  // θ_{n-1}: the angle of m1 about t from the time-parallel reference director
+  // a = P_{t_s}^{t} a_s = a_s - (a_s·t)/(1 + t_s·t) (t_s + t) (a_s ⊥ t_s).
+  const FrameSource& s = sources_[n_ - 1];
+  const Jet k = Dot(s.a, t) * rod::Inverse(Jet::Constant(1.0) + Dot(s.t, t));
+  const JetVec a = JetVec::Constant(s.a) - k * (JetVec::Constant(s.t) + t);
+  const JetVec b = rod::CrossJ(t, a);
+  const Jet theta = rod::Atan2(Dot(b, m1), Dot(a, m1));
+  gm.theta = grasp_theta_near_ +
+             std::remainder(theta.v - grasp_theta_near_, 2.0 * std::numbers::pi);
+  gm.jac.setZero();
+  for (int c = 0; c < 3; ++c) {
+    gm.jac(c, c) = 1.0;
+    gm.jac(3 + c, c) = 1.0;
+    gm.jac.block<1, 3>(c, 3) = -rest_ * t.c[c].g.transpose();
+    gm.hess_phi[c] = -rest_ * t.c[c].h;
+    gm.hess_phi[3 + c].setZero();
+  }
+  gm.jac.block<1, 3>(6, 3) = theta.g.transpose();
+  gm.hess_phi[6] = theta.h;
+  return gm;
+}
+
+V3 RodModel::Node(int k, const Vec& x, const GraspMap& gm) const {
+  if (k == 0) return p_.clamp_position;
+  if (k == 1) return p_.clamp_position + rest_ * p_.clamp_rotation.col(0);
+  if (k == n_ - 1) return gm.xn1;
+  if (k == n_) return gm.xn;
+  return x.segment<3>(NodeIndex(k));
+}
+
+double RodModel::Theta(int j, const Vec& x, const GraspMap& gm) const {
+  if (j == 0) return 0.0;
+  if (j == n_ - 1) return gm.theta;
+  return x[ThetaIndex(j)];
+}
+
+template <class F>
+void RodModel::Local(int t, const Vec& x, const GraspMap& gm, bool want_h, F&& f) const {
+  const Term& term = terms_[t];
+  Eigen::Matrix<double, kMaxLocal, 1> gy;
+  Eigen::Matrix<double, kMaxLocal, kMaxLocal> hy;
+  const int i = term.index;
+  if (term.grasp) {
+    // The chain rule below multiplies full fixed-size blocks (no dynamic temporaries).
+    gy.setZero();
+    hy.setZero();
+  }
+  if (!term.vertex) {
+    Eigen::Matrix<double, 6, 1> g6;
+    Eigen::Matrix<double, 6, 6> h6;
+    // ½ EA (|e|/ℓ - 1)² ℓ = (EA / 2ℓ) (|e| - ℓ)²  [DER (2) with the stretching of DVT §4]
+    internal::StretchTerm<3>(Node(i, x, gm), Node(i + 1, x, gm),
+                             0.5 * p_.stretch_stiffness / rest_, rest_, &g6,
+                             want_h ? &h6 : nullptr);
+    gy.head<6>() = g6;
+    if (want_h) hy.topLeftCorner<6, 6>() = h6;
+  } else {
+    const V3 xa = Node(i - 1, x, gm), xb = Node(i, x, gm), xc = Node(i + 1, x, gm);
+    rod::Vec8 g8;
+    rod::Mat8 h8;
+    rod::VertexEnergy(xb - xa, xc - xb, Theta(i - 1, x, gm), Theta(i, x, gm), sources_[i - 1],
+                      sources_[i], twist_near_[i], stiffness_, &g8, want_h ? &h8 : nullptr);
+    // (e0, e1) = (x_i - x_{i-1}, x_{i+1} - x_i).
+    gy.segment<3>(0) = -g8.segment<3>(0);
+    gy.segment<3>(3) = g8.segment<3>(0) - g8.segment<3>(3);
+    gy.segment<3>(6) = g8.segment<3>(3);
+    gy.segment<2>(9) = g8.tail<2>();
+    if (want_h) {
+      // Hy = Lᵀ H8 L with node a's edge coefficients D(a, ·) = (-1, 0), (1, -1), (0, 1),
+      // block by block (the dense product would cost several times more).
+      static constexpr double kD[3][2] = {{-1.0, 0.0}, {1.0, -1.0}, {0.0, 1.0}};
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) {
+          M3 blk = M3::Zero();
+          for (int e = 0; e < 2; ++e) {
+            if (kD[a][e] == 0.0) continue;
+            for (int f = 0; f < 2; ++f) {
+              if (kD[b][f] != 0.0) blk += (kD[a][e] * kD[b][f]) * h8.block<3, 3>(3 * e, 3 * f);
+            }
+          }
+          hy.block<3, 3>(3 * a, 3 * b) = blk;
+        }
+        Eigen::Matrix<double, 3, 2> side = Eigen::Matrix<double, 3, 2>::Zero();
+        for (int e = 0; e < 2; ++e) {
+          if (kD[a][e] != 0.0) side += kD[a][e] * h8.block<3, 2>(3 * e, 6);
+        }
+        hy.block<3, 2>(3 * a, 9) = side;
+        hy.block<2, 3>(9, 3 * a) = side.transpose();
+      }
+      hy.block<2, 2>(9, 9) = h8.block<2, 2>(6, 6);
+    }
+  }
+  const int nloc = term.nloc;
+  if (!term.grasp) {
+    f(gy.data(), hy.data(), kMaxLocal);
+    return;
+  }
+  // Chain rule through the grasp map: y = C z (+ curvature of the grasp coordinates).
+  const int k = assembly_.TermSize(t);
+  Eigen::Matrix<double, kMaxLocal, kMaxVars> c = Eigen::Matrix<double, kMaxLocal, kMaxVars>::Zero();
+  for (int r = 0; r < nloc; ++r) {
+    if (term.code[r] >= 0) {
+      c(r, term.pos[r]) = 1.0;
+    } else if (term.code[r] <= -2) {
+      c.block<1, 6>(r, k - 6) = gm.jac.row(-2 - term.code[r]);
+    }
+  }
+  Eigen::Matrix<double, kMaxVars, 1> ga;
+  Eigen::Matrix<double, kMaxVars, kMaxVars> ha;
+  ga.noalias() = c.transpose() * gy;
+  if (want_h) {
+    const Eigen::Matrix<double, kMaxLocal, kMaxVars> hc = hy * c;
+    ha.noalias() = c.transpose() * hc;
+    for (int r = 0; r < nloc; ++r) {
+      if (term.code[r] <= -2) ha.block<3, 3>(k - 3, k - 3) += gy[r] * gm.hess_phi[-2 - term.code[r]];
+    }
+  }
+  f(ga.data(), ha.data(), kMaxVars);
+}
+
+double RodModel::Energy(const Vec& x, const Vec& u) const {
+  const GraspMap gm = Grasp(u, false);
+  double e = 0.0;
+  for (const Term& term : terms_) {
+    const int i = term.index;
+    if (!term.vertex) {
+      e += internal::StretchTerm<3>(Node(i, x, gm), Node(i + 1, x, gm),
+                                    0.5 * p_.stretch_stiffness / rest_, rest_, nullptr, nullptr);
+    } else {
+      const V3 xa = Node(i - 1, x, gm), xb = Node(i, x, gm), xc = Node(i + 1, x, gm);
+      e += rod::VertexEnergy(xb - xa, xc - xb, Theta(i - 1, x, gm), Theta(i, x, gm),
+                             sources_[i - 1], sources_[i], twist_near_[i], stiffness_, nullptr,
+                             nullptr);
+    }
+  }
+  return e;
+}
+
+void RodModel::Gradient(const Vec& x, const Vec& u, Vec* g) const {
+  if (g->size() != nx_) g->resize(nx_);
+  g->setZero();
+  const GraspMap gm = Grasp(u, true);
+  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+    Local(t, x, gm, false,
+          [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
+  }
+}
+
+void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
+  const SparseMatrix& pattern = assembly_.Pattern();
+  if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
+      !h->isCompressed()) {
+    *h = pattern;
+  }
+  double* values = h->valuePtr();
+  std::fill(values, values + pattern.nonZeros(), 0.0);
+  const GraspMap gm = Grasp(u, true);
+  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+    Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
+      assembly_.AddHessian(t, lh, ld, values);
+    });
+  }
+}
+
+void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
+  if (eu->size() != 6) eu->resize(6);
+  eu->setZero();
+  const GraspMap gm = Grasp(u, true);
+  for (int t : control_terms_) {
+    Local(t, x, gm, false, [&](const double* lg, const double*, int) {
+      assembly_.AddControlGradient(t, lg, eu->data());
+    });
+  }
+}
+
+void RodModel::MixedHessian(const Vec& x, const Vec& u, Mat* exu) const {
+  if (exu->rows() != nx_ || exu->cols() != 6) exu->resize(nx_, 6);
+  exu->setZero();
+  const GraspMap gm = Grasp(u, true);
+  for (int t : control_terms_) {
+    Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
+      assembly_.AddMixedHessian(t, lh, ld, exu);
+    });
+  }
+}
+
+void RodModel::ControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
+  if (euu->rows() != 6 || euu->cols() != 6) euu->resize(6, 6);
+  euu->setZero();
+  const GraspMap gm = Grasp(u, true);
+  for (int t : control_terms_) {
+    Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
+      assembly_.AddControlHessian(t, lh, ld, euu);
+    });
+  }
+}
+
+Vec RodModel::InitialState(const Vec& u) const {
+  const GraspMap gm = Grasp(u, false);
+  Vec x = Vec::Zero(nx_);
+  const V3 x1 = Node(1, x, gm);
+  for (int k = 2; k <= n_ - 2; ++k) {
+    x.segment<3>(NodeIndex(k)) = x1 + (static_cast<double>(k - 1) / (n_ - 2)) * (gm.xn1 - x1);
+  }
+  for (int j = 1; j <= n_ - 2; ++j) x[ThetaIndex(j)] = gm.theta * j / (n_ - 1);
+  return x;
+}
+
+void RodModel::NodePositions(const Vec& x, const Vec& u, Eigen::Matrix3Xd* nodes) const {
+  if (nodes->cols() != n_ + 1) nodes->resize(3, n_ + 1);
+  const GraspMap gm = Grasp(u, false);
+  for (int k = 0; k <= n_; ++k) nodes->col(k) = Node(k, x, gm);
+}
+
+double RodModel::Probe(const Vec& x, const Vec& u) const {
+  const GraspMap gm = Grasp(u, false);
+  const V3 c = p_.clamp_position;
+  V3 d = gm.xn - c;
+  const double len = d.norm();
+  d = len > 1e-12 * p_.length ? V3(d / len) : V3::Zero();
+  double probe = 0.0;
+  for (int k = 0; k <= n_; ++k) {
+    const V3 r = Node(k, x, gm) - c;
+    probe = std::max(probe, (r - r.dot(d) * d).norm());
+  }
+  return probe;
+}
+
+double RodModel::ForceScale() const {
+  return p_.bend_stiffness / (p_.length * p_.length);
+}
+
+Vec RodModel::MaterialAngles(const Vec& x, const Vec& u) const {
+  const GraspMap gm = Grasp(u, false);
+  Vec theta(n_);
+  for (int j = 0; j < n_; ++j) theta[j] = Theta(j, x, gm);
+  return theta;
+}
+
+V3 RodModel::MaterialDirector(const Vec& x, const Vec& u, int j) const {
+  const GraspMap gm = Grasp(u, false);
+  const V3 t = (Node(j + 1, x, gm) - Node(j, x, gm)).normalized();
+  V3 a, b;
+  rod::ReferenceFrame(sources_[j], t, &a, &b);
+  const double th = Theta(j, x, gm);
+  return std::cos(th) * a + std::sin(th) * b;
+}
+
+void RodModel::AcceptState(const Vec& x, const Vec& u) {
+  const GraspMap gm = Grasp(u, false);
+  // Continued values first, against the old sources (at the accepted state the new
+  // frames equal the old ones carried there, so E(x, u) does not change).
+  for (int i = 1; i <= n_ - 1; ++i) {
+    twist_near_[i] = rod::ReferenceTwist(Node(i, x, gm) - Node(i - 1, x, gm),
+                                         Node(i + 1, x, gm) - Node(i, x, gm), sources_[i - 1],
+                                         sources_[i], twist_near_[i]);
+  }
+  grasp_theta_near_ = gm.theta;
+  for (int j = 0; j < n_; ++j) {
+    const V3 t = (Node(j + 1, x, gm) - Node(j, x, gm)).normalized();
+    V3 a, b;
+    rod::ReferenceFrame(sources_[j], t, &a, &b);
+    // Re-orthonormalise so rounding does not accumulate over many updates.
+    sources_[j].t = t;
+    sources_[j].a = (a - a.dot(t) * t).normalized();
+  }
+}
+
+}  // namespace snapthread

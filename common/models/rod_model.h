@@ -1,0 +1,129 @@
+// The discrete elastic rod (issue 14; Bergou et al. 2008 [DER], 2010 [DVT]):
+// n edges, nodes x_0 .. x_n and one material angle θ_j per edge against a time-parallel
+// reference frame (rod_frames.h, rod_energy.h; docs/models-rod.md).
+//
+// Clamp and grasp are full poses. The clamp (position c, rotation R_c) fixes edge 0:
+// x_0 = c, x_1 = c + ℓ R_c e_x, material frame (m1, m2) = (R_c e_y, R_c e_z), θ_0 = 0.
+// The grasp u = (p, φ) with orientation R(u) = exp([φ]×) R_start fixes edge n-1:
+// x_n = p, x_{n-1} = p - ℓ R(u) e_x, m1_{n-1} = R(u) e_y. Body axes: x along the rod,
+// y = m1, z = m2.
+//
+// State x (4n - 11 entries), ordered for a narrow band:
+//   [θ_1, x_2, θ_2, x_3, θ_3, ..., x_{n-2}, θ_{n-2}]   (half-bandwidth 10: a vertex couples three nodes)
+//
+// Controls and torque. E_u = (E_p, E_φ). F = -E_p is the force of the rod on the hand
+// (world frame). -E_φ is the torque conjugate to the rotation vector φ; at φ = 0 (and
+// whenever φ is parallel to the rotation axis, e.g. a roll about a fixed axis) it is the
+// torque of the rod on the hand about the grasp point x_n in world coordinates. In
+// general the world torque is τ = -J_l(φ)^{-T} E_φ with the left Jacobian of SO(3),
+// J_l(φ) = I + (1 - cos|φ|)/|φ|² [φ]× + (|φ| - sin|φ|)/|φ|³ [φ]×².
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "models/hessian_assembly.h"
+#include "models/model.h"
+#include "models/rod_energy.h"
+
+namespace snapthread {
+
+struct RodParams {
+  int n = 10;                       // edges (≥ 3)
+  double length = 1.0;              // rest length L (m); every edge ℓ = L / n
+  double stretch_stiffness = 1000;  // EA (N)
+  double bend_stiffness = 1.0;      // B1 = EI about m2, for κ1 (N m²)
+  double bend_stiffness_2 = 1.0;    // B2 about m1, for κ2 (N m²)
+  double twist_stiffness = 1.0;     // GJ (N m²)
+  double natural_curvature = 0.0;   // κ̄1 (1/m), bending towards m1
+  double natural_curvature_2 = 0.0; // κ̄2 (1/m), bending towards m2
+  double radius = 0.01;             // drawing only (m)
+  Eigen::Vector3d clamp_position = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d clamp_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d grasp_rotation = Eigen::Matrix3d::Identity();  // R_start (φ = 0)
+
+  bool IsValid(std::string* error) const;
+};
+
+class RodModel final : public Model {
+ public:
+  // Throws std::invalid_argument if !params.IsValid().
+  explicit RodModel(const RodParams& params);
+
+  std::string_view Name() const override { return "rod"; }
+  int NumStates() const override { return nx_; }
+  int NumControls() const override { return 6; }
+  int SpatialDimension() const override { return 3; }
+
+  double Energy(const Vec& x, const Vec& u) const override;
+  void Gradient(const Vec& x, const Vec& u, Vec* g) const override;
+  const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
+  void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override;
+  void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override;
+  void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override;
+  void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override;
+
+  // Nodes evenly spaced on the segment x_1 .. x_{n-1}, twist spread evenly.
+  Vec InitialState(const Vec& u) const override;
+  void NodePositions(const Vec& x, const Vec& u, Eigen::Matrix3Xd* nodes) const override;
+  // The largest distance of any node from the clamp–grasp line (x_0, x_n): 0 while straight.
+  double Probe(const Vec& x, const Vec& u) const override;
+  // EI / L².
+  double ForceScale() const override;
+  int HessianBandwidth() const override { return assembly_.Bandwidth(); }
+  // Moves the time-parallel reference frames (and the continued reference twists and
+  // grasp angle) to the accepted state.
+  void AcceptState(const Vec& x, const Vec& u) override;
+
+  // Layout, for tests and scene code: the state index of coordinate 0 of node k and of
+  // θ_j, or -1 when the clamp or the grasp sets it.
+  int NodeIndex(int k) const;
+  int ThetaIndex(int j) const;
+  // θ_j for every edge (θ_0 = 0, θ_{n-1} from the grasp).
+  Vec MaterialAngles(const Vec& x, const Vec& u) const;
+  // Material director m1 of edge j.
+  Eigen::Vector3d MaterialDirector(const Vec& x, const Vec& u, int j) const;
+  const RodParams& params() const { return p_; }
+
+ private:
+  static constexpr int kMaxLocal = 11;  // a vertex term: three nodes and two angles
+  struct GraspMap;
+  // One energy term (stretching of an edge, or bending and twist at a vertex). Local
+  // coordinate codes: >= 0 a state index, -1 fixed by the clamp, -2 - g grasp
+  // coordinate g (0..2 x_{n-1}, 3..5 x_n, 6 θ_{n-1}).
+  struct Term {
+    bool vertex = false;
+    int index = 0;  // edge (stretch) or vertex
+    int nloc = 0;
+    bool grasp = false;
+    std::array<int, kMaxLocal> code{};
+    std::array<int, kMaxLocal> pos{};  // grasp terms: assembly position of state coordinates
+  };
+  void BuildTerms();
+  GraspMap Grasp(const Vec& u, bool derivatives) const;
+  Eigen::Vector3d Node(int k, const Vec& x, const GraspMap& gm) const;
+  double Theta(int j, const Vec& x, const GraspMap& gm) const;
+  // Calls f(local gradient, local Hessian, leading dimension) for term t in its
+  // assembly variables.
+  template <class F>
+  void Local(int t, const Vec& x, const GraspMap& gm, bool want_h, F&& f) const;
+
+  RodParams p_;
+  int n_;
+  int nx_;
+  double rest_;  // ℓ
+  rod::VertexStiffness stiffness_;
+  internal::HessianAssembly assembly_;
+  std::vector<Term> terms_;
+  std::vector<int> control_terms_;
+  // Lagged data (AcceptState): per edge the frame source, per vertex the reference twist,
+  // and the grasp's material angle, each the value at the last accepted state.
+  std::vector<rod::FrameSource> sources_;
+  std::vector<double> twist_near_;
+  double grasp_theta_near_ = 0.0;
+};
+
+}  // namespace snapthread

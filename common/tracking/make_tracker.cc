@@ -1,0 +1,27 @@
+#include "tracking/make_tracker.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "models/registry.h"
+
+namespace snapthread {
+
+std::unique_ptr<EquilibriumTracker> MakeTracker(const Scene& scene) {
+  std::unique_ptr<EquilibriumTracker> tracker;
+  try {
+    // The model's and the solver's messages start with the key ("params.n: ...").
+    tracker = std::make_unique<EquilibriumTracker>(MakeModel(scene.params), scene.solver);
+  } catch (const std::invalid_argument& e) {
+    throw SceneError(scene.file + ": " + e.what());
+  }
+  if (scene.grasp_start.size() != tracker->model().NumControls()) {
+    throw SceneError(scene.file + ": grasp.start has " + std::to_string(scene.grasp_start.size()) +
+                     " entries, model " + std::string(tracker->model().Name()) + " has " +
+                     std::to_string(tracker->model().NumControls()) + " controls");
+  }
+  tracker->SetSnapThreshold(0.1 * SnapLengthScale(scene.params));
+  return tracker;
+}
+
+}  // namespace snapthread
