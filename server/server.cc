@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "messages/pose_mapping.h"
+#include "scene_dir.h"
 #include "server_messages.h"
 #include "server_session.h"
 #include "tracking/make_tracker.h"
@@ -63,6 +64,7 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
   if (!params_.IsValid(&error)) throw std::invalid_argument(error);
   channels_ = transport::Channels(params_.session);
   method_override_ = params_.method;
+  if (params_.scene_dir.empty()) params_.scene_dir = DefaultSceneDir();
 
   // The scene first: a bad scene is the user's most likely mistake, report it before
   // touching the network.
@@ -137,6 +139,7 @@ void Server::Stop() {
   inbox_.RequestStop();
   if (receive_thread_.joinable()) receive_thread_.join();
   if (solve_thread_.joinable()) solve_thread_.join();
+  load_.Join();  // a scene load still running (bounded by its file size and the parser)
   if (state_sub_ != nullptr) lcm_->unsubscribe(state_sub_);
   if (command_sub_ != nullptr) lcm_->unsubscribe(command_sub_);
   state_sub_ = command_sub_ = nullptr;
@@ -214,6 +217,7 @@ void Server::SolveLoop() {
       ApplyCommand(command);
       changed_session = true;
     }
+    if (PollSceneLoad()) changed_session = true;
     if (taken.pose) SolveAndPublish(*taken.pose);
     now = SteadyClock::now();
     if (now >= next_shape || changed_session) {
