@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include <spdlog/spdlog.h>
@@ -92,11 +93,23 @@ void DeviceClient::Start(std::string* notes) {
   started_ = true;
 }
 
+bool DeviceClient::FadeOut(double timeout_s) {
+  safety_.RequestFadeOut();
+  if (!started_) return true;
+  const int64_t deadline_us = Now() + static_cast<int64_t>(1e6 * timeout_s);
+  while (Now() < deadline_us) {
+    if (tick_.counters().force_norm_n.load() == 0.0) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return tick_.counters().force_norm_n.load() == 0.0;
+}
+
 void DeviceClient::Stop() {
   if (!started_) return;
   started_ = false;
   loop_.Stop();
   end_us_ = Now();
+  final_force_n_ = tick_.counters().force_norm_n.load();
   const double zero[3] = {0.0, 0.0, 0.0};
   device_->Command(zero, zero);
   stop_threads_.store(true);
@@ -251,6 +264,7 @@ DeviceClientSummary DeviceClient::Summary(int64_t now_us) const {
   s.publish_failures = publish_failures_.load();
   s.poses_published = poses_published_.load();
   s.max_force_n = safety_.max_force_n();
+  s.final_force_n = final_force_n_;
   s.realtime = loop_.realtime_active();
   return s;
 }

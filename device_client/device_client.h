@@ -65,6 +65,7 @@ struct DeviceClientSummary {
   uint64_t read_failures = 0, pose_ring_drops = 0, trace_ring_drops = 0;
   uint64_t invalid_poses_unpublished = 0, publish_failures = 0, poses_published = 0;
   double max_force_n = 0.0;
+  double final_force_n = 0.0;  // |F| commanded at the last servo tick before Stop
   bool realtime = false;
 };
 
@@ -81,6 +82,10 @@ class DeviceClient {
   // Production: starts the servo loop and the receive and io threads. *notes gets one
   // line per real-time feature that could not be enabled.
   void Start(std::string* notes);
+  // Fades the force to zero through the safety ramp (fade_time_s) while the servo loop
+  // runs; waits up to timeout_s for the last commanded |F| to reach 0 (true when it did).
+  // Call before Stop on a signal.
+  bool FadeOut(double timeout_s);
   // Stops the threads, commands zero force, flushes the rings and the trace. Idempotent.
   void Stop();
 
@@ -146,6 +151,7 @@ class DeviceClient {
   std::thread receive_thread_;
   std::thread io_thread_;
   bool started_ = false;
+  double final_force_n_ = 0.0;  // |F| at the last tick, kept by Stop
 };
 
 }  // namespace snapthread::device

@@ -71,14 +71,14 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
       "  \"models_received\": %llu,\n  \"models_rejected\": %llu,\n  \"invalid_models\": %llu,\n"
       "  \"poses_rejected\": %llu,\n  \"force_clamps\": %llu,\n  \"stiffness_clamps\": %llu,\n"
       "  \"slew_limits\": %llu,\n  \"fade_ticks\": %llu,\n  \"snaps_felt\": %llu,\n"
-      "  \"max_force_n\": %.6f,\n  \"nonfinite_outputs\": %llu,\n  \"overruns\": %llu,\n"
+      "  \"max_force_n\": %.6f,\n  \"final_force_n\": %.6f,\n  \"nonfinite_outputs\": %llu,\n  \"overruns\": %llu,\n"
       "  \"read_failures\": %llu,\n  \"pose_ring_drops\": %llu,\n  \"trace_ring_drops\": %llu,\n"
       "  \"invalid_poses_unpublished\": %llu,\n  \"realtime\": %s\n}\n",
       o.backend.c_str(), o.session.c_str(), s.duration_s, u(s.ticks), s.tick_rate_hz,
       s.lateness_us.p50, s.lateness_us.p99, s.lateness_us_max, s.round_trip_us.p50,
       s.round_trip_us.p99, u(s.models_received), u(s.models_rejected), u(s.invalid_models),
       u(s.poses_rejected), u(s.force_clamps), u(s.stiffness_clamps), u(s.slew_limits),
-      u(s.fade_ticks), u(s.snaps_felt), s.max_force_n, u(s.nonfinite_outputs), u(s.overruns),
+      u(s.fade_ticks), u(s.snaps_felt), s.max_force_n, s.final_force_n, u(s.nonfinite_outputs), u(s.overruns),
       u(s.read_failures), u(s.pose_ring_drops), u(s.trace_ring_drops),
       u(s.invalid_poses_unpublished), s.realtime ? "true" : "false");
   std::fclose(f);
@@ -263,6 +263,11 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   while (!g_stop_requested.load()) {
     if (o.duration_s > 0.0 && Seconds(transport::MonotonicMicros() - start_us) >= o.duration_s) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  // Fade to zero within the safety ramp before the servo loop stops (issue 12 item 5).
+  if (!client->FadeOut(cc.limits.fade_time_s + 0.3)) {
+    spdlog::warn("device: the force did not fade to zero within {} ms; stopping anyway",
+                 1e3 * cc.limits.fade_time_s + 300.0);
   }
   client->Stop();
   device->Close();

@@ -128,6 +128,11 @@ void ForceSafety::Step(const double position_m[3], bool pose_ok, const LocalMode
     out->fading = stale;
     if (stale) Bump(counters_.fade_ticks);
   }
+  // Stopping: fade out as for a stale model (the trace shows it as fading).
+  if (fade_out_.load(std::memory_order_relaxed)) {
+    stale = true;
+    out->fading = true;
+  }
   const double dgain = dt_s / limits_.fade_time_s;
   gain_ = std::clamp(stale ? gain_ - dgain : gain_ + dgain, 0.0, 1.0);
   out->gain = gain_;

@@ -100,6 +100,10 @@ class ForceSafety {
   void Step(const double position_m[3], bool pose_ok, const LocalModel* model, int64_t now_us,
             SafetyOutput* out);
 
+  // From any thread: fade the force out as for a stale model, for good (a stop on
+  // SIGINT/SIGTERM ends within the safety ramp instead of stepping to zero).
+  void RequestFadeOut() { fade_out_.store(true, std::memory_order_relaxed); }
+
   const SafetyLimits& limits() const { return limits_; }
   const SafetyCounters& counters() const { return counters_; }
   // Largest |F| commanded so far, newtons (written by the servo thread).
@@ -112,6 +116,7 @@ class ForceSafety {
   std::atomic<double> max_force_n_{0.0};
   double last_force_n_[3] = {0.0, 0.0, 0.0};
   double gain_ = 0.0;  // starts at zero: the first model fades in
+  std::atomic<bool> fade_out_{false};
   int64_t last_now_us_ = -1;
 };
 

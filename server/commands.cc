@@ -1,5 +1,10 @@
 // The COMMAND channel: RESET, LOAD_SCENE and SET_METHOD, applied on the solve thread
 // between two updates. A refused command leaves the session as it was.
+//
+// Commands come from the network (issue 12 item 3): LOAD_SCENE takes a scene *name* from
+// --scene-dir (scene_dir.h) and loads it on a loader thread with a time limit, so the
+// solve thread keeps serving the current scene; SET_METHOD is limited to --allow-methods.
+#include <chrono>
 #include <exception>
 #include <memory>
 #include <string>
@@ -7,6 +12,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "scene_dir.h"
 #include "server.h"
 #include "server_session.h"
 #include "snapthread/force_model_t.hpp"
@@ -17,6 +23,7 @@ namespace snapthread::server {
 void Server::ApplyCommand(const command_t& command) {
   std::string message;
   bool ok = true;
+  bool rejected = false;
   switch (command.command) {
     case command_t::RESET: {
       try {
@@ -29,21 +36,43 @@ void Server::ApplyCommand(const command_t& command) {
       break;
     }
     case command_t::LOAD_SCENE: {
+      // A name that is not one (a path, "..") is refused here at once; the file itself is
+      // opened and checked on the loader thread.
       try {
-        std::unique_ptr<Session> next = MakeSession(LoadScene(command.argument));
-        session_ = std::move(next);
-        message = "LOAD_SCENE: now scene '" + session_->scene.name + "' (" + command.argument + ")";
-      } catch (const std::exception& e) {
+        SceneFileName(command.argument);
+      } catch (const SceneNameError& e) {
         ok = false;
-        message = "LOAD_SCENE refused, keeping scene '" + session_->scene.name + "': " + e.what();
+        rejected = true;
+        message = std::string(e.what()) + "; keeping scene '" + session_->scene.name + "'";
+        break;
       }
-      break;
+      if (load_.busy()) {
+        ok = false;
+        message = "LOAD_SCENE '" + command.argument + "' refused: LOAD_SCENE '" + load_name_ +
+                  "' is still in progress";
+        break;
+      }
+      StartSceneLoad(command.argument);
+      return;  // reported when the load ends (PollSceneLoad)
     }
     case command_t::SET_METHOD: {
       if (SolverRegistry::Global().Find(command.argument) == nullptr) {
         ok = false;
         message = "SET_METHOD refused: unknown method '" + command.argument + "' (expected " +
                   SolverRegistry::Global().NamesText(", ", " or ") + ")";
+        break;
+      }
+      if (!params_.IsMethodAllowed(command.argument)) {
+        ok = false;
+        rejected = true;
+        message = "SET_METHOD refused: method '" + command.argument +
+                  "' is not in --allow-methods; keeping " + session_->tracker->options().method;
+        break;
+      }
+      // The loader builds the next session with method_override_: keep it fixed meanwhile.
+      if (load_.busy()) {
+        ok = false;
+        message = "SET_METHOD refused: LOAD_SCENE '" + load_name_ + "' is in progress, retry";
         break;
       }
       try {
@@ -63,12 +92,69 @@ void Server::ApplyCommand(const command_t& command) {
       ok = false;
       message = "unknown command " + std::to_string(command.command);
   }
+  FinishCommand(command.command, ok, message, rejected);
+}
+
+void Server::StartSceneLoad(const std::string& name) {
+  load_name_ = name;
+  const std::string dir = params_.scene_dir;
+  const auto limit = std::chrono::duration_cast<BackgroundJob<Session>::Clock::duration>(
+      std::chrono::duration<double>(params_.load_timeout_s));
+  spdlog::info("server: LOAD_SCENE '{}': loading from {}", name, dir);
+  // The loader reads params_, hooks_ and method_override_ (fixed while it runs) and
+  // builds a new session; it never touches session_.
+  load_.Start(
+      [this, dir, name]() -> std::unique_ptr<Session> {
+        if (hooks_.before_load) hooks_.before_load();
+        std::string path;
+        const std::string text = ReadSceneByName(dir, name, &path);
+        return MakeSession(ParseScene(text, path));
+      },
+      limit);
+}
+
+bool Server::PollSceneLoad() {
+  std::unique_ptr<Session> next;
+  BackgroundJob<Session>::Failure failure;
+  const std::string keeping = "keeping scene '" + session_->scene.name + "'";
+  switch (load_.Poll(&next, &failure)) {
+    case BackgroundJob<Session>::State::kIdle:
+    case BackgroundJob<Session>::State::kRunning:
+      return false;
+    case BackgroundJob<Session>::State::kDone:
+      session_ = std::move(next);
+      FinishCommand(command_t::LOAD_SCENE, true,
+                    "LOAD_SCENE: now scene '" + session_->scene.name + "' (" + load_name_ + ")");
+      return true;
+    case BackgroundJob<Session>::State::kFailed: {
+      bool policy = false;
+      try {
+        if (failure.error) std::rethrow_exception(failure.error);
+      } catch (const SceneNameError&) {
+        policy = true;
+      } catch (...) {
+      }
+      FinishCommand(command_t::LOAD_SCENE, false,
+                    "LOAD_SCENE refused, " + keeping + ": " + failure.message, policy);
+      return true;
+    }
+    case BackgroundJob<Session>::State::kTimedOut:
+      FinishCommand(command_t::LOAD_SCENE, false,
+                    "LOAD_SCENE '" + load_name_ + "' abandoned after " +
+                        std::to_string(params_.load_timeout_s) + " s (--load-timeout), " + keeping,
+                    true);
+      return true;
+  }
+  return false;
+}
+
+void Server::FinishCommand(int8_t command, bool ok, const std::string& message, bool rejected) {
   // The message first, then the counters: a caller that waits on a counter reads the
   // message of that command.
   SetInfo(session_->scene.name, session_->tracker->options().method, &message);
   if (ok) {
     // A new start: the shape's snap count is "since the session (re)started".
-    if (command.command != command_t::SET_METHOD) {
+    if (command != command_t::SET_METHOD) {
       snaps_since_reset_ = 0;
       last_status_ = force_model_t::STATUS_REGULAR;
       for (double& f : last_force_n_) f = 0.0;
@@ -77,6 +163,7 @@ void Server::ApplyCommand(const command_t& command) {
     commands_applied_.fetch_add(1);
   } else {
     spdlog::warn("server: {}", message);
+    if (rejected) rejected_messages_.fetch_add(1);
     commands_refused_.fetch_add(1);
   }
 }

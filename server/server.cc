@@ -13,6 +13,7 @@
 #include "auth/message_gate.h"
 #include "auth/message_mac.h"
 #include "messages/pose_mapping.h"
+#include "scene_dir.h"
 #include "server_messages.h"
 #include "server_session.h"
 #include "tracking/make_tracker.h"
@@ -76,6 +77,7 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
   command_filter_.SetEpoch(epoch_);  // commands must carry this start's epoch
   channels_ = transport::Channels(params_.session);
   method_override_ = params_.method;
+  if (params_.scene_dir.empty()) params_.scene_dir = DefaultSceneDir();
 
   // The scene first: a bad scene is the user's most likely mistake, report it before
   // touching the network.
@@ -157,6 +159,7 @@ void Server::Stop() {
   inbox_.RequestStop();
   if (receive_thread_.joinable()) receive_thread_.join();
   if (solve_thread_.joinable()) solve_thread_.join();
+  load_.Join();  // a scene load still running (bounded by its file size and the parser)
   if (state_sub_ != nullptr) lcm_->unsubscribe(state_sub_);
   if (command_sub_ != nullptr) lcm_->unsubscribe(command_sub_);
   state_sub_ = command_sub_ = nullptr;
@@ -279,6 +282,7 @@ void Server::SolveLoop() {
       ApplyCommand(command);
       changed_session = true;
     }
+    if (PollSceneLoad()) changed_session = true;
     if (taken.pose) SolveAndPublish(*taken.pose);
     now = SteadyClock::now();
     if (now >= next_shape || changed_session) {

@@ -32,6 +32,7 @@
 #include "auth/session_epoch.h"
 #include "auth/session_key.h"
 
+#include "background_job.h"
 #include "server_inbox.h"
 #include "server_params.h"
 #include "scene/scene.h"
@@ -73,6 +74,8 @@ struct ServerStats {
 struct ServerTestHooks {
   // Just before each tracker update (a test blocks here to pile up poses).
   std::function<void()> before_update;
+  // On the loader thread, before a LOAD_SCENE reads its file (a test makes loads slow).
+  std::function<void()> before_load;
   // Just after each tracker update, with the controls and the tracker (its state and
   // last result): a test compares the server's path with a sweep of the same scene.
   std::function<void(const Vec& u, const EquilibriumTracker& tracker)> after_update;
@@ -137,6 +140,14 @@ class Server {
   // Solve thread.
   void SolveAndPublish(const PoseSample& pose);
   void ApplyCommand(const command_t& command);
+  // LOAD_SCENE off the solve thread (commands.cc): starts the loader; the solve loop polls
+  // it and swaps the session in when it is ready (true when the session changed or a
+  // load ended).
+  void StartSceneLoad(const std::string& name);
+  bool PollSceneLoad();
+  // Logs and counts the outcome of a command; `rejected` also counts a policy refusal in
+  // rejected_messages.
+  void FinishCommand(int8_t command, bool ok, const std::string& message, bool rejected = false);
   void PublishShape();
   void PublishStatus();
   std::unique_ptr<Session> MakeSession(const Scene& scene) const;
@@ -174,6 +185,8 @@ class Server {
   // Solve-thread state.
   std::unique_ptr<Session> session_;
   std::string method_override_;  // "" = the scene's method
+  BackgroundJob<Session> load_;   // the LOAD_SCENE in progress, if any
+  std::string load_name_;         // its argument
   int64_t model_seq_ = 0, shape_seq_ = 0, status_seq_ = 0;
   int64_t snaps_since_reset_ = 0;
   int8_t last_status_ = 0;

@@ -5,6 +5,7 @@
 // start (or the --summary file cannot be written), 2 for bad arguments (including a
 // scene that does not load).
 #include <pthread.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <csignal>
@@ -18,6 +19,7 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "scene_dir.h"
 #include "server.h"
 #include "solvers/registry.h"
 #include "server_params.h"
@@ -75,6 +77,17 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--method", params.method,
                  "Override the scene's solver: " + snapthread::SolverRegistry::Global().NamesText(" | ", " | "));
+  app.add_option("--scene-dir", params.scene_dir,
+                 "Directory LOAD_SCENE commands load scenes from, by name only (default: " +
+                     snapthread::server::DefaultSceneDir() + ")");
+  app.add_option("--load-timeout", params.load_timeout_s,
+                 "Seconds a LOAD_SCENE may take before it is abandoned (the current scene "
+                 "is served meanwhile)")
+      ->capture_default_str();
+  app.add_option("--allow-methods", params.allow_methods,
+                 "Comma-separated methods SET_METHOD may switch to (default: all: " +
+                     snapthread::SolverRegistry::Global().NamesText(",", ",") + ")")
+      ->delimiter(',');
   app.add_option("--duration", params.duration_s, "Run time in seconds; 0 = until SIGINT/SIGTERM")
       ->capture_default_str();
   app.add_option("--log-level", params.log_level,
@@ -101,6 +114,14 @@ int main(int argc, char** argv) {
 
   std::string error;
   if (!params.IsValid(&error)) return Usage(error);
+  {
+    const std::string dir =
+        params.scene_dir.empty() ? snapthread::server::DefaultSceneDir() : params.scene_dir;
+    struct stat info {};
+    if (::stat(dir.c_str(), &info) != 0 || !S_ISDIR(info.st_mode)) {
+      return Usage("--scene-dir: " + dir + " is not a directory");
+    }
+  }
   spdlog::set_level(spdlog::level::from_str(params.log_level));
   spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
 

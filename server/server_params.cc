@@ -1,5 +1,6 @@
 #include "server_params.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "solvers/registry.h"
@@ -49,6 +50,19 @@ bool ServerParams::IsValid(std::string* error) const {
                              SolverRegistry::Global().NamesText(", ", " or ") + ")");
     }
   }
+  for (const std::string& name : allow_methods) {
+    if (SolverRegistry::Global().Find(name) == nullptr) {
+      return Fail(error, "--allow-methods: unknown method '" + name + "' (expected " +
+                             SolverRegistry::Global().NamesText(", ", " or ") + ")");
+    }
+  }
+  if (!method.empty() && !IsMethodAllowed(method)) {
+    return Fail(error, "--method: '" + method + "' is not in --allow-methods");
+  }
+  if (!std::isfinite(load_timeout_s) || load_timeout_s <= 0.0 || load_timeout_s > 3600.0) {
+    return Fail(error, "--load-timeout: must be in (0, 3600] seconds, got " +
+                           std::to_string(load_timeout_s));
+  }
   if (!IsKnownLogLevel(log_level)) {
     return Fail(error, "--log-level: unknown level '" + log_level +
                            "' (expected trace, debug, info, warn, error, critical or off)");
@@ -57,6 +71,11 @@ bool ServerParams::IsValid(std::string* error) const {
     return Fail(error, "--duration: must be >= 0 seconds, got " + std::to_string(duration_s));
   }
   return true;
+}
+
+bool ServerParams::IsMethodAllowed(const std::string& name) const {
+  return allow_methods.empty() ||
+         std::find(allow_methods.begin(), allow_methods.end(), name) != allow_methods.end();
 }
 
 }  // namespace snapthread::server

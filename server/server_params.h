@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "messages/channels.h"
 
@@ -21,8 +22,18 @@ struct ServerParams {
   // and publishes <session>_FORCE_MODEL, _SHAPE and _SOLVER_STATUS. [A-Za-z0-9_]+,
   // at most kMaxSessionLength characters.
   std::string session = "SNAPTHREAD";
-  // Scene YAML file (required).
+  // Scene YAML file (required). The operator's command line may name any path; the
+  // COMMAND channel may not (scene_dir).
   std::string scene_path;
+  // Where LOAD_SCENE finds scenes, by name only (scene_dir.h). Empty: the project's
+  // scenes/ directory (DefaultSceneDir()).
+  std::string scene_dir;
+  // A LOAD_SCENE that takes longer than this (read, parse, build the tracker) is
+  // abandoned and reported; the current scene is served meanwhile. Seconds, > 0.
+  double load_timeout_s = 5.0;
+  // Methods SET_METHOD may switch to; empty = every registered method. Each name must
+  // be registered (checked by IsValid); --method must be one of them.
+  std::vector<std::string> allow_methods;
   // thread_shape_t rate for viewers, Hz (> 0). 60 Hz matches a display refresh.
   double shape_rate_hz = 60.0;
   // solver_status_t rate, Hz (> 0).
@@ -43,6 +54,8 @@ struct ServerParams {
   // False with a message naming the offending field (as a command-line flag) when
   // invalid. Does not touch the file system (the scene is checked when loaded).
   bool IsValid(std::string* error) const;
+  // SET_METHOD may switch to `method` (allow_methods empty or naming it).
+  bool IsMethodAllowed(const std::string& method) const;
 };
 
 }  // namespace snapthread::server

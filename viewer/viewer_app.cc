@@ -18,6 +18,7 @@
 #include "png_writer.h"
 #include "renderer.h"
 #include "session_receiver.h"
+#include "stop_signals.h"
 #include "scene/scene.h"
 #include "models/registry.h"
 #include "messages/lcm_url.h"
@@ -183,7 +184,7 @@ int RunPrintRates(const ViewerOptions& options) {
   std::printf("channel rates of session %s on %s (once per second)\n", options.session.c_str(),
               options.lcm_url.c_str());
   std::fflush(stdout);
-  while (options.duration_s <= 0 || Seconds(start) < options.duration_s) {
+  while ((options.duration_s <= 0 || Seconds(start) < options.duration_s) && !StopRequested()) {
     lcm.handleTimeout(50);
     const double since = Seconds(last_report);
     if (since >= 1.0) {
@@ -277,7 +278,7 @@ int RunViewer(const ViewerOptions& options) {
     const auto start = Clock::now();
     const bool screenshot = !options.screenshot_path.empty();
     const double frame_period_s = 1.0 / options.max_fps;
-    while (!glfwWindowShouldClose(window)) {
+    while (!glfwWindowShouldClose(window) && !StopRequested()) {
       const auto frame_start = Clock::now();
       glfwPollEvents();
       int w = 0, h = 0;

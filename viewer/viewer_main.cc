@@ -6,6 +6,7 @@
 
 #include "messages/channels.h"
 #include "messages/lcm_url.h"
+#include "stop_signals.h"
 #include "viewer_app.h"
 
 int main(int argc, char** argv) {
@@ -56,6 +57,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "snapthread-viewer: --grasp-mode needs --scene FILE\n");
     return snapthread::viewer::kExitSetupFailed;
   }
+  snapthread::viewer::InstallStopSignals();
   if (o.print_rates) return snapthread::viewer::RunPrintRates(o);
   return snapthread::viewer::RunViewer(o);
 }

@@ -310,6 +310,36 @@ TEST(DeviceForceSafetyTest, StaleModelFadesToZeroAndFreshModelRecovers) {
   EXPECT_GE(recovered_after, 0.9e3 * limits.fade_time_s);  // faded in, not stepped
 }
 
+// A stop (SIGINT/SIGTERM in snapthread-device) fades a fresh model's force to zero
+// within the fade time, monotonically and within the slew limit, and it stays there.
+TEST(DeviceForceSafetyTest, FadeOutOnStopReachesZeroWithinTheRamp) {
+  const SafetyLimits limits = TestLimits();
+  ForceSafety s(limits, false);
+  const double pos[3] = {0, 0, 0};
+  int64_t now = 0;
+  SafetyOutput out;
+  LocalModel m = Prepared(Model(2.5, 0.0), now);
+  Settle(&s, m, pos, &now, &out, 300);
+  ASSERT_NEAR(out.force_n[0], 2.5, 1e-12);
+  s.RequestFadeOut();
+  double prev = out.force_n[0];
+  int zero_after = -1;
+  for (int i = 0; i < 300; ++i) {
+    m.receive_us = now;  // the model stays fresh: the stop alone fades the force
+    s.Step(pos, true, &m, now, &out);
+    now += kTickUs;
+    EXPECT_TRUE(out.fading);
+    EXPECT_LE(out.force_n[0], prev + 1e-12) << i;
+    EXPECT_LE(prev - out.force_n[0], limits.max_force_rate_n_per_s * limits.tick_period_s + 1e-9) << i;
+    prev = out.force_n[0];
+    if (zero_after < 0 && out.force_n[0] == 0.0) zero_after = i + 1;
+  }
+  ASSERT_GT(zero_after, 0);
+  EXPECT_LE(zero_after, 1e3 * limits.fade_time_s + 2);
+  EXPECT_GE(zero_after, 0.9e3 * limits.fade_time_s);  // faded, not stepped
+  EXPECT_EQ(out.force_n[0], 0.0);
+}
+
 TEST(DeviceForceSafetyTest, BadPosesGetZeroForceAtOnce) {
   ForceSafety s(TestLimits(), false);
   const double good[3] = {0.01, 0, 0};

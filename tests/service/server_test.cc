@@ -30,6 +30,7 @@
 #include "auth/session_epoch.h"
 #include "environment.h"
 #include "session_key_file.h"
+#include "temp_dir.h"
 
 namespace snapthread::server {
 namespace {
@@ -161,10 +162,12 @@ class ServerTest : public ::testing::Test {
     ASSERT_TRUE(lcm_.good());
   }
 
-  void StartServer(const std::string& scene_file, ServerTestHooks hooks = {}) {
+  void StartServer(const std::string& scene_file, ServerTestHooks hooks = {},
+                   const std::string& scene_dir = "") {
     ServerParams params;
     params.session = "MEMQ";
     params.scene_path = ScenePath(scene_file);
+    params.scene_dir = scene_dir;
     params.log_level = "warn";
     params.key_path = key_file_.path();
     server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
@@ -401,7 +404,14 @@ TEST_F(ServerTest, LatestWinsWithoutHelp) {
 }
 
 TEST_F(ServerTest, CommandsResetSetMethodLoadScene) {
-  StartServer("curve2d_snap.yaml");
+  // LOAD_SCENE takes names from --scene-dir: one with a good and a broken scene.
+  const test_support::ScopedTempDir scene_dir("server_scenes");
+  {
+    std::ofstream(scene_dir.path() + "/zeeman.yaml") << test_support::ReadFile(ScenePath("zeeman.yaml"));
+    std::ofstream(scene_dir.path() + "/broken.yaml")
+        << "name: broken\nmodel: curve2d\nparams:\n  n: -4\n  frobnicate: 1\n";
+  }
+  StartServer("curve2d_snap.yaml", {}, scene_dir.path());
   const Scene curve = LoadScene(ScenePath("curve2d_snap.yaml"));
   auto model = MakeModel(curve.params);
   const auto poses = PathPoses(curve, 40, 0.0);
@@ -444,15 +454,11 @@ TEST_F(ServerTest, CommandsResetSetMethodLoadScene) {
 
   // LOAD_SCENE, bad: a missing file and a file with an unknown key are refused with the
   // loader's message; the old scene stays and still answers.
-  Command(command_t::LOAD_SCENE, ScenePath("no_such_scene.yaml"));
+  Command(command_t::LOAD_SCENE, "no_such_scene");
   ASSERT_TRUE(WaitFor([&] { return server_->Stats().commands_refused == 2; }));
   EXPECT_NE(server_->Stats().last_command_message.find("no_such_scene.yaml"), std::string::npos);
-  const std::string bad_path = ::testing::TempDir() + "/server_test_bad_scene.yaml";
-  {
-    std::ofstream bad(bad_path);
-    bad << "name: broken\nmodel: curve2d\nparams:\n  n: -4\n  frobnicate: 1\n";
-  }
-  Command(command_t::LOAD_SCENE, bad_path);
+  const std::string bad_path = scene_dir.path() + "/broken.yaml";
+  Command(command_t::LOAD_SCENE, "broken");
   ASSERT_TRUE(WaitFor([&] { return server_->Stats().commands_refused == 3; }));
   std::string refused;
   try {
@@ -472,7 +478,7 @@ TEST_F(ServerTest, CommandsResetSetMethodLoadScene) {
   // LOAD_SCENE, good: the zeeman machine, answered like a direct tracker of that scene.
   const Scene zeeman = LoadScene(ScenePath("zeeman.yaml"));
   since = probe_->num_shapes();
-  Command(command_t::LOAD_SCENE, ScenePath("zeeman.yaml"));
+  Command(command_t::LOAD_SCENE, "zeeman");
   ASSERT_TRUE(probe_->WaitShape(since, [](const thread_shape_t& s) { return s.model == "zeeman"; }));
   EXPECT_EQ(server_->Stats().scene, zeeman.name);
   // The method override from SET_METHOD survives the new scene.

@@ -1,0 +1,317 @@
+// Commands from the network (issue 12 item 3), the server in one process over memq://:
+// LOAD_SCENE by name only from --scene-dir (every way out of the directory refused and
+// counted), loads off the solve thread with a time limit while force models keep flowing,
+// and --allow-methods.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include "environment.h"
+#include "messages/pose_mapping.h"
+#include "scene/scene.h"
+#include "scene_dir.h"
+#include "server.h"
+#include "temp_dir.h"
+
+namespace snapthread::server {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using test_support::ScenePath;
+
+constexpr double kWaitS = 20.0;  // generous: the machine is shared
+
+command_t MakeCommand(int8_t command, const std::string& argument) {
+  command_t c;
+  c.utime = 0;
+  c.command = command;
+  c.argument = argument;
+  return c;
+}
+
+// A server on memq:// answering a pose stream at ~200 Hz; records when each force model
+// arrives so a test can bound the longest gap.
+class CommandsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(lcm_.good());
+    scene_dir_ = std::make_unique<test_support::ScopedTempDir>("scene_dir");
+    CopyScene("zeeman.yaml");
+  }
+
+  void TearDown() override {
+    StopPoses();
+    if (server_) server_->Stop();
+    if (sub_ != nullptr) lcm_.unsubscribe(sub_);
+    server_.reset();
+  }
+
+  const std::string& dir() const { return scene_dir_->path(); }
+  void CopyScene(const std::string& file) {
+    std::ofstream(dir() + "/" + file) << test_support::ReadFile(ScenePath(file));
+  }
+
+  void StartServer(ServerParams params = {}, ServerTestHooks hooks = {}) {
+    params.session = "MEMQ";
+    params.scene_path = ScenePath("curve2d_snap.yaml");
+    params.scene_dir = dir();
+    params.log_level = "off";
+    server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
+    sub_ = lcm_.subscribe(server_->channels().force_model, &CommandsTest::OnModel, this);
+    server_->Start();
+    const Scene scene = LoadScene(params.scene_path);
+    pose_ = messages::ControlsToPosition(scene.device, scene.grasp_layout, scene.grasp_start);
+    poser_ = std::thread([this] {
+      int64_t seq = 0;
+      while (!stop_poses_.load()) {
+        device_state_t s;
+        s.utime = 1000 + seq;
+        s.seq = seq++;
+        s.device_id = "test";
+        for (int i = 0; i < 3; ++i) s.position[i] = pose_[i];
+        for (int i = 0; i < 4; ++i) s.orientation[i] = i == 0 ? 1.0 : 0.0;
+        s.buttons = 1;
+        lcm_.publish(server_->channels().device_state, &s);
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    });
+    ASSERT_TRUE(test_support::WaitUntil([&] { return Models() > 20; }, kWaitS, 0.002));
+  }
+
+  void StopPoses() {
+    stop_poses_ = true;
+    if (poser_.joinable()) poser_.join();
+  }
+
+  void OnModel(const lcm::ReceiveBuffer*, const std::string&) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    arrivals_.push_back(Clock::now());
+  }
+  size_t Models() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return arrivals_.size();
+  }
+  // The longest gap between two force models from arrival index `from` on, seconds.
+  double MaxGapSince(size_t from) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    double gap = 0.0;
+    for (size_t i = std::max<size_t>(from, 1); i < arrivals_.size(); ++i) {
+      gap = std::max(gap, std::chrono::duration<double>(arrivals_[i] - arrivals_[i - 1]).count());
+    }
+    return gap;
+  }
+
+  void Command(int8_t command, const std::string& argument) {
+    const command_t c = MakeCommand(command, argument);
+    ASSERT_EQ(lcm_.publish(server_->channels().command, &c), 0);
+  }
+  bool WaitRefused(int64_t n) {
+    return test_support::WaitUntil([&] { return server_->Stats().commands_refused >= n; }, kWaitS,
+                                   0.002);
+  }
+  bool WaitApplied(int64_t n) {
+    return test_support::WaitUntil([&] { return server_->Stats().commands_applied >= n; }, kWaitS,
+                                   0.002);
+  }
+
+  lcm::LCM lcm_{"memq://"};
+  std::unique_ptr<test_support::ScopedTempDir> scene_dir_;
+  std::unique_ptr<Server> server_;
+  lcm::Subscription* sub_ = nullptr;
+  Eigen::Vector3d pose_ = Eigen::Vector3d::Zero();
+  std::thread poser_;
+  std::atomic<bool> stop_poses_{false};
+  std::mutex mutex_;
+  std::vector<Clock::time_point> arrivals_;
+};
+
+TEST_F(CommandsTest, EveryWayOutOfTheSceneDirIsRefusedAndCounted) {
+  // The directory's traps: symlinks out (a file, a device), a FIFO, a 2 MiB file, a
+  // directory, and a symlink that stays inside (also refused: regular files only).
+  ASSERT_EQ(::symlink("/etc/passwd", (dir() + "/passwd.yaml").c_str()), 0);
+  ASSERT_EQ(::symlink("/dev/zero", (dir() + "/zero.yaml").c_str()), 0);
+  ASSERT_EQ(::symlink((dir() + "/zeeman.yaml").c_str(), (dir() + "/inside.yaml").c_str()), 0);
+  ASSERT_EQ(::mkfifo((dir() + "/fifo.yaml").c_str(), 0600), 0);
+  {
+    std::ofstream big(dir() + "/big.yaml");
+    big << "name: big\n#" << std::string(2 << 20, 'x') << "\n";
+  }
+  ASSERT_EQ(::mkdir((dir() + "/folder.yaml").c_str(), 0700), 0);
+  StartServer();
+  const std::string scene = server_->Stats().scene;
+
+  struct Case {
+    std::string argument;
+    std::string expect;  // in the refusal message
+  };
+  const std::vector<Case> cases = {
+      {"/etc/passwd", "path separator"},
+      {"/dev/zero", "path separator"},
+      {"../scenes/x", "path separator"},
+      {"..", "'..'"},
+      {"", "empty scene name"},
+      {".hidden", "start with '.'"},
+      {"a b", "characters other than"},
+      {"passwd", "resolves outside"},
+      {"zero.yaml", "resolves outside"},
+      {"inside", "symbolic link"},
+      {"fifo", "a FIFO, not a regular file"},
+      {"big", "over the 1 MiB limit"},
+      {"folder", "a directory, not a regular file"},
+      {"no_such_scene", "no scene no_such_scene.yaml"},
+  };
+  const size_t models_before = Models();
+  int64_t refused = 0;
+  for (const Case& c : cases) {
+    Command(command_t::LOAD_SCENE, c.argument);
+    ASSERT_TRUE(WaitRefused(++refused)) << c.argument;
+    const ServerStats s = server_->Stats();
+    EXPECT_NE(s.last_command_message.find(c.expect), std::string::npos)
+        << c.argument << ": " << s.last_command_message;
+    EXPECT_NE(s.last_command_message.find("keeping scene '" + scene + "'"), std::string::npos)
+        << s.last_command_message;
+    EXPECT_EQ(s.rejected_messages, refused) << c.argument;
+    EXPECT_EQ(s.scene, scene);
+  }
+  EXPECT_EQ(server_->Stats().commands_applied, 0);
+  // The server kept answering through all of it and after.
+  EXPECT_TRUE(test_support::WaitUntil([&] { return Models() > models_before + 20; }, kWaitS, 0.002));
+  EXPECT_LT(MaxGapSince(models_before), 0.5);
+
+  // A good name loads, with or without .yaml.
+  Command(command_t::LOAD_SCENE, "zeeman");
+  ASSERT_TRUE(WaitApplied(1));
+  EXPECT_EQ(server_->Stats().scene, LoadScene(ScenePath("zeeman.yaml")).name);
+  CopyScene("curve2d_snap.yaml");
+  Command(command_t::LOAD_SCENE, "curve2d_snap.yaml");
+  ASSERT_TRUE(WaitApplied(2));
+  EXPECT_EQ(server_->Stats().scene, scene);
+  EXPECT_EQ(server_->Stats().rejected_messages, refused);
+}
+
+TEST_F(CommandsTest, ForceModelsKeepFlowingDuringASlowLoad) {
+  std::atomic<bool> in_load{false};
+  ServerTestHooks hooks;
+  hooks.before_load = [&] {
+    in_load = true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  };
+  StartServer({}, std::move(hooks));
+  const std::string method = server_->Stats().method;
+  const size_t from = Models();
+  Command(command_t::LOAD_SCENE, "zeeman");
+  ASSERT_TRUE(test_support::WaitUntil([&] { return in_load.load(); }, kWaitS, 0.002));
+  // While it loads: another load and a method switch are refused, the scene stays.
+  Command(command_t::LOAD_SCENE, "zeeman");
+  ASSERT_TRUE(WaitRefused(1));
+  EXPECT_NE(server_->Stats().last_command_message.find("still in progress"), std::string::npos);
+  Command(command_t::SET_METHOD, "newton");
+  ASSERT_TRUE(WaitRefused(2));
+  EXPECT_NE(server_->Stats().last_command_message.find("in progress"), std::string::npos);
+  EXPECT_EQ(server_->Stats().method, method);
+  EXPECT_EQ(server_->Stats().commands_applied, 0);
+  const size_t during = Models();
+  ASSERT_TRUE(WaitApplied(1));
+  EXPECT_EQ(server_->Stats().scene, LoadScene(ScenePath("zeeman.yaml")).name);
+  // Models flowed through the 1.5 s load: ~200 Hz poses, no gap of 0.5 s.
+  EXPECT_GT(Models(), during + 50);
+  EXPECT_LT(MaxGapSince(from), 0.5);
+  EXPECT_EQ(server_->Stats().rejected_messages, 0);
+}
+
+TEST_F(CommandsTest, ALoadPastItsTimeLimitIsAbandonedAndReported) {
+  std::atomic<int> loads{0};
+  ServerTestHooks hooks;
+  hooks.before_load = [&] {
+    if (loads.fetch_add(1) == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  };
+  ServerParams params;
+  params.load_timeout_s = 0.3;
+  StartServer(params, std::move(hooks));
+  const std::string scene = server_->Stats().scene;
+  const size_t from = Models();
+  const auto t0 = Clock::now();
+  Command(command_t::LOAD_SCENE, "zeeman");
+  ASSERT_TRUE(WaitRefused(1));
+  const double reported_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_LT(reported_s, 1.2) << "the time limit is 0.3 s";
+  const ServerStats s = server_->Stats();
+  EXPECT_NE(s.last_command_message.find("abandoned"), std::string::npos) << s.last_command_message;
+  EXPECT_EQ(s.rejected_messages, 1);
+  EXPECT_EQ(s.scene, scene);
+  // The abandoned load ends later; its scene is not swapped in.
+  std::this_thread::sleep_for(std::chrono::milliseconds(1700));
+  EXPECT_EQ(server_->Stats().scene, scene);
+  EXPECT_EQ(server_->Stats().commands_applied, 0);
+  EXPECT_LT(MaxGapSince(from), 0.5);
+  // Then a load within the limit succeeds.
+  Command(command_t::LOAD_SCENE, "zeeman");
+  ASSERT_TRUE(WaitApplied(1));
+  EXPECT_EQ(server_->Stats().scene, LoadScene(ScenePath("zeeman.yaml")).name);
+}
+
+TEST_F(CommandsTest, AllowMethodsRefusesAMethodSwitch) {
+  ServerParams params;
+  params.allow_methods = {"newton"};
+  StartServer(params);
+  const std::string method = server_->Stats().method;
+  ASSERT_NE(method, "newton-ls");
+  Command(command_t::SET_METHOD, "newton-ls");
+  ASSERT_TRUE(WaitRefused(1));
+  ServerStats s = server_->Stats();
+  EXPECT_EQ(s.method, method);
+  EXPECT_EQ(s.rejected_messages, 1);
+  EXPECT_NE(s.last_command_message.find("not in --allow-methods"), std::string::npos)
+      << s.last_command_message;
+  Command(command_t::SET_METHOD, "newton");
+  ASSERT_TRUE(WaitApplied(1));
+  EXPECT_EQ(server_->Stats().method, "newton");
+}
+
+TEST(ServerParamsTest, AllowMethodsAndLoadTimeoutAreChecked) {
+  ServerParams params;
+  params.scene_path = "x.yaml";
+  std::string error;
+  params.allow_methods = {"newton", "gradient-descent"};
+  EXPECT_FALSE(params.IsValid(&error));
+  EXPECT_NE(error.find("--allow-methods: unknown method 'gradient-descent'"), std::string::npos) << error;
+  params.allow_methods = {"newton"};
+  params.method = "newton-ls";
+  EXPECT_FALSE(params.IsValid(&error));
+  EXPECT_NE(error.find("--method: 'newton-ls' is not in --allow-methods"), std::string::npos) << error;
+  params.method = "newton";
+  EXPECT_TRUE(params.IsValid(&error)) << error;
+  EXPECT_TRUE(params.IsMethodAllowed("newton"));
+  EXPECT_FALSE(params.IsMethodAllowed("higher-order"));
+  params.load_timeout_s = 0.0;
+  EXPECT_FALSE(params.IsValid(&error));
+  EXPECT_NE(error.find("--load-timeout"), std::string::npos) << error;
+}
+
+TEST(SceneDirTest, NamesBecomeYamlFilesAndPathsAreRefused) {
+  EXPECT_EQ(SceneFileName("curve2d_snap"), "curve2d_snap.yaml");
+  EXPECT_EQ(SceneFileName("curve2d_snap.yaml"), "curve2d_snap.yaml");
+  for (const std::string bad : {"/etc/passwd", "../x", "a/b", "..", "", ".x", "a\\b", "x;y"}) {
+    EXPECT_THROW(SceneFileName(bad), SceneNameError) << bad;
+  }
+  // The default directory is the project's scenes/, and its scenes load by name.
+  std::string path;
+  const std::string text = ReadSceneByName(DefaultSceneDir(), "curve2d_snap", &path);
+  EXPECT_EQ(ParseScene(text, path).name, LoadScene(ScenePath("curve2d_snap.yaml")).name);
+}
+
+}  // namespace
+}  // namespace snapthread::server
