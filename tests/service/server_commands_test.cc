@@ -19,6 +19,9 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/message_mac.h"
+#include "auth/session_epoch.h"
+#include "session_key_file.h"
 #include "environment.h"
 #include "messages/pose_mapping.h"
 #include "scene/scene.h"
@@ -69,6 +72,7 @@ class CommandsTest : public ::testing::Test {
     params.scene_path = ScenePath("curve2d_snap.yaml");
     params.scene_dir = dir();
     params.log_level = "off";
+    params.key_path = key_file_.path();
     server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
     sub_ = lcm_.subscribe(server_->channels().force_model, &CommandsTest::OnModel, this);
     server_->Start();
@@ -84,7 +88,10 @@ class CommandsTest : public ::testing::Test {
         for (int i = 0; i < 3; ++i) s.position[i] = pose_[i];
         for (int i = 0; i < 4; ++i) s.orientation[i] = i == 0 ? 1.0 : 0.0;
         s.buttons = 1;
-        lcm_.publish(server_->channels().device_state, &s);
+        if (auth::Sign(&s, server_->channels().device_state, server_->epoch(), auth_seq_.Next(),
+                       key_file_.key())) {
+          lcm_.publish(server_->channels().device_state, &s);
+        }
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
     });
@@ -115,7 +122,9 @@ class CommandsTest : public ::testing::Test {
   }
 
   void Command(int8_t command, const std::string& argument) {
-    const command_t c = MakeCommand(command, argument);
+    command_t c = MakeCommand(command, argument);
+    ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
+                           key_file_.key()));
     ASSERT_EQ(lcm_.publish(server_->channels().command, &c), 0);
   }
   bool WaitRefused(int64_t n) {
@@ -127,6 +136,8 @@ class CommandsTest : public ::testing::Test {
                                    0.002);
   }
 
+  test_support::SessionKeyFile key_file_;
+  auth::AuthSequence auth_seq_;
   lcm::LCM lcm_{"memq://"};
   std::unique_ptr<test_support::ScopedTempDir> scene_dir_;
   std::unique_ptr<Server> server_;
