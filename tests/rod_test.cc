@@ -25,14 +25,17 @@
 
 // Allocation counting (as in linear_solver_test.cc): malloc is replaced and counts
 // while the calling thread has counting switched on; operator new goes through malloc.
-extern "C" void* __libc_malloc(size_t size);
-extern "C" void* __libc_calloc(size_t count, size_t size);
-extern "C" void* __libc_realloc(void* ptr, size_t size);
-extern "C" void __libc_free(void* ptr);
 namespace {
 std::atomic<long> g_mallocs{0};
 thread_local bool t_counting = false;
 }  // namespace
+// Under AddressSanitizer the sanitizer owns malloc: no interposition there, and the
+// allocation-counting tests run in the Release build only (deploy/test.sh).
+#if !defined(__SANITIZE_ADDRESS__)
+extern "C" void* __libc_malloc(size_t size);
+extern "C" void* __libc_calloc(size_t count, size_t size);
+extern "C" void* __libc_realloc(void* ptr, size_t size);
+extern "C" void __libc_free(void* ptr);
 extern "C" void* malloc(size_t size) {
   if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
   return __libc_malloc(size);
@@ -56,6 +59,7 @@ void operator delete(void* p) noexcept { __libc_free(p); }
 void operator delete[](void* p) noexcept { __libc_free(p); }
 void operator delete(void* p, size_t) noexcept { __libc_free(p); }
 void operator delete[](void* p, size_t) noexcept { __libc_free(p); }
+#endif  // !__SANITIZE_ADDRESS__
 
 namespace snapthread {
 namespace {

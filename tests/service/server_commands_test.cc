@@ -19,9 +19,11 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "command_message.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "session_key_file.h"
+#include "arrival_log.h"
 #include "environment.h"
 #include "messages/pose_mapping.h"
 #include "scene/scene.h"
@@ -37,13 +39,7 @@ using test_support::ScenePath;
 
 constexpr double kWaitS = 20.0;  // generous: the machine is shared
 
-command_t MakeCommand(int8_t command, const std::string& argument) {
-  command_t c;
-  c.utime = 0;
-  c.command = command;
-  c.argument = argument;
-  return c;
-}
+using test_support::MakeCommand;
 
 // A server on memq:// answering a pose stream at ~200 Hz; records when each force model
 // arrives so a test can bound the longest gap.
@@ -103,23 +99,9 @@ class CommandsTest : public ::testing::Test {
     if (poser_.joinable()) poser_.join();
   }
 
-  void OnModel(const lcm::ReceiveBuffer*, const std::string&) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    arrivals_.push_back(Clock::now());
-  }
-  size_t Models() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return arrivals_.size();
-  }
-  // The longest gap between two force models from arrival index `from` on, seconds.
-  double MaxGapSince(size_t from) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    double gap = 0.0;
-    for (size_t i = std::max<size_t>(from, 1); i < arrivals_.size(); ++i) {
-      gap = std::max(gap, std::chrono::duration<double>(arrivals_[i] - arrivals_[i - 1]).count());
-    }
-    return gap;
-  }
+  void OnModel(const lcm::ReceiveBuffer*, const std::string&) { arrivals_.Mark(); }
+  size_t Models() { return arrivals_.count(); }
+  double MaxGapSince(size_t from) { return arrivals_.MaxGapSince(from); }
 
   void Command(int8_t command, const std::string& argument) {
     command_t c = MakeCommand(command, argument);
@@ -146,7 +128,7 @@ class CommandsTest : public ::testing::Test {
   std::thread poser_;
   std::atomic<bool> stop_poses_{false};
   std::mutex mutex_;
-  std::vector<Clock::time_point> arrivals_;
+  test_support::ArrivalLog arrivals_;
 };
 
 TEST_F(CommandsTest, EveryWayOutOfTheSceneDirIsRefusedAndCounted) {

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "command_message.h"
 #include "messages/pose_mapping.h"
 #include "server.h"
 #include "server_messages.h"
@@ -143,13 +144,7 @@ device_state_t MakePose(int64_t seq, const Eigen::Vector3d& p,
   return s;
 }
 
-command_t MakeCommand(int8_t command, const std::string& argument) {
-  command_t c;
-  c.utime = 0;
-  c.command = command;
-  c.argument = argument;
-  return c;
-}
+using test_support::MakeCommand;
 
 bool WaitFor(const std::function<bool()>& pred) {
   return test_support::WaitUntil(pred, std::chrono::duration<double>(kWait).count(), 0.002);

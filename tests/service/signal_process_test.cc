@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "arrival_log.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "messages/channels.h"
@@ -140,22 +141,14 @@ class StatusListener {
     thread_.join();
   }
   void On(const lcm::ReceiveBuffer*, const std::string&, const solver_status_t* msg) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    times_.push_back(Clock::now());
-    last_ = *msg;
-  }
-  size_t count() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return times_.size();
-  }
-  double MaxGapSince(size_t from) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    double gap = 0.0;
-    for (size_t i = std::max<size_t>(from, 1); i < times_.size(); ++i) {
-      gap = std::max(gap, std::chrono::duration<double>(times_[i] - times_[i - 1]).count());
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      last_ = *msg;
     }
-    return gap;
+    times_.Mark();
   }
+  size_t count() { return times_.count(); }
+  double MaxGapSince(size_t from) { return times_.MaxGapSince(from); }
   solver_status_t last() {
     std::lock_guard<std::mutex> lock(mutex_);
     return last_;
@@ -167,7 +160,7 @@ class StatusListener {
   lcm::LCM lcm_;
   transport::Channels channels_;
   std::mutex mutex_;
-  std::vector<Clock::time_point> times_;
+  test_support::ArrivalLog times_;
   solver_status_t last_{};
   std::atomic<bool> stop_{false};
   std::thread thread_;
