@@ -25,8 +25,6 @@ class BandedLdlt final : public SymmetricLinearSolver {
   LinearSolverStatus Analyze(const SparseMatrix& a) override;
   LinearSolverStatus Factorize(const SparseMatrix& a) override;
   LinearSolverStatus Solve(const Vec& b, Vec* x) const override;
-  int NegativePivots() const override { return negative_pivots_; }
-  double MinAbsPivot() const override { return min_abs_pivot_; }
 
   // Half-bandwidth max |i - j| of the analysed pattern (-1 before Analyze()).
   int HalfBandwidth() const { return bandwidth_; }
@@ -37,8 +35,6 @@ class BandedLdlt final : public SymmetricLinearSolver {
   int bandwidth_ = -1;
   Mat band_;  // (b+1) x n, see the file comment
   bool factorized_ = false;
-  int negative_pivots_ = 0;
-  double min_abs_pivot_ = 0.0;
 };
 
 }  // namespace snapthread

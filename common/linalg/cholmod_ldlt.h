@@ -36,8 +36,6 @@ class CholmodLdlt final : public SymmetricLinearSolver {
   LinearSolverStatus Analyze(const SparseMatrix& a) override;
   LinearSolverStatus Factorize(const SparseMatrix& a) override;
   LinearSolverStatus Solve(const Vec& b, Vec* x) const override;
-  int NegativePivots() const override { return negative_pivots_; }
-  double MinAbsPivot() const override { return min_abs_pivot_; }
 
  private:
   void FreeFactor();
@@ -61,8 +59,6 @@ class CholmodLdlt final : public SymmetricLinearSolver {
   mutable cholmod_dense* y_ = nullptr;
   mutable cholmod_dense* e_ = nullptr;
   bool factorized_ = false;
-  int negative_pivots_ = 0;
-  double min_abs_pivot_ = 0.0;
 };
 
 }  // namespace snapthread

@@ -29,8 +29,6 @@ class DenseLdlt final : public SymmetricLinearSolver {
   LinearSolverStatus Analyze(const SparseMatrix& a) override;
   LinearSolverStatus Factorize(const SparseMatrix& a) override;
   LinearSolverStatus Solve(const Vec& b, Vec* x) const override;
-  int NegativePivots() const override { return negative_pivots_; }
-  double MinAbsPivot() const override { return min_abs_pivot_; }
 
  private:
   internal::PatternCopy pattern_;
@@ -40,8 +38,6 @@ class DenseLdlt final : public SymmetricLinearSolver {
   // place because copying it would read its not-yet-initialised info member).
   std::optional<Eigen::LDLT<Mat, Eigen::Lower>> ldlt_;
   bool factorized_ = false;
-  int negative_pivots_ = 0;
-  double min_abs_pivot_ = 0.0;
 };
 
 }  // namespace snapthread

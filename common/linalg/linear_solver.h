@@ -38,15 +38,18 @@ class SymmetricLinearSolver {
 
   // Inertia from the pivots of D in A = L D L^T (Sylvester's law of inertia): the
   // number of negative eigenvalues of A (valid after a successful Factorize()).
-  virtual int NegativePivots() const = 0;
+  // Every backend records both from its pivots in Factorize().
+  int NegativePivots() const { return negative_pivots_; }
   // Smallest |d_ii|: a cheap singularity indicator.
-  virtual double MinAbsPivot() const = 0;
+  double MinAbsPivot() const { return min_abs_pivot_; }
 
   // Text of the last failure ("" after success).
   const std::string& message() const { return message_; }
 
  protected:
   std::string message_;
+  int negative_pivots_ = 0;
+  double min_abs_pivot_ = 0.0;
 };
 
 // Backends: "cholmod" (SuiteSparse simplicial LDL^T, AMD ordering), "dense" (Eigen,
