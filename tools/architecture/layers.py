@@ -94,12 +94,12 @@ def reachable(edges, start):
     succ = {}
     for a, b in edges:
         succ.setdefault(a, set()).add(b)
-    seen, todo = set(), [start]
-    while todo:
-        for n in succ.get(todo.pop(), ()):
+    seen, pending = set(), [start]
+    while pending:
+        for n in succ.get(pending.pop(), ()):
             if n not in seen:
                 seen.add(n)
-                todo.append(n)
+                pending.append(n)
     return seen
 
 
