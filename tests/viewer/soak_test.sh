@@ -38,7 +38,7 @@ if [ "$(id -u)" -ne 0 ]; then prio=""; logger_prio=""; fi
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
 trap cleanup EXIT
-# stop_logger, fail, json, make_key, run_session
+# fail, json, make_key, run_session, end_session
 source "$(dirname "$0")/../support/script_support.sh"
 make_key
 
@@ -53,14 +53,11 @@ for v in 1 2; do
 done
 sleep 0.5
 run_session "$prio" "$prio"
-wait "$server_pid"; server_rc=$?
 wait "$viewer1_pid"; v1_rc=$?
 wait "$viewer2_pid"; v2_rc=$?
-stop_logger "$logger_pid"
 
 # 1
-[ $device_rc -eq 0 ] || fail "device exited $device_rc"
-[ $server_rc -eq 0 ] || fail "server exited $server_rc"
+end_session "$logger_pid"
 [ $v1_rc -eq 0 ] && [ $v2_rc -eq 0 ] || fail "viewer exit codes $v1_rc $v2_rc"
 ticks=$(json "$work/device.json" "['ticks']")
 echo "device: $ticks ticks in ${duration} s, tick_rate_hz $(json "$work/device.json" "['tick_rate_hz']"), lateness p99 $(json "$work/device.json" "['lateness_us_p99']") us"
