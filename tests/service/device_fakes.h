@@ -126,15 +126,18 @@ class SpringServer {
   // Answers every new pose (latest last); returns how many.
   int AnswerAll() {
     int n = 0;
-    for (const auto& s : TakeNewPoses()) {
-      force_model_t m = ModelFor(s);
-      if (key_ != nullptr && !auth::Sign(&m, channels_.force_model, epoch_, auth_seq_.Next(), *key_)) {
-        continue;
-      }
-      t_->Deliver(m);
-      ++n;
-    }
+    for (const auto& s : TakeNewPoses()) n += Send(ModelFor(s)) ? 1 : 0;
     return n;
+  }
+
+  // Sends a model (signed with this server's epoch after SignWith); false when it
+  // cannot be signed.
+  bool Send(force_model_t m) {
+    if (key_ != nullptr && !auth::Sign(&m, channels_.force_model, epoch_, auth_seq_.Next(), *key_)) {
+      return false;
+    }
+    t_->Deliver(m);
+    return true;
   }
 
   double anchor_m[3] = {0.0, 0.0, 0.0};
