@@ -7,7 +7,9 @@
 // branch, the old one again, then the new one (three steps) in most unsigned runs.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -23,6 +25,7 @@
 #include "scene/scene.h"
 #include "server_messages.h"
 #include "sim_path_device.h"
+#include "stability.h"
 #include "tracking/make_tracker.h"
 
 namespace snapthread::device {
@@ -232,6 +235,127 @@ TEST(DeviceModelOrderTest, EachSnapIsOneForceStepUnderLossAndReordering) {
 
 TEST(DeviceModelOrderTest, SignedSnapIsOneForceStepUnderLossAndReordering) {
   ExpectOneStepPerSnapUnderLoss(true, 8);
+}
+
+// ---- the real tracker on curve2d_snap ----------------------------------------------------
+
+// The server's solve path in-process (MakeTracker, PoseToControls, BuildForceModel), with
+// its pose handling: of the poses that arrived, only the newest is solved, and never one
+// older than the last solved (the real server's inbox and per-device auth_seq filter).
+class TrackerServer {
+ public:
+  TrackerServer(InMemoryTransport* wire, const Scene& scene)
+      : wire_(wire), scene_(scene), tracker_(MakeTracker(scene)) {
+    tracker_->Reset(scene.grasp_start);
+  }
+
+  void AnswerNewest() {
+    const device_state_t* newest = nullptr;
+    for (; taken_ < wire_->states.size(); ++taken_) {
+      const device_state_t& s = wire_->states[taken_];
+      if (s.seq > last_seq_ && (newest == nullptr || s.seq > newest->seq)) newest = &s;
+    }
+    if (newest == nullptr) return;
+    last_seq_ = newest->seq;
+    const Eigen::Vector3d p(newest->position[0], newest->position[1], newest->position[2]);
+    const Eigen::Vector4d q(newest->orientation[0], newest->orientation[1],
+                            newest->orientation[2], newest->orientation[3]);
+    server::ForceModelInputs in;
+    in.mapping = &scene_.device;
+    in.model = &tracker_->model();
+    in.u = messages::PoseToControls(scene_.device, scene_.grasp_layout, p, q,
+                                    messages::RestGripDirection(scene_));
+    in.position_m = p;
+    in.result = &tracker_->Update(in.u);
+    in.device_seq = newest->seq;
+    in.device_utime = newest->utime;
+    in.seq = ++seq_;
+    const force_model_t m = server::BuildForceModel(in);
+    if (m.status == force_model_t::STATUS_SNAPPED) ++snaps_;
+    wire_->Deliver(m);
+  }
+  int snaps() const { return snaps_; }
+
+ private:
+  InMemoryTransport* wire_;
+  const Scene& scene_;
+  std::unique_ptr<EquilibriumTracker> tracker_;
+  size_t taken_ = 0;
+  int64_t last_seq_ = -1, seq_ = 0;
+  int snaps_ = 0;
+};
+
+constexpr int kTrackerLegs = 6;  // 1 s each, one snap in each
+
+// The hand moves the grasp of curve2d_snap up and down through both snaps (Y = ±3.41)
+// at 15 cm/s (7.5 model units/s).
+// Returns the force handed to the backend each tick, per component (x, y).
+std::array<std::vector<double>, 2> RunTrackerThroughSnaps(const Scene& scene,
+                                                          const LinkOptions* link) {
+  g_now_us = 1000000;
+  Vec lo(2), hi(2);
+  lo << 9.0, -3.75;
+  hi << 9.0, 3.75;
+  const Eigen::Vector3d a = messages::ControlsToPosition(scene.device, scene.grasp_layout, lo);
+  const Eigen::Vector3d b = messages::ControlsToPosition(scene.device, scene.grasp_layout, hi);
+  SimPathDevice device(ScriptedPath({{a.x(), a.y(), a.z()}, {b.x(), b.y(), b.z()}}, 0.15),
+                       &FakeClock);
+  EXPECT_TRUE(device.Open(nullptr));
+  InMemoryTransport wire;
+  std::unique_ptr<LossyTransport> lossy;
+  if (link != nullptr) lossy = std::make_unique<LossyTransport>(&wire, *link, &FakeClock);
+  TrackerServer server(&wire, scene);
+  DeviceClientConfig config;
+  config.limits = LimitsFrom(device.capabilities(), &scene.device);
+  config.loop.realtime = false;
+  config.log_period_us = 0;
+  config.clock = &FakeClock;
+  DeviceClient client(&device,
+                      lossy ? static_cast<DeviceTransport*>(lossy.get()) : &wire, config);
+  std::array<std::vector<double>, 2> f;
+  for (int i = 0; i < kTrackerLegs * 1000 - 20; ++i) {
+    g_now_us += 1000;
+    client.Tick(g_now_us, 0);
+    for (int c = 0; c < 2; ++c) f[c].push_back(device.last_force_n()[c]);
+    client.Service(g_now_us);
+    server.AnswerNewest();
+    client.Receive(0);
+  }
+  EXPECT_EQ(server.snaps(), kTrackerLegs);
+  return f;
+}
+
+// Reversals of a rendered force (the stability suite's zig-zag filter: a move of more
+// than `tolerance` back from the last extreme), after the fade-in.
+int Reversals(const std::vector<double>& f, double tolerance) {
+  std::vector<SweepRow> rows;
+  for (size_t i = kSettledTick; i < f.size(); ++i) {
+    SweepRow r;
+    r.force = Vec::Constant(1, f[i]);
+    rows.push_back(r);
+  }
+  return CountReversals(rows, 0, tolerance);
+}
+
+TEST(DeviceModelOrderTest, TrackerSnapsAreOneForceStepEachUnderLossAndReordering) {
+  const char* dir = std::getenv("SNAPTHREAD_SOURCE_DIR");
+  const Scene scene =
+      LoadScene(std::string(dir != nullptr ? dir : "..") + "/scenes/curve2d_snap.yaml");
+  // A snap changes F_x by 0.5 N and F_y by 0.2 N; 0.02 N is far above the solver's noise.
+  const double kTolerance = 0.02;
+  const auto ref = RunTrackerThroughSnaps(scene, nullptr);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_GE(Reversals(ref[c], kTolerance), kTrackerLegs) << c;  // at least the snaps
+  }
+  for (uint32_t seed = 1; seed <= 12; ++seed) {
+    LinkOptions link;  // 20 % loss, 5 ± 2 ms
+    link.seed = seed;
+    const auto lossy = RunTrackerThroughSnaps(scene, &link);
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_EQ(Reversals(lossy[c], kTolerance), Reversals(ref[c], kTolerance))
+          << "component " << c << " seed " << seed;
+    }
+  }
 }
 
 }  // namespace
