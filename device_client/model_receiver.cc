@@ -13,7 +13,7 @@
 namespace snapthread::device {
 
 ModelReceiver::ModelReceiver(const SafetyLimits& limits, ModelSlot* slot, ModelAuth auth)
-    : limits_(limits), slot_(slot), auth_(std::move(auth)) {}
+    : limits_(limits), slot_(slot), auth_(std::move(auth)), order_(auth_.key == nullptr) {}
 
 void ModelReceiver::LogAuth(auth::FreshnessFilter* filter, int64_t now_us) {
   std::string line;
@@ -65,7 +65,7 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
     // Never an older model after a newer one. Counted apart (part of models_rejected, as
     // the signed session's stale auth_seq is) and not logged: reordering is what a lossy
     // network does, not an attack.
-    if (order_.Check(msg.epoch, msg.seq, msg.device_seq) != ModelOrder::Verdict::kNewer) {
+    if (!order_.IsNewer(msg.epoch, msg.seq, msg.device_seq)) {
       out_of_order_.fetch_add(1);
       return false;
     }

@@ -68,10 +68,10 @@ class ModelReceiver {
   SafetyLimits limits_;
   ModelSlot* slot_;
   ModelAuth auth_;
+  ModelOrder order_;  // receive thread only
   auth::FreshnessFilter status_filter_{"SOLVER_STATUS",
                                        auth::FreshnessFilter::EpochPolicy::kAdopt};
   auth::FreshnessFilter model_filter_{"FORCE_MODEL"};
-  ModelOrder order_;  // receive thread only
   std::atomic<uint64_t> received_{0}, rejected_{0}, stiffness_clamps_{0}, invalid_models_{0},
       snaps_felt_{0}, out_of_order_{0};
   mutable std::mutex mutex_;  // the round-trip windows (receiver and status threads)

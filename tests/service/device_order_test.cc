@@ -42,17 +42,21 @@ int64_t FakeClock() { return g_now_us; }
 // ---- ModelOrder on its own --------------------------------------------------------------
 
 TEST(DeviceModelOrderTest, OnlyNewerPosesAndSolvesPass) {
-  ModelOrder order;
-  EXPECT_EQ(order.Check(7, 10, 100), ModelOrder::Verdict::kNewer);  // the first one
-  order.Applied(7, 10, 100);
-  EXPECT_EQ(order.Check(7, 11, 101), ModelOrder::Verdict::kNewer);
-  EXPECT_EQ(order.Check(7, 11, 100), ModelOrder::Verdict::kOlderPose);  // same pose again
-  EXPECT_EQ(order.Check(7, 12, 99), ModelOrder::Verdict::kOlderPose);   // late pose, new solve
-  EXPECT_EQ(order.Check(7, 9, 105), ModelOrder::Verdict::kOlderSolve);  // new pose, old solve
-  EXPECT_EQ(order.Check(7, 10, 105), ModelOrder::Verdict::kOlderSolve);
-  // A new server session numbers its solves afresh, but the pose order still holds.
-  EXPECT_EQ(order.Check(8, 1, 105), ModelOrder::Verdict::kNewer);
-  EXPECT_EQ(order.Check(8, 1, 100), ModelOrder::Verdict::kOlderPose);
+  for (bool check_solve_seq : {false, true}) {
+    ModelOrder order(check_solve_seq);
+    EXPECT_TRUE(order.IsNewer(7, 10, 100));  // the first one
+    order.Applied(7, 10, 100);
+    EXPECT_TRUE(order.IsNewer(7, 11, 101));
+    EXPECT_FALSE(order.IsNewer(7, 11, 100));  // the same pose again (a duplicate)
+    EXPECT_FALSE(order.IsNewer(7, 12, 99));   // a late pose answered after a newer one
+    // A newer pose from an older solve: refused by seq when unsigned; signed sessions
+    // leave the solve order to auth_seq (a resumed server restarts seq, same epoch).
+    EXPECT_EQ(order.IsNewer(7, 9, 105), !check_solve_seq);
+    EXPECT_EQ(order.IsNewer(7, 10, 105), !check_solve_seq);
+    // Another server session numbers its solves afresh; the pose order still holds.
+    EXPECT_TRUE(order.IsNewer(8, 1, 105));
+    EXPECT_FALSE(order.IsNewer(8, 1, 100));
+  }
 }
 
 // ---- the link itself ----------------------------------------------------------------------
