@@ -14,8 +14,9 @@ constexpr auto kErrorLogPeriod = std::chrono::seconds(10);
 
 }  // namespace
 
-CheckpointWriter::CheckpointWriter(std::string path, const auth::SessionKey& key)
-    : path_(std::move(path)), key_(key) {
+CheckpointWriter::CheckpointWriter(std::string path, const auth::SessionKey& key,
+                                   std::function<void()> before_write)
+    : path_(std::move(path)), key_(key), before_write_(std::move(before_write)) {
   thread_ = std::thread([this] { Loop(); });
 }
 
@@ -66,6 +67,7 @@ void CheckpointWriter::Loop() {
     writing_ = true;
     lock.unlock();
 
+    if (before_write_) before_write_();
     const auto t0 = SteadyClock::now();
     std::string error;
     try {

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -34,7 +35,10 @@ class CheckpointWriter {
   static constexpr size_t kWindow = 4096;
 
   // `key` signs the files and must outlive the writer. Starts the writer thread.
-  CheckpointWriter(std::string path, const auth::SessionKey& key);
+  // `before_write` (tests) runs on the writer thread before each write: a test blocks
+  // there to stand for a slow disk.
+  CheckpointWriter(std::string path, const auth::SessionKey& key,
+                   std::function<void()> before_write = {});
   // Flush() then stops the thread.
   ~CheckpointWriter();
   CheckpointWriter(const CheckpointWriter&) = delete;
@@ -53,6 +57,7 @@ class CheckpointWriter {
 
   std::string path_;
   const auth::SessionKey& key_;
+  std::function<void()> before_write_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;       // a snapshot was offered, or stop
   std::condition_variable done_cv_;  // a write finished

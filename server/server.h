@@ -86,6 +86,8 @@ struct ServerTestHooks {
   // Just after each tracker update, with the controls and the tracker (its state and
   // last result): a test compares the server's path with a sweep of the same scene.
   std::function<void(const Vec& u, const EquilibriumTracker& tracker)> after_update;
+  // On the checkpoint writer thread, before each write (a test blocks it: a slow disk).
+  std::function<void()> before_checkpoint_write;
 };
 
 class Server {

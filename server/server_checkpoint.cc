@@ -50,7 +50,7 @@ void Server::SetUpCheckpoints() {
   session_->scene_text = ReadText(params_.scene_path);
   resumed_ = ResumeFromCheckpoint();
   checkpoint_writer_ = std::make_unique<CheckpointWriter>(
-      CheckpointPath(params_.state_dir, channels_.session), key_);
+      CheckpointPath(params_.state_dir, channels_.session), key_, hooks_.before_checkpoint_write);
 }
 
 bool Server::ResumeFromCheckpoint() {
