@@ -1,5 +1,8 @@
 #include "checkpoint_writer.h"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <exception>
 #include <utility>
 
@@ -58,6 +61,10 @@ CheckpointWriterStats CheckpointWriter::Stats() const {
 }
 
 void CheckpointWriter::Loop() {
+  // SCHED_BATCH (no privilege needed): the scheduler does not let this thread preempt the
+  // solve thread when Offer wakes it; it writes when a core is free.
+  const sched_param batch{};
+  pthread_setschedparam(pthread_self(), SCHED_BATCH, &batch);
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     cv_.wait(lock, [this] { return pending_.has_value() || stop_; });
