@@ -348,6 +348,11 @@ int RunViewer(const ViewerOptions& options) {
       std::printf("snapthread-viewer: %lld shapes, %lld bad messages\n",
                   static_cast<long long>(receiver.shapes_received()),
                   static_cast<long long>(receiver.bad_messages()));
+      // Against the server's numbering: what was published while this viewer listened.
+      const ShapeSequence seq = receiver.shape_sequence();
+      std::printf("snapthread-viewer: shape seq %lld..%lld: %lld received, %lld missed\n",
+                  static_cast<long long>(seq.first), static_cast<long long>(seq.highest),
+                  static_cast<long long>(seq.received), static_cast<long long>(seq.Missed()));
     }
     receiver.Stop();
   }
