@@ -4,6 +4,7 @@
 #include <sys/signalfd.h>
 
 #include <cstdio>
+#include <ctime>
 #include <exception>
 #include <optional>
 
@@ -25,12 +26,25 @@ int main(int argc, char** argv) {
   app.add_option("-l,--lcm-url", o.lcm_url,
                  "LCM URL (default: env LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
   app.add_flag("-f,--force", o.force, "overwrite an existing file");
+  bool use_strftime = false;
+  app.add_flag("-s,--strftime", use_strftime, "format FILE with strftime (local time), as lcm-logger -s");
   app.add_flag("-q,--quiet", quiet, "no summary at the end");
   app.add_option("--duration-s", o.duration_s, "stop after this many seconds (0 = at a signal)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--flush-interval", o.flush_interval_ms, "flush the file every MS milliseconds")
       ->capture_default_str()->check(CLI::Range(1, 10000));
   CLI11_PARSE(app, argc, argv);
+  if (use_strftime) {
+    const std::time_t now = std::time(nullptr);
+    std::tm local{};
+    localtime_r(&now, &local);
+    char name[4096];
+    if (std::strftime(name, sizeof name, o.path.c_str(), &local) == 0) {
+      std::fprintf(stderr, "snapthread-logger: --strftime: '%s' formats to nothing\n", o.path.c_str());
+      return 1;
+    }
+    o.path = name;
+  }
   // A receiver: a kernel buffer that rides out seconds off the CPU (lcm_url.h).
   o.lcm_url = snapthread::transport::WithReceiveBuffer(snapthread::transport::ResolveLcmUrl(o.lcm_url));
 
