@@ -29,12 +29,8 @@ SessionLogger::SessionLogger(const LoggerOptions& options) : options_(options), 
     throw std::runtime_error("refusing to overwrite existing file " + options_.path +
                              " (--force overwrites it)");
   }
-  log_ = new lcm::LogFile(options_.path, "w");
-  if (!log_->good()) {
-    delete log_;
-    log_ = nullptr;
-    throw std::runtime_error("cannot write the log file " + options_.path);
-  }
+  log_ = std::make_unique<lcm::LogFile>(options_.path, "w");
+  if (!log_->good()) throw std::runtime_error("cannot write the log file " + options_.path);
   subscription_ = lcm_.subscribe(options_.channel, &SessionLogger::OnMessage, this);
   if (subscription_ == nullptr) {
     throw std::runtime_error("cannot subscribe to channels '" + options_.channel + "'");
@@ -44,8 +40,7 @@ SessionLogger::SessionLogger(const LoggerOptions& options) : options_(options), 
 
 SessionLogger::~SessionLogger() {
   if (subscription_ != nullptr) lcm_.unsubscribe(subscription_);
-  delete log_;  // flushes and closes
-}
+}  // log_ flushes and closes the file
 
 void SessionLogger::OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   lcm::LogEvent event;

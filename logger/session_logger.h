@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include <lcm/lcm-cpp.hpp>
@@ -52,7 +53,7 @@ class SessionLogger {
 
   LoggerOptions options_;
   lcm::LCM lcm_;
-  lcm::LogFile* log_ = nullptr;
+  std::unique_ptr<lcm::LogFile> log_;
   lcm::Subscription* subscription_ = nullptr;
   int64_t messages_ = 0;
   int64_t bytes_ = 0;
