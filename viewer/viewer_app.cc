@@ -223,6 +223,9 @@ int RunViewer(const ViewerOptions& options) {
   lcm::LCM lcm(options.lcm_url);
   if (!LcmOpened(lcm, options)) return kExitSetupFailed;
   SessionReceiver receiver(&lcm, options.session, &*key);
+  // Receiving starts before the window: GL start-up takes seconds on a loaded machine, and
+  // LCM drops what the shape queue cannot hold meanwhile.
+  receiver.Start();
   std::unique_ptr<GraspPublisher> grasp;
   if (scene) {
     grasp = std::make_unique<GraspPublisher>(&lcm, options.session, scene->device, &*key,
@@ -274,7 +277,6 @@ int RunViewer(const ViewerOptions& options) {
     glfwSetScrollCallback(window, &OnScroll);
     glfwSetKeyCallback(window, &OnKey);
 
-    receiver.Start();
     const auto start = Clock::now();
     const bool screenshot = !options.screenshot_path.empty();
     const double frame_period_s = 1.0 / options.max_fps;
@@ -348,6 +350,11 @@ int RunViewer(const ViewerOptions& options) {
       std::printf("snapthread-viewer: %lld shapes, %lld bad messages\n",
                   static_cast<long long>(receiver.shapes_received()),
                   static_cast<long long>(receiver.bad_messages()));
+      // Against the server's numbering: what was published while this viewer listened.
+      const ShapeSequence seq = receiver.shape_sequence();
+      std::printf("snapthread-viewer: shape seq %lld..%lld: %lld received, %lld missed\n",
+                  static_cast<long long>(seq.first), static_cast<long long>(seq.highest),
+                  static_cast<long long>(seq.received), static_cast<long long>(seq.Missed()));
     }
     receiver.Stop();
   }

@@ -6,7 +6,7 @@
 #
 #   server host:   snapthread-server
 #   device host:   snapthread-device --backend virtual-hand
-#   observer host: lcm-logger, snapthread-viewer (xvfb screenshot), snapthread-viewer --print-rates
+#   observer host: snapthread-logger, snapthread-viewer (xvfb screenshot), snapthread-viewer --print-rates
 #
 # Asserts: the device received force models; both observers received shapes; the log holds
 # every sequence number the server published (FORCE_MODEL 0..updates-1, no gaps) and every
@@ -92,8 +92,8 @@ echo "namespaces: server $ns_srv ($subnet.1), device $ns_dev ($subnet.2), observ
 # Started with ip netns exec directly (not through a shell function), so $! is the process
 # itself and the logger gets the SIGINT that makes it close the log.
 
-# SCHED_FIFO for the logger, as in the soak test: a stalled logger drops messages.
-ip netns exec "$ns_obs" chrt -f 10 lcm-logger -q -c "${session}_.*" --lcm-url="$url" -f "$work/session.lcmlog" > "$work/logger.txt" 2>&1 &
+# The logger at normal priority, as in the soak test (logger/session_logger.h).
+ip netns exec "$ns_obs" "$bin/snapthread-logger" -q -c "${session}_.*" --lcm-url "$url" -f "$work/session.lcmlog" > "$work/logger.txt" 2>&1 &
 logger_pid=$!
 ip netns exec "$ns_obs" "$bin/snapthread-viewer" --key "$key" --print-rates --session "$session" --lcm-url "$url" \
     --duration-s $((duration + 3)) > "$work/observer_rates.txt" 2>&1 &

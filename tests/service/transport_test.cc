@@ -91,6 +91,19 @@ TEST(TransportLcmUrlTest, FlagThenEnvironmentThenDefault) {
   }
 }
 
+TEST(TransportLcmUrlTest, ReceiversAskForABufferTheKernelGrants) {
+  const std::string udpm = "udpm://239.255.76.67:7667";
+  EXPECT_EQ(WithReceiveBuffer(udpm + "?ttl=0", 8388608, 4194304), udpm + "?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(WithReceiveBuffer(udpm, 1048576, 4194304), udpm + "?recv_buf_size=1048576");
+  EXPECT_EQ(WithReceiveBuffer(udpm + "?ttl=1", 1048576, 0), udpm + "?ttl=1&recv_buf_size=1048576");
+  // The user's own size stays; other providers have no such option.
+  EXPECT_EQ(WithReceiveBuffer(udpm + "?recv_buf_size=65536", 1048576, 4194304),
+            udpm + "?recv_buf_size=65536");
+  EXPECT_EQ(WithReceiveBuffer("memq://", 1048576, 4194304), "memq://");
+  EXPECT_EQ(WithReceiveBuffer("file:///tmp/x.lcmlog?mode=r", 1048576, 4194304),
+            "file:///tmp/x.lcmlog?mode=r");
+}
+
 TEST(TransportClockTest, MonotonicAdvancesAndRealtimeIsRecent) {
   const int64_t a = MonotonicMicros();
   std::this_thread::sleep_for(std::chrono::milliseconds(2));
