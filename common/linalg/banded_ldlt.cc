@@ -90,37 +90,51 @@ int FactorBand(double* data, int n, int b, double threshold, double* pivot) {
 template <int B>
 void SolveBand(const double* data, int n, int b, double* v, int m, std::ptrdiff_t stride) {
   const int ld = b + 1;
-  for (int i = 0; i < n; ++i) {
+  // Rows 0 .. head-1 have a band cut off by the matrix' edge (every row without a
+  // compile-time B); rows head .. n-1 have the full band of B.
+  const int head = B > 0 ? std::min(B, n) : n;
+  for (int i = 0; i < head; ++i) {
     const double* ri = data + static_cast<std::ptrdiff_t>(i) * ld;
     for (int c = 0; c < m; ++c) {
       double* vc = v + c * stride;
       double s = 0.0;
-      if (B > 0 && i >= B) {
-        const double* xc = vc + (i - B);
-#pragma GCC unroll 32
-        for (int k = 0; k < B; ++k) s += ri[k] * xc[k];
-      } else {
-        for (int k = std::max(0, i - b); k < i; ++k) s += ri[k - i + b] * vc[k];
-      }
+      for (int k = std::max(0, i - b); k < i; ++k) s += ri[k - i + b] * vc[k];
       vc[i] -= s;
     }
   }
-  for (int i = 0; i < n; ++i) {
-    const double d = data[static_cast<std::ptrdiff_t>(i) * ld + b];
-    for (int c = 0; c < m; ++c) v[c * stride + i] /= d;
+  if constexpr (B > 0) {
+    for (int i = head; i < n; ++i) {
+      const double* ri = data + static_cast<std::ptrdiff_t>(i) * (B + 1);
+      for (int c = 0; c < m; ++c) {
+        double* xc = v + c * stride + (i - B);  // xc[B] is row i
+        double s = 0.0;
+#pragma GCC unroll 32
+        for (int k = 0; k < B; ++k) s += ri[k] * xc[k];
+        xc[B] -= s;
+      }
+    }
   }
-  for (int i = n - 1; i > 0; --i) {
+  for (int c = 0; c < m; ++c) {
+    double* vc = v + c * stride;
+    for (int i = 0; i < n; ++i) vc[i] /= data[static_cast<std::ptrdiff_t>(i) * ld + b];
+  }
+  if constexpr (B > 0) {
+    for (int i = n - 1; i >= head; --i) {
+      const double* ri = data + static_cast<std::ptrdiff_t>(i) * (B + 1);
+      for (int c = 0; c < m; ++c) {
+        double* xc = v + c * stride + (i - B);
+        const double xi = xc[B];
+#pragma GCC unroll 32
+        for (int k = 0; k < B; ++k) xc[k] -= ri[k] * xi;
+      }
+    }
+  }
+  for (int i = std::min(head, n) - 1; i > 0; --i) {
     const double* ri = data + static_cast<std::ptrdiff_t>(i) * ld;
     for (int c = 0; c < m; ++c) {
       double* vc = v + c * stride;
       const double xi = vc[i];
-      if (B > 0 && i >= B) {
-        double* xc = vc + (i - B);
-#pragma GCC unroll 32
-        for (int k = 0; k < B; ++k) xc[k] -= ri[k] * xi;
-      } else {
-        for (int k = std::max(0, i - b); k < i; ++k) vc[k] -= ri[k - i + b] * xi;
-      }
+      for (int k = std::max(0, i - b); k < i; ++k) vc[k] -= ri[k - i + b] * xi;
     }
   }
 }
