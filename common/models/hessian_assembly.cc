@@ -103,12 +103,6 @@ void HessianAssembly::AddHessian(int term, const double* local_h, int ld, double
   for (; run != end; ++run) {
     const double* src = local_h + run->local_row + run->local_col * ld;
     double* dst = values + run->value;
-    if (run->len == 3) {  // a node's three coordinates: the common run in 3D
-      dst[0] += src[0];
-      dst[1] += src[1];
-      dst[2] += src[2];
-      continue;
-    }
     for (int r = 0; r < run->len; ++r) dst[r] += src[r];
   }
 }
