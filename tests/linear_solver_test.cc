@@ -19,6 +19,7 @@
 #include "linalg/linear_solver.h"
 #include "models/models.h"
 #include "solvers/solver.h"
+#include "tracking/tracker.h"
 
 namespace snapthread {
 namespace {
@@ -466,6 +467,74 @@ TEST_P(LinearSolverTest, EquilibriumSolvesAfterTheFirstDoNotAllocate) {
     for (int k = 0; k < 10; ++k) {
       u[1] += 0.01;
       terminations[k] = solver->Solve(u, &x).termination;
+    }
+    counter.Stop();
+    for (Termination t : terminations) EXPECT_EQ(t, Termination::kConverged) << method;
+    EXPECT_EQ(counter.mallocs(), 0) << method;
+    EXPECT_EQ(counter.news(), 0) << method;
+  }
+}
+
+// SolveMany() runs several right-hand sides at once (the implicit differentiation's
+// E_xu columns): each column is Solve() of that column to the last bit, and repeated
+// calls with the result already sized do not allocate.
+TEST_P(LinearSolverTest, SolveManyEqualsSolvePerColumnWithoutAllocating) {
+  std::mt19937 rng(11);
+  for (int n : {1, 5, 9, 300}) {
+    const int b = std::min(8, n - 1);
+    Mat dense = RandomSpdBand(n, b, &rng);
+    dense.diagonal().array() -= 0.3 * dense.diagonal().mean();  // indefinite
+    const SparseMatrix a = BandToSparse(dense, b);
+    auto solver = Make();
+    ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess);
+    ASSERT_EQ(solver->Factorize(a), LinearSolverStatus::kSuccess) << solver->message();
+    Mat rhs(n, 3);
+    for (int j = 0; j < 3; ++j) rhs.col(j) = RandomVector(n, &rng);
+    Mat x;
+    ASSERT_EQ(solver->SolveMany(rhs, &x), LinearSolverStatus::kSuccess);
+    ASSERT_EQ(x.rows(), n);
+    ASSERT_EQ(x.cols(), 3);
+    for (int j = 0; j < 3; ++j) {
+      Vec column;
+      ASSERT_EQ(solver->Solve(rhs.col(j), &column), LinearSolverStatus::kSuccess);
+      for (int i = 0; i < n; ++i) ASSERT_EQ(x(i, j), column[i]) << "n = " << n << ", column " << j << ", row " << i;
+    }
+    EXPECT_EQ(solver->SolveMany(rhs, &rhs), LinearSolverStatus::kInvalidInput);
+    LinearSolverStatus again = LinearSolverStatus::kInvalidInput;
+    AllocationCounter counter;
+    again = solver->SolveMany(rhs, &x);
+    counter.Stop();
+    EXPECT_EQ(again, LinearSolverStatus::kSuccess);
+    EXPECT_EQ(counter.mallocs(), 0) << "n = " << n;
+  }
+}
+
+// A whole tracker update (predictor, solve, F and K by implicit differentiation) does
+// not touch the heap once the tracker has run its first updates, for every method and
+// backend (the 1 kHz device never waits on it, but the server's solve loop should not
+// allocate per pose either).
+TEST_P(LinearSolverTest, TrackerUpdatesAfterTheFirstDoNotAllocate) {
+  ModelParams p;
+  p.model = "thread3d";
+  p.Set("n", 12);
+  for (const char* method : {"newton", "newton-ls", "higher-order"}) {
+    SolverOptions o;
+    o.method = method;
+    o.linear_solver = GetParam();
+    EquilibriumTracker tracker(MakeModel(p), o);
+    Vec u = Vec::Zero(3);
+    u << 0.8 * p.Integer("n"), 0.5, 0.1;
+    tracker.Reset(u);
+    for (int k = 0; k < 3; ++k) {
+      u[1] += 0.01;
+      tracker.Update(u);
+    }
+    std::vector<Termination> terminations(20);
+    AllocationCounter counter;
+    for (int k = 0; k < 20; ++k) {
+      u[1] += 0.01;
+      u[2] -= 0.005;
+      terminations[k] = tracker.Update(u).summary.termination;
     }
     counter.Stop();
     for (Termination t : terminations) EXPECT_EQ(t, Termination::kConverged) << method;

@@ -68,7 +68,7 @@ class EquilibriumTracker {
   double lambda_ref_ = -1.0;
   TrackResult result_;
   // scratch
-  Vec eu_, scratch_, x_pred_;
+  Vec eu_, scratch_, x_pred_, du_;
   Mat exu_, euu_, sol_;
 };
 
