@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "models/chain_model.h"
 #include "models/registry.h"
 
@@ -99,6 +101,30 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   // Clamped–pinned Euler load with EI = (β/2) L (see chain_model.h).
   double ForceScale() const override { return EulerLoad(n_, rest_, half_beta_); }
 
+  // The roll: rotation of the free nodes p_2 .. p_{N-1} about the clamp–grasp axis (the
+  // line through p_0 = 0 and the grasp), node 1 (x_1 only) and a grip's s unchanged. E
+  // is invariant when the grasp (and a grip direction) lies on the clamp axis, where
+  // the two axes coincide; near it the roll is nearly free. About the clamp axis instead
+  // the grasp would not be on the axis, and rolling half a turn would stretch the last
+  // segment by twice the grasp's offset: an orbit far from the near-symmetric one.
+  int NumSymmetries() const override { return 1; }
+  void SymmetryGenerator(int /*k*/, const Vec& x, const Vec& u, Vec* g) const override {
+    g->setZero(x.size());
+    const V3 axis = RollAxis(u);
+    for (int i = 2; i <= LastFreeNode(); ++i) {
+      const int o = 1 + 3 * (i - 2);
+      g->segment<3>(o) = axis.cross(V3(x.segment<3>(o)));
+    }
+  }
+  void ApplySymmetry(int /*k*/, double t, const Vec& x, const Vec& u, Vec* y) const override {
+    *y = x;
+    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(t, RollAxis(u)).toRotationMatrix();
+    for (int i = 2; i <= LastFreeNode(); ++i) {
+      const int o = 1 + 3 * (i - 2);
+      y->segment<3>(o) = rotation * V3(x.segment<3>(o));
+    }
+  }
+
  private:
   friend class ChainModel<Thread3dModel>;
   struct Term {
@@ -120,6 +146,14 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
     return 1 + 3 * (i - 2) + k;
   }
   bool IsGripNode(int i) const { return grip_ && i == n_ - 1; }
+  // The unit clamp–grasp direction (the clamp axis +x for a grasp at the clamp).
+  V3 RollAxis(const Vec& u) const {
+    const V3 p = u.head<3>();
+    const double length = p.norm();
+    return length > 1e-12 * rest_ ? V3(p / length) : V3::UnitX();
+  }
+  // The last node whose three coordinates are state variables.
+  int LastFreeNode() const { return grip_ ? n_ - 2 : n_ - 1; }
   V3 Node(int i, const Vec& x, const Vec& u) const {
     if (i == 0) return V3::Zero();
     if (i == 1 && !IsGripNode(1)) return V3(x[0], 0.0, 0.0);
