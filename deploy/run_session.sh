@@ -10,6 +10,8 @@
 #                              [--lcm-url URL] [--bin-dir DIR] [--out-root DIR] [--key FILE]
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+# make_session_key
+source "$here/deploy/lib/session_key.sh"
 
 duration=10
 scene="$here/scenes/curve2d_snap.yaml"
@@ -39,11 +41,7 @@ done
 out="$out_root/session-$(date -u +%Y%m%d-%H%M%S)"
 mkdir -p "$out"
 log="$out/session.lcmlog"
-if [ -z "$key" ]; then
-  key="$out/session.key"
-  "$bin/snapthread-keygen" --key "$key" > "$out/keygen.txt" 2>&1 ||
-    { echo "run_session: could not make a session key:" >&2; cat "$out/keygen.txt" >&2; exit 1; }
-fi
+make_session_key run_session "$out/session.key" "$out/keygen.txt"
 pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done

@@ -165,17 +165,21 @@ std::optional<auth::SessionKey> LoadViewerKey(const ViewerOptions& options) {
   }
 }
 
+// Whether the LCM at --lcm-url opened; if not, says so and how to start it.
+bool LcmOpened(const lcm::LCM& lcm, const ViewerOptions& options) {
+  if (lcm.good()) return true;
+  std::fprintf(stderr, "snapthread-viewer: cannot open LCM at %s. %s\n", options.lcm_url.c_str(),
+               transport::LcmStartHint(options.lcm_url).c_str());
+  return false;
+}
+
 }  // namespace
 
 int RunPrintRates(const ViewerOptions& options) {
   const std::optional<auth::SessionKey> key = LoadViewerKey(options);
   if (!key) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
-  if (!lcm.good()) {
-    std::fprintf(stderr, "snapthread-viewer: cannot open LCM at %s. %s\n", options.lcm_url.c_str(),
-                 transport::LcmStartHint(options.lcm_url).c_str());
-    return kExitSetupFailed;
-  }
+  if (!LcmOpened(lcm, options)) return kExitSetupFailed;
   ChannelRateMonitor monitor(&lcm, options.session + "_.*");
   // Checks shapes and statuses on the same LCM (handled by this loop) to count refusals.
   SessionReceiver checked(&lcm, options.session, &*key);
@@ -217,11 +221,7 @@ int RunViewer(const ViewerOptions& options) {
   const std::optional<auth::SessionKey> key = LoadViewerKey(options);
   if (!key) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
-  if (!lcm.good()) {
-    std::fprintf(stderr, "snapthread-viewer: cannot open LCM at %s. %s\n", options.lcm_url.c_str(),
-                 transport::LcmStartHint(options.lcm_url).c_str());
-    return kExitSetupFailed;
-  }
+  if (!LcmOpened(lcm, options)) return kExitSetupFailed;
   SessionReceiver receiver(&lcm, options.session, &*key);
   // Receiving starts before the window: GL start-up takes seconds on a loaded machine, and
   // LCM drops what the shape queue cannot hold meanwhile.

@@ -46,3 +46,12 @@ run_session() {
       --duration "$duration" --no-rt --summary "$work/device.json" > "$work/device.txt" 2>&1
   device_rc=$?
 }
+# end_session LOGGER_PID: after run_session (and after waiting for the other processes,
+# such as viewers), waits for the server (sets server_rc), stops the logger and fails
+# unless the device and the server exited 0.
+end_session() {
+  wait "$server_pid"; server_rc=$?
+  stop_logger "$1"
+  [ $device_rc -eq 0 ] || fail "device exited $device_rc"
+  [ $server_rc -eq 0 ] || fail "server exited $server_rc"
+}

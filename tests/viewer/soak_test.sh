@@ -38,7 +38,7 @@ if [ "$(id -u)" -ne 0 ]; then prio=""; fi
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
 trap cleanup EXIT
-# stop_logger, fail, json, make_key, start_xvfb, run_session
+# fail, json, make_key, start_xvfb, run_session, end_session
 source "$(dirname "$0")/../support/script_support.sh"
 make_key
 echo "soak: ${duration} s, $viewers viewers and snapthread-logger, outputs in $work"
@@ -63,14 +63,11 @@ for p in "$logger_pid" "${viewer_pids[@]}"; do
     awk -v i="$inode" -v p="$p" '$10 == i && $2 ~ /:1DF3$/ { print "pid " p " socket " i " kernel drops " $NF }' /proc/net/udp
   done
 done > "$work/socket_drops.txt"
-wait "$server_pid"; server_rc=$?
 viewer_rcs=()
 for p in "${viewer_pids[@]}"; do wait "$p"; viewer_rcs+=($?); done
-stop_logger "$logger_pid"
+end_session "$logger_pid"
 
 # 1
-[ $device_rc -eq 0 ] || fail "device exited $device_rc"
-[ $server_rc -eq 0 ] || fail "server exited $server_rc"
 for v in $(seq $viewers); do [ "${viewer_rcs[$((v - 1))]}" -eq 0 ] || fail "viewer $v exited ${viewer_rcs[$((v - 1))]}"; done
 ticks=$(json "$work/device.json" "['ticks']")
 echo "device: $ticks ticks in ${duration} s, tick_rate_hz $(json "$work/device.json" "['tick_rate_hz']"), lateness p99 $(json "$work/device.json" "['lateness_us_p99']") us"
