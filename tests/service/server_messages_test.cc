@@ -174,6 +174,16 @@ TEST(ServerMessagesTest, StatusFlags) {
   r.summary.termination = Termination::kInvalidInput;
   EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_INVALID);
   EXPECT_EQ(ClassifyStatus(nullptr), force_model_t::STATUS_INVALID);
+  // A snap spread over updates by the time budget (docs/time-budget.md).
+  r.summary.termination = Termination::kSnapping;
+  r.summary.status = EquilibriumStatus::kSnapping;
+  r.snapped = false;
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_SNAPPING);
+  // A NaN residual is a failed row, never a force model.
+  r.summary.termination = Termination::kConverged;
+  r.summary.status = EquilibriumStatus::kFailed;
+  r.summary.residual = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_INVALID);
 }
 
 TEST(ServerMessagesTest, NonFiniteResultBecomesInvalidZeroModel) {
