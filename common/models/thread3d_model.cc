@@ -30,7 +30,6 @@ namespace {
 
 using internal::BendTerm;
 using internal::ChainModel;
-using internal::ChainParamSpecs;
 using internal::HessianAssembly;
 using internal::StretchTerm;
 using V3 = Eigen::Vector3d;
@@ -50,33 +49,21 @@ int NumControlsFor(const ModelParams& p) { return p.Bool("grip_direction") ? 6 :
 class Thread3dModel final : public ChainModel<Thread3dModel> {
  public:
   explicit Thread3dModel(const ModelParams& params)
-      : ChainModel(NumStatesFor(params), NumControlsFor(params)),
-        n_(params.Integer("n")),
+      : ChainModel(params, NumStatesFor(params), NumControlsFor(params)),
         rest_(params.Number("segment_length")),
         half_beta_(0.5 * params.Number("bending")),
         half_gamma_(0.5 * params.Number("stretching")),
         energy_shift_(-n_ * params.Number("bending") * params.Number("reference_bend") / 2.0),
-        grip_(params.Bool("grip_direction")),
-        nx_(NumStatesFor(params)),
-        nu_(NumControlsFor(params)) {
-    for (int i = 1; i <= n_; ++i) AddTerm(false, i - 1);
-    for (int j = 1; j <= n_ - 1; ++j) AddTerm(true, j - 1);
-    FinishTerms();
+        grip_(params.Bool("grip_direction")) {
+    AddChainTerms();
   }
 
   std::string_view Name() const override { return kName; }
   int SpatialDimension() const override { return 3; }
 
+  // (3.7), (3.9) as the sums above: Σ γ/2 (l_i - L)² + Σ β/2 (1 - w_j·w_{j+1}) - N β B / 2.
   double Energy(const Vec& x, const Vec& u) const override {
-    double e = energy_shift_;
-    for (const Term& term : terms_) {
-      const int a = term.first_node;
-      e += term.bend ? BendTerm<3>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u),
-                                   half_beta_, nullptr, nullptr)
-                     : StretchTerm<3>(Node(a, x, u), Node(a + 1, x, u), half_gamma_, rest_,
-                                      nullptr, nullptr);
-    }
-    return e;
+    return ChainEnergy<3>(x, u, energy_shift_, half_beta_, half_gamma_, rest_);
   }
 
   // Nodes evenly spaced on the chord from 0 to p_N, plus a bump 1e-3 L sin(π i / N) in a
@@ -314,14 +301,11 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
     f(gg.data(), hh.data(), kMaxVars);
   }
 
-  const int n_;
   const double rest_;        // L
   const double half_beta_;   // β/2
   const double half_gamma_;  // γ/2
   const double energy_shift_;  // -N β B / 2
   const bool grip_;
-  const int nx_;
-  const int nu_;
   std::vector<Term> terms_;
 };
 
@@ -331,7 +315,7 @@ ModelRegistration Thread3dRegistration() {
   ModelRegistration r;
   r.name = kName;
   r.doc = "3D elastic thread of N segments, clamped at the origin, held at its end (3.1-3.10, 3.15)";
-  r.params = ChainParamSpecs("beta in beta/2 (b_i - B) (3.9)", "gamma in gamma/2 (l_i - L)^2 (3.7)");
+  r.params = internal::ChainParamSpecs("beta in beta/2 (b_i - B) (3.9)", "gamma in gamma/2 (l_i - L)^2 (3.7)");
   r.params.push_back({.name = "reference_bend", .default_value = 0.0, .doc = "B (3.9); shifts the energy only"});
   r.params.push_back({.name = "grip_direction", .kind = ParamKind::kBool, .default_value = 0.0,
                       .doc = "the grip also holds the last segment's direction: u = (X, Y, Z, dx, dy, dz)"});
