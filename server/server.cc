@@ -112,6 +112,7 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
     }
     options.method = method_override_;
   }
+  if (params_.time_budget_us >= 0.0) options.max_time_us = params_.time_budget_us;
   session->scene.solver = options;
   // The one scene -> tracker path (SceneError for invalid parameters or options).
   session->tracker = MakeTracker(session->scene);

@@ -77,6 +77,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--method", params.method,
                  "Override the scene's solver: " + snapthread::SolverRegistry::Global().NamesText(" | ", " | "));
+  app.add_option("--time-budget-us", params.time_budget_us,
+                 "Wall-clock budget per update, microseconds (0 = none; default: the scene's "
+                 "solver.time_budget_us). A longer snap spreads over updates (status snapping)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--scene-dir", params.scene_dir,
                  "Directory LOAD_SCENE commands load scenes from, by name only (default: " +
                      snapthread::server::DefaultSceneDir() + ")");

@@ -44,6 +44,8 @@ int8_t ClassifyStatus(const TrackResult* result) {
   switch (result->summary.status) {
     case EquilibriumStatus::kSnapped: return force_model_t::STATUS_SNAPPED;
     case EquilibriumStatus::kNearFold: return force_model_t::STATUS_NEAR_FOLD;
+    case EquilibriumStatus::kSnapping: return force_model_t::STATUS_SNAPPING;
+    case EquilibriumStatus::kFailed: return force_model_t::STATUS_INVALID;
     case EquilibriumStatus::kRegular: break;
   }
   return result->stiffness_regularized ? force_model_t::STATUS_NEAR_FOLD : force_model_t::STATUS_REGULAR;

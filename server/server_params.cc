@@ -44,6 +44,9 @@ bool ServerParams::IsValid(std::string* error) const {
   if (!std::isfinite(status_rate_hz) || status_rate_hz <= 0.0 || status_rate_hz > 1000.0) {
     return Fail(error, "--status-rate-hz: must be in (0, 1000], got " + std::to_string(status_rate_hz));
   }
+  if (!std::isfinite(time_budget_us)) {
+    return Fail(error, "--time-budget-us: must be a finite number (>= 0; omit it for the scene's)");
+  }
   if (!method.empty()) {
     if (SolverRegistry::Global().Find(method) == nullptr) {
       return Fail(error, "--method: unknown method '" + method + "' (expected " +

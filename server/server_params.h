@@ -41,6 +41,11 @@ struct ServerParams {
   // Solver method override: "" (use the scene's), "newton", "newton-ls" or
   // "higher-order". An override survives RESET and LOAD_SCENE until SET_METHOD.
   std::string method;
+  // Wall-clock budget per update, microseconds (--time-budget-us): < 0 = the scene's
+  // solver.time_budget_us, 0 = none. Like --method it survives RESET and LOAD_SCENE. A
+  // snap that outlasts it spreads over updates, published as STATUS_SNAPPING with the
+  // snap's current force and K = 0 (docs/time-budget.md).
+  double time_budget_us = -1.0;
   // spdlog level name: trace, debug, info, warn, error, critical, off.
   std::string log_level = "info";
   // Run time in seconds for the process (server_main.cc); 0 = until SIGINT/SIGTERM.

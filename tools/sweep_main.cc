@@ -1,5 +1,6 @@
 // snapthread-sweep: offline quasi-static sweep of a scene along a straight control path,
 // one CSV row per step.
+#include <cmath>
 #include <fstream>
 #include <iostream>
 
@@ -15,7 +16,7 @@ int main(int argc, char** argv) {
   CLI::App app{"snapthread-sweep: quasi-static sweep of a scene's grasp from --from to --to"};
   std::string scene_file, from, to, method, out_file;
   int steps = 100, max_iterations = -1;
-  double cutoff = 0.0;
+  double cutoff = 0.0, time_budget_us = 0.0;
   bool back = false;
   std::vector<std::string> sets;
   app.add_option("--scene", scene_file, "scene YAML file")->required();
@@ -31,6 +32,9 @@ int main(int argc, char** argv) {
   app.add_option("--method", method, SolverRegistry::Global().NamesText(" | ", " | ") + " (default: the scene's)");
   app.add_option("--cutoff", cutoff, "stop when |E_x| < cutoff (default: the scene's)");
   app.add_option("--max-iterations", max_iterations, "iteration budget per step, 0 = unlimited");
+  app.add_option("--time-budget-us", time_budget_us,
+                 "wall-clock budget per step in microseconds, 0 = none (a snap may then spread over steps: "
+                 "termination 'snapping')");
   app.add_option("--set", sets, "override a scene key, e.g. --set params.n=20 (repeatable)");
   app.add_option("--out", out_file, "CSV output file (default: standard output)");
   // The models a scene may name, with their parameters (--set params.<name>=...).
@@ -52,6 +56,11 @@ int main(int argc, char** argv) {
     if (app.count("--max-iterations")) {
       if (max_iterations < 0) throw std::invalid_argument("--max-iterations: expected an integer >= 0");
       scene.solver.max_iterations = max_iterations;
+    }
+    if (app.count("--time-budget-us")) {
+      if (!(time_budget_us >= 0.0) || !std::isfinite(time_budget_us))
+        throw std::invalid_argument("--time-budget-us: expected a finite number >= 0");
+      scene.solver.max_time_us = time_budget_us;
     }
     if (steps < 1) throw std::invalid_argument("--steps: expected an integer >= 1");
     std::vector<Vec> controls;

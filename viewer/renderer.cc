@@ -81,6 +81,7 @@ const char* StatusName(int status) {
     case 1: return "NEAR FOLD";
     case 2: return "SNAPPED";
     case 3: return "INVALID";
+    case 4: return "SNAPPING";
     default: return "?";
   }
 }
@@ -94,6 +95,7 @@ Rgb StatusColor(int status) {
     case 0: return {0.55f, 0.80f, 0.95f};  // regular: pale blue
     case 1: return {1.00f, 0.62f, 0.10f};  // near fold: orange
     case 2: return {0.95f, 0.20f, 0.20f};  // snapped: red
+    case 4: return {0.85f, 0.35f, 0.75f};  // snapping (time budget): magenta
     default: return {0.55f, 0.55f, 0.55f};  // invalid: grey
   }
 }

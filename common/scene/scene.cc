@@ -231,8 +231,8 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
 
   if (root["solver"]) {
     const YAML::Node s = root["solver"];
-    rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "max_time_us", "linear_solver",
-                               "degeneracy_ratio", "max_reduction_step", "secant_predictor"});
+    rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "time_budget_us", "max_time_us",
+                               "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor"});
     if (s["method"]) {
       // A registered solver's name: checked where the solver is made (MakeSolver), since
       // a scene links no solver code (the device client reads scenes).
@@ -242,7 +242,12 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
     if (s["max_iterations"]) {
       sc.solver.max_iterations = rd.Get<int>(s["max_iterations"], "solver.max_iterations", "an integer >= 0");
     }
-    sc.solver.max_time_us = rd.Number(s, "max_time_us", "solver.max_time_us", 0.0);
+    // time_budget_us (issue 13); max_time_us is its earlier spelling, still read.
+    if (s["time_budget_us"] && s["max_time_us"])
+      throw SceneError(file_label + ": solver.time_budget_us: also given as solver.max_time_us; keep one");
+    sc.solver.max_time_us = s["time_budget_us"]
+                                ? rd.Number(s, "time_budget_us", "solver.time_budget_us", 0.0)
+                                : rd.Number(s, "max_time_us", "solver.max_time_us", 0.0);
     if (s["linear_solver"])
       sc.solver.linear_solver = rd.Get<std::string>(s["linear_solver"], "solver.linear_solver", "a backend name");
     sc.solver.degeneracy_ratio = rd.Number(s, "degeneracy_ratio", "solver.degeneracy_ratio", sc.solver.degeneracy_ratio);

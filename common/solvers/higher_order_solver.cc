@@ -212,7 +212,7 @@ bool HigherOrderSolver::FinishSnap(const Vec& u, Vec* x, SolverSummary* s) {
 
 SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   SolverSummary s;
-  if (!BeginSolve(u, *x, &s)) return s;
+  if (!BeginSolve(u, *x, &s) || ContinueSnap(u, x, &s)) return s;
   Vec& xr = *x;
   double r = EvalGradient(xr, u, &s);
   s.termination = Termination::kBudgetSpent;

@@ -37,6 +37,7 @@ SolverBase::SolverBase(const Model& model, const SolverOptions& options)
 
 void SolverBase::Reset() {
   ws_.eig.Reset();
+  snap_in_progress_ = false;
   factor_valid_ = false;
   lambda_ref_ = -1.0;
 }
@@ -67,6 +68,14 @@ bool SolverBase::BeginSolve(const Vec& u, const Vec& x, SolverSummary* s) {
     return false;
   }
   ws_.last_good = x;
+  return true;
+}
+
+bool SolverBase::ContinueSnap(const Vec& u, Vec* x, SolverSummary* s) {
+  if (!snap_in_progress_) return false;
+  s->snapped = true;
+  s->termination = MinimizeFully(u, x, s) ? Termination::kConverged : Termination::kLinearSolverFailed;
+  Conclude(u, x, s, /*leave_saddles=*/true);
   return true;
 }
 
@@ -131,6 +140,12 @@ void SolverBase::Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_sad
     if (MinimizeFully(u, x, s)) s->termination = Termination::kConverged;
     Finish(*x, u, s);
   }
+  // The time budget ran out inside the snap minimiser (wherever it was started): the
+  // state is its last accepted one; the next update carries the snap on (ContinueSnap).
+  if (snap_in_progress_) {
+    s->termination = Termination::kSnapping;
+    s->message = "time budget spent inside a snap; it continues at the next update";
+  }
   // The status against the reference of the last regular state, then the reference.
   s->lambda_ref = lambda_ref_;
   s->status = DecideStatus(*s, options_.degeneracy_ratio, /*left_branch=*/false);
@@ -139,12 +154,14 @@ void SolverBase::Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_sad
 }
 
 bool SolverBase::BudgetLeft(const SolverSummary& s) const {
-  if (s.iterations >= Budget()) return false;
-  if (options_.max_time_us > 0.0) {
-    const double us = std::chrono::duration<double, std::micro>(Clock::now() - start_).count();
-    if (us >= options_.max_time_us) return false;
-  }
-  return true;
+  // Every update takes at least one iteration, whatever the clock says (a budget below
+  // one iteration, or a preempted thread, must not stall the state for good).
+  return s.iterations < Budget() && (s.iterations == 0 || !TimeSpent());
+}
+
+bool SolverBase::TimeSpent() const {
+  if (!(options_.max_time_us > 0.0)) return false;
+  return std::chrono::duration<double, std::micro>(Clock::now() - start_).count() >= options_.max_time_us;
 }
 
 double SolverBase::EvalGradient(const Vec& x, const Vec& u, Vec* g, SolverSummary* s) const {
@@ -267,8 +284,15 @@ bool SolverBase::MinimizeFully(const Vec& u, Vec* x, SolverSummary* s) {
   // A snap across a symmetry axis goes round the orbit: move there on the circle first.
   MoveAlongSymmetries(u, x);
   double r = EvalGradient(*x, u, s);
+  snap_in_progress_ = false;
   for (int it = 0; it < kMaxIterations; ++it) {
     if (!std::isfinite(r)) return false;
+    // The time budget caps a snap too (DESIGN.md #4 finishes it inside its update only
+    // without one): stop at an accepted state, carry on at the next update.
+    if (it > 0 && r >= options_.cutoff && TimeSpent()) {
+      snap_in_progress_ = true;
+      return false;
+    }
     if (r < options_.cutoff) {
       // Stationary: a minimum only if E_xx has no negative pivot.
       if (FactorAt(*x, u, s) != LinearSolverStatus::kSuccess || ws_.factor->NegativePivots() == 0) return true;
@@ -328,7 +352,7 @@ NewtonSolver::NewtonSolver(const Model& model, const SolverOptions& options, boo
 
 SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
   SolverSummary s;
-  if (!BeginSolve(u, *x, &s)) return s;
+  if (!BeginSolve(u, *x, &s) || ContinueSnap(u, x, &s)) return s;
   double r = EvalGradient(*x, u, &s);
   s.termination = Termination::kBudgetSpent;
   while (NextIteration(r, x, &s)) {

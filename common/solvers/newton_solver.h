@@ -35,6 +35,10 @@ class SolverBase : public EquilibriumSolver {
   // Returns false, with summary->termination = kInvalidInput and a message, when x or
   // u has the wrong size or is not finite: then the method must return at once.
   bool BeginSolve(const Vec& u, const Vec& x, SolverSummary* s);
+  // After BeginSolve: when the last update ran out of time inside a snap (kSnapping),
+  // carries the snap on from x (the snap's last state) with the minimiser, concludes
+  // and returns true: the method returns s at once. Otherwise false.
+  bool ContinueSnap(const Vec& u, Vec* x, SolverSummary* s);
   // Loop head shared by every method: stops on a non-finite residual (restoring the last
   // finite state), on convergence or when the budget is spent; otherwise counts the
   // iteration, remembers the state and returns true.
@@ -101,6 +105,9 @@ class SolverBase : public EquilibriumSolver {
   };
 
   bool BudgetLeft(const SolverSummary& s) const;
+  // The time budget (options.max_time_us > 0) is spent: one steady_clock read per
+  // iteration is the whole cost of the check.
+  bool TimeSpent() const;
   int Budget() const;
   // Factorises E_xx + shift I into the second factorisation (the pattern has the diagonal).
   LinearSolverStatus FactorShifted(double shift, SolverSummary* s);
@@ -124,6 +131,8 @@ class SolverBase : public EquilibriumSolver {
   // Finish() may use it instead of factorising again (kReuseStep).
   bool factor_before_tiny_step_ = false;
   double lambda_ref_ = -1.0;     // lambda_0 at the last regular converged state
+  // MinimizeFully stopped at the time budget: the snap goes on at the next update.
+  bool snap_in_progress_ = false;
   double best_residual_ = 0.0;   // stagnation tracking in NextIteration
   int stalled_iterations_ = 0;
   Clock::time_point start_;

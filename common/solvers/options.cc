@@ -12,7 +12,7 @@ bool SolverOptions::IsValid(std::string* error) const {
   if (!(cutoff > 0.0) || !std::isfinite(cutoff)) return fail("solver.cutoff: expected a finite number > 0");
   if (max_iterations < 0) return fail("solver.max_iterations: expected an integer >= 0 (0 = unlimited)");
   if (!(max_time_us >= 0.0) || !std::isfinite(max_time_us))
-    return fail("solver.max_time_us: expected a finite number >= 0 (0 = none)");
+    return fail("solver.time_budget_us: expected a finite number >= 0 (0 = none)");
   if (!(degeneracy_ratio > 0.0 && degeneracy_ratio < 1.0))
     return fail("solver.degeneracy_ratio: expected a number in (0, 1)");
   if (!(max_reduction_step > 0.0) || !std::isfinite(max_reduction_step))

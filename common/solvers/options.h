@@ -17,7 +17,10 @@ struct SolverOptions {
   // Iteration budget per control update; 0 means unlimited (capped at
   // kUnlimitedIterations as a safety net).
   int max_iterations = 50;
-  // Wall-clock budget per update in microseconds; 0 = none.
+  // Wall-clock budget per update in microseconds; 0 = none (scene key
+  // solver.time_budget_us, --time-budget-us). It caps a snap too: an update that runs out
+  // inside one returns its last accepted state as kSnapping and the next update carries
+  // the snap on (docs/time-budget.md). Checked once per iteration (a steady_clock read).
   double max_time_us = 0.0;
   // Linear algebra backend (see MakeLinearSolver).
   std::string linear_solver = "auto";

@@ -1,5 +1,6 @@
 #include "solvers/summary.h"
 
+#include <cmath>
 #include <cstdio>
 
 namespace snapthread {
@@ -11,6 +12,7 @@ const char* ToString(Termination t) {
     case Termination::kLinearSolverFailed: return "linear-solver-failed";
     case Termination::kNonFinite: return "non-finite";
     case Termination::kInvalidInput: return "invalid-input";
+    case Termination::kSnapping: return "snapping";
   }
   return "unknown";
 }
@@ -20,12 +22,16 @@ const char* ToString(EquilibriumStatus s) {
     case EquilibriumStatus::kRegular: return "regular";
     case EquilibriumStatus::kNearFold: return "near-fold";
     case EquilibriumStatus::kSnapped: return "snapped";
+    case EquilibriumStatus::kSnapping: return "snapping";
+    case EquilibriumStatus::kFailed: return "failed";
   }
   return "unknown";
 }
 
 bool SolverSummary::IsSolutionUsable() const {
-  return termination == Termination::kConverged || termination == Termination::kBudgetSpent;
+  const bool usable_end = termination == Termination::kConverged || termination == Termination::kBudgetSpent ||
+                          termination == Termination::kSnapping;
+  return usable_end && std::isfinite(residual) && std::isfinite(energy);
 }
 
 std::string SolverSummary::BriefReport() const {
@@ -45,6 +51,8 @@ bool NearFold(double lambda_min, int negative_pivots, double lambda_ref, double 
 }
 
 EquilibriumStatus DecideStatus(const SolverSummary& s, double degeneracy_ratio, bool left_branch) {
+  if (!s.IsSolutionUsable()) return EquilibriumStatus::kFailed;
+  if (s.termination == Termination::kSnapping) return EquilibriumStatus::kSnapping;
   if (left_branch) return EquilibriumStatus::kSnapped;
   return NearFold(s.lambda_min, s.negative_pivots, s.lambda_ref, degeneracy_ratio)
              ? EquilibriumStatus::kNearFold

@@ -12,12 +12,19 @@ enum class Termination {
   kLinearSolverFailed,  // factorisation failed and no fallback could proceed
   kNonFinite,           // a NaN/Inf appeared; the state was restored
   kInvalidInput,        // the state or the controls had the wrong size or were not finite
+  // The time budget (SolverOptions::max_time_us) ran out inside a snap: the state is the
+  // snap minimiser's last accepted (energy-decreasing) one, no equilibrium; the next
+  // update carries the snap on.
+  kSnapping,
 };
 const char* ToString(Termination t);
 
 // What the equilibrium looks like to a user of the force: regular, near a fold
-// (E_xx nearly singular: stiffness from the reduction), or the state just snapped.
-enum class EquilibriumStatus { kRegular = 0, kNearFold = 1, kSnapped = 2 };
+// (E_xx nearly singular: stiffness from the reduction), or the state just snapped;
+// snapping: no equilibrium yet, a snap spread over updates by the time budget is under
+// way; failed: no usable state (the solve failed, or a residual or energy is NaN or
+// infinite) — never a force model.
+enum class EquilibriumStatus { kRegular = 0, kNearFold = 1, kSnapped = 2, kSnapping = 3, kFailed = 4 };
 const char* ToString(EquilibriumStatus s);
 
 struct SolverSummary {
@@ -42,9 +49,10 @@ struct SolverSummary {
   std::string message;
 
   bool IsConverged() const { return termination == Termination::kConverged; }
-  // False when the returned state is no usable equilibrium (the linear solver failed,
-  // a NaN appeared, the input was invalid): its force must not be rendered. A spent
-  // budget is usable: the state is the last accepted one.
+  // False when the returned state is no usable state (the linear solver failed, a NaN
+  // appeared, the input was invalid, the residual or energy is not finite): its force
+  // must not be rendered. A spent budget is usable: the state is the last accepted one;
+  // so is a snap under way (kSnapping), though it is no equilibrium.
   bool IsSolutionUsable() const;
   std::string BriefReport() const;
 };
@@ -61,6 +69,8 @@ bool NearFold(double lambda_min, int negative_pivots, double lambda_ref, double 
 // of branch); the tracker calls it again with left_branch = whether the state jumped to
 // another branch, and everything downstream (sweep CSV, server messages) reads
 // summary.status:
+//   failed     !summary.IsSolutionUsable() (it outranks everything);
+//   snapping   termination kSnapping (a snap under way: no branch to judge yet);
 //   snapped    left_branch (it outranks a near-fold verdict at the new state);
 //   near-fold  NearFold(summary.lambda_min, .negative_pivots, .lambda_ref, ratio);
 //   regular    otherwise.

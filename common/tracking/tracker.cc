@@ -14,6 +14,7 @@ EquilibriumTracker::EquilibriumTracker(std::unique_ptr<Model> model, const Solve
   x_ = Vec::Zero(n);
   x_prev_ = x_;
   x_pred_ = x_;
+  snap_origin_ = x_;
   u_ = Vec::Zero(m);
   u_prev_ = u_;
   eu_.resize(m);
@@ -101,6 +102,9 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   // 2 x_{i-1} - x_{i-2}, scaled by how much of the previous control step the new one
   // repeats (the secant is reset by a snap; the tangent at the new branch is valid).
   x_pred_ = x_;
+  // A snap cut by the time budget goes on from its last state: no prediction from a
+  // state that is no equilibrium (neither the tangent nor the secant is kept for it).
+  const bool continuing_snap = result_.summary.termination == Termination::kSnapping;
   const bool tangent_ok = have_tangent_ && !result_.stiffness_regularized &&
                           result_.summary.status != EquilibriumStatus::kNearFold;
   if (options_.secant_predictor && tangent_ok) {
@@ -124,11 +128,13 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   // A snap is a jump to another branch: the state left the predicted one by more than
   // the threshold (for every method alike, so the charts compare like with like). The
   // status is DecideStatus's, now with that fact.
-  const double jump = (x_ - x_pred_).lpNorm<Eigen::Infinity>();
+  // A snap spread over updates jumps from the state predicted where it began.
+  if (!continuing_snap) snap_origin_ = x_pred_;
+  const double jump = (x_ - snap_origin_).lpNorm<Eigen::Infinity>();
   result_.summary.status = DecideStatus(result_.summary, options_.degeneracy_ratio, jump > snap_threshold_);
   result_.snapped = result_.summary.status == EquilibriumStatus::kSnapped;
-  // After a snap the secant would point along the jump: restart it.
-  have_prev_ = !result_.snapped;
+  // After a snap the secant would point along the jump: restart it (and during one).
+  have_prev_ = !result_.snapped && result_.summary.status != EquilibriumStatus::kSnapping;
   ComputeForces();
   model_->AcceptState(x_, u_);
   return result_;
@@ -147,6 +153,16 @@ void EquilibriumTracker::ComputeForces() {
   m.ControlHessian(x_, u_, &euu_);
   m.MixedHessian(x_, u_, &exu_);
   result_.stiffness_regularized = false;
+  if (result_.summary.status == EquilibriumStatus::kSnapping) {
+    // Mid-snap (time budget): the state is an accepted, energy-decreasing one but no
+    // equilibrium, so there is no implicit derivative. The force of that state with
+    // K = 0: the device renders a constant force that moves on towards the new branch
+    // update by update, never a stiffness extrapolated from a non-equilibrium.
+    result_.stiffness.setZero();
+    result_.stiffness_regularized = true;
+    have_tangent_ = false;
+    return;
+  }
   // All columns of E_xx^-1 E_xu in one pass over the factor the solver returned.
   const SymmetricLinearSolver* f = solver_->Factorization();
   const bool ok = f != nullptr && f->SolveMany(exu_, &sol_) == LinearSolverStatus::kSuccess && sol_.allFinite();

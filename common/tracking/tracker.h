@@ -62,6 +62,7 @@ class EquilibriumTracker {
   SolverOptions options_;
   std::unique_ptr<EquilibriumSolver> solver_;
   Vec x_, x_prev_, u_, u_prev_;
+  Vec snap_origin_;  // the predicted state of the update where the current snap began
   bool have_prev_ = false;
   bool have_tangent_ = false;  // sol_ holds E_xx^-1 E_xu of the current state
   double snap_threshold_ = 0.1;

@@ -174,6 +174,16 @@ TEST(ServerMessagesTest, StatusFlags) {
   r.summary.termination = Termination::kInvalidInput;
   EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_INVALID);
   EXPECT_EQ(ClassifyStatus(nullptr), force_model_t::STATUS_INVALID);
+  // A snap spread over updates by the time budget (docs/time-budget.md).
+  r.summary.termination = Termination::kSnapping;
+  r.summary.status = EquilibriumStatus::kSnapping;
+  r.snapped = false;
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_SNAPPING);
+  // A NaN residual is a failed row, never a force model.
+  r.summary.termination = Termination::kConverged;
+  r.summary.status = EquilibriumStatus::kFailed;
+  r.summary.residual = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(ClassifyStatus(&r), force_model_t::STATUS_INVALID);
 }
 
 TEST(ServerMessagesTest, NonFiniteResultBecomesInvalidZeroModel) {
@@ -199,17 +209,14 @@ TEST(ServerMessagesTest, NonFiniteResultBecomesInvalidZeroModel) {
     EXPECT_TRUE(transport::Validate(m, nullptr)) << "variant " << variant;
     std::string why;
     EXPECT_TRUE(transport::Validate(m, &why)) << why;
-    if (variant < 3) {
-      EXPECT_EQ(m.status, force_model_t::STATUS_INVALID) << "variant " << variant;
-      for (int i = 0; i < 3; ++i) {
-        EXPECT_EQ(m.f0[i], 0.0);
-        for (int j = 0; j < 3; ++j) EXPECT_EQ(m.K[i][j], 0.0);
-      }
-    } else {
-      // A NaN residual alone does not invalidate a finite force: it is reported as 0.
-      EXPECT_EQ(m.status, force_model_t::STATUS_REGULAR);
-      EXPECT_EQ(m.residual, 0.0);
+    // A NaN residual says the state itself is not finite (issue 13: NaN or inf rows are
+    // failed, never a force model), even where the force happened to be finite.
+    EXPECT_EQ(m.status, force_model_t::STATUS_INVALID) << "variant " << variant;
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(m.f0[i], 0.0);
+      for (int j = 0; j < 3; ++j) EXPECT_EQ(m.K[i][j], 0.0);
     }
+    EXPECT_TRUE(std::isfinite(m.residual)) << "variant " << variant;
   }
   // A failed update (no result) is INVALID too, with the pose echoed.
   ForceModelInputs in;

@@ -234,7 +234,9 @@ TEST(TransportValidateTest, RejectsNonFiniteForceModel) {
     auto e = Sample<force_model_t>(); e.residual = bad; EXPECT_FALSE(Validate(e, nullptr));
   }
   auto s = Sample<force_model_t>();
-  s.status = 4;
+  s.status = force_model_t::STATUS_SNAPPING;  // the last status constant
+  EXPECT_TRUE(Validate(s, nullptr));
+  s.status = force_model_t::STATUS_SNAPPING + 1;
   EXPECT_FALSE(Validate(s, nullptr));
   s.status = -1;
   EXPECT_FALSE(Validate(s, nullptr));
