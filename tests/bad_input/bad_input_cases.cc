@@ -240,7 +240,22 @@ std::vector<Case> CommandLineCases() {
       {"snapthread-linear-bench", {"--ring", "--thread3d"}, none, "--ring"},
       {"snapthread-linear-bench", {"--bogus"}, none, "--bogus"},
       {"snapthread-linear-bench", {"--sizes"}, none, "--sizes"},
-      // deploy/run_session.sh: the session wrapper around lcm-logger and the binaries
+      // snapthread-logger
+      {"snapthread-logger", {"-l", "{url}", "-f", "{in}"}, Kind(InputKind::kFifo), "not a regular file"},
+      {"snapthread-logger", {"-l", "{url}", "-f", "{in}"}, Kind(InputKind::kDevZero), "not a regular file"},
+      {"snapthread-logger", {"-l", "{url}", "-f", "{in}"}, Kind(InputKind::kDirectory), "directory"},
+      {"snapthread-logger", {"-l", "{url}", "{in}"}, Text("a log"), "--force"},
+      {"snapthread-logger", {"-l", "{url}", "{dir}/no/such/dir/x.lcmlog"}, none, "cannot write"},
+      {"snapthread-logger", {"-l", "{url}", "--duration-s", "nan", "{dir}/x.lcmlog"}, none, "--duration-s"},
+      {"snapthread-logger", {"-l", "{url}", "--duration-s", "-5", "{dir}/x.lcmlog"}, none, "--duration-s"},
+      {"snapthread-logger", {"-l", "{url}", "--flush-interval", "abc", "{dir}/x.lcmlog"}, none, "--flush-interval"},
+      {"snapthread-logger", {"-l", "{url}", "--flush-interval", "0", "{dir}/x.lcmlog"}, none, "--flush-interval"},
+      {"snapthread-logger", {"-l", "bogus://nowhere", "{dir}/x.lcmlog"}, none, "bogus://nowhere"},
+      {"snapthread-logger", {"-l", "{url}", "-s", ""}, none, "--strftime"},
+      {"snapthread-logger", {"-l", "{url}", "--bogus", "{dir}/x.lcmlog"}, none, "--bogus"},
+      {"snapthread-logger", {"-l", "{url}", "-c"}, none, "--channel"},
+      {"snapthread-logger", {"-l", "{url}"}, none, "file"},
+      // deploy/run_session.sh: the session wrapper around the logger and the binaries
       {run_session, {"--duration", "abc"}, none, "--duration"},
       {run_session, {"--duration", "-5"}, none, "--duration"},
       {run_session, {"--duration", "1e999"}, none, "--duration"},
