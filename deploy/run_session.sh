@@ -21,6 +21,11 @@ bin="${SNAPTHREAD_BIN_DIR:-$here/build/bin}"
 out_root="$here/out"
 key="${SNAPTHREAD_KEY_FILE:-}"
 while (($#)); do
+  # Every option takes a value: without one, say which (set -u would only say "$2: unbound").
+  case "$1" in
+    --duration|--scene|--session|--lcm-url|--bin-dir|--out-root|--key)
+      (($# >= 2)) || { echo "run_session: $1 needs a value (see --help)" >&2; exit 2; } ;;
+  esac
   case "$1" in
     --duration) duration=$2; shift 2 ;;
     --scene) scene=$2; shift 2 ;;
@@ -33,6 +38,15 @@ while (($#)); do
     *) echo "run_session: unknown argument $1" >&2; exit 2 ;;
   esac
 done
+# Bad arguments end here with a message, before a logger or server is started for a
+# session that could not run.
+[[ "$duration" =~ ^[0-9]+$ ]] && ((10#$duration >= 1 && 10#$duration <= 86400)) ||
+  { echo "run_session: --duration '$duration': expected whole seconds in [1, 86400]" >&2; exit 2; }
+duration=$((10#$duration))
+[ -f "$scene" ] && [ -r "$scene" ] ||
+  { echo "run_session: --scene '$scene': not a readable regular file" >&2; exit 2; }
+[[ "$session" =~ ^[A-Za-z0-9_]+$ ]] ||
+  { echo "run_session: --session '$session': expected [A-Za-z0-9_]+" >&2; exit 2; }
 for b in snapthread-server snapthread-device snapthread-viewer snapthread-logger snapthread-report snapthread-keygen; do
   [ -x "$bin/$b" ] || { echo "run_session: $bin/$b missing (build first: deploy/setup.sh)" >&2; exit 1; }
 done

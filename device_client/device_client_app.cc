@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -150,11 +151,24 @@ int RunDeviceClient(const DeviceClientOptions& o) {
                  o.session.c_str());
     return kExitBadArguments;
   }
-  if (!(o.rate_hz >= 100.0 && o.rate_hz <= 10000.0) || o.publish_divisor < 1 ||
-      o.trace_divisor < 1 || !(o.model_timeout_ms > 0.0) || !(o.fade_ms > 0.0) ||
-      !(o.speed_m_per_s > 0.0) || !(o.duration_s >= 0.0)) {
-    std::fprintf(stderr, "snapthread-device: options out of range (see --help)\n");
-    return kExitBadArguments;
+  // Also what CLI11's range checks let through: "nan" fails no comparison.
+  const struct {
+    const char* flag;
+    bool ok;
+  } ranges[] = {
+      {"--rate-hz", o.rate_hz >= 100.0 && o.rate_hz <= 10000.0},
+      {"--publish-divisor", o.publish_divisor >= 1},
+      {"--trace-divisor", o.trace_divisor >= 1},
+      {"--model-timeout-ms", o.model_timeout_ms > 0.0 && std::isfinite(o.model_timeout_ms)},
+      {"--fade-ms", o.fade_ms > 0.0 && std::isfinite(o.fade_ms)},
+      {"--speed-m-per-s", o.speed_m_per_s > 0.0 && std::isfinite(o.speed_m_per_s)},
+      {"--duration", o.duration_s >= 0.0 && std::isfinite(o.duration_s)},
+  };
+  for (const auto& range : ranges) {
+    if (!range.ok) {
+      std::fprintf(stderr, "snapthread-device: %s: out of range (see --help)\n", range.flag);
+      return kExitBadArguments;
+    }
   }
 
   // ---- the session key: without it nothing the server sends can be trusted -------------

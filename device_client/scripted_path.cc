@@ -1,13 +1,18 @@
 #include "scripted_path.h"
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
 #include "messages/pose_mapping.h"
+#include "scene/input_file.h"
 
 namespace snapthread::device {
+namespace {
+
+constexpr std::size_t kMaxPathCsvBytes = std::size_t{16} << 20;
+
+}  // namespace
 
 ScriptedPath::ScriptedPath(std::vector<std::array<double, 3>> waypoints_m, double speed_m_per_s)
     : waypoints_(std::move(waypoints_m)), speed_m_per_s_(speed_m_per_s) {
@@ -47,8 +52,9 @@ ScriptedPath ScriptedPath::FromScene(const Scene& scene, double speed_m_per_s) {
 }
 
 ScriptedPath ScriptedPath::FromCsv(const std::string& path, double speed_m_per_s) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open path CSV");
+  // Bounded and non-blocking (a FIFO or /dev/zero is refused, not waited on); a path of
+  // 16 MiB is over 500k waypoints.
+  std::istringstream in(ReadInputFile(path, kMaxPathCsvBytes, "path CSV"));
   std::vector<std::array<double, 3>> pts;
   std::string line;
   int line_no = 0;

@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <sys/signalfd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <exception>
@@ -34,6 +35,10 @@ int main(int argc, char** argv) {
   app.add_option("--flush-interval", o.flush_interval_ms, "flush the file every MS milliseconds")
       ->capture_default_str()->check(CLI::Range(1, 10000));
   CLI11_PARSE(app, argc, argv);
+  if (!std::isfinite(o.duration_s)) {  // CLI11's NonNegativeNumber lets "nan" through
+    std::fprintf(stderr, "snapthread-logger: --duration-s: expected a finite number\n");
+    return 1;
+  }
   if (use_strftime) {
     const std::time_t now = std::time(nullptr);
     std::tm local{};

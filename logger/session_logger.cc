@@ -13,9 +13,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-bool Exists(const std::string& path) {
+// A FIFO would block the open for a reader, /dev/zero would swallow the log: only a new
+// or a regular file is a log file. Throws for anything else; true when it exists.
+bool ExistingRegularFile(const std::string& path) {
   struct stat st {};
-  return stat(path.c_str(), &st) == 0;
+  if (stat(path.c_str(), &st) != 0) return false;
+  if (!S_ISREG(st.st_mode)) {
+    throw std::runtime_error(path + " is " + (S_ISDIR(st.st_mode) ? "a directory" : "not a regular file") +
+                             " (a FIFO or device): the log must be a file");
+  }
+  return true;
 }
 
 }  // namespace
@@ -25,7 +32,7 @@ SessionLogger::SessionLogger(const LoggerOptions& options) : options_(options), 
     throw std::runtime_error("cannot open LCM at " + options_.lcm_url + ". " +
                              transport::LcmStartHint(options_.lcm_url));
   }
-  if (!options_.force && Exists(options_.path)) {
+  if (ExistingRegularFile(options_.path) && !options_.force) {
     throw std::runtime_error("refusing to overwrite existing file " + options_.path +
                              " (--force overwrites it)");
   }

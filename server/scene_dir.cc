@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "scene/input_file.h"
+
 namespace snapthread::server {
 namespace {
 
@@ -24,16 +26,6 @@ std::string RealPath(const std::string& path) {
   char buf[PATH_MAX];
   if (::realpath(path.c_str(), buf) == nullptr) return "";
   return buf;
-}
-
-const char* FileKind(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISLNK(mode)) return "a symbolic link";
-  return "not a regular file";
 }
 
 }  // namespace
@@ -99,7 +91,7 @@ std::string ReadSceneByName(const std::string& dir, const std::string& name, std
     throw SceneNameError(quoted + "cannot stat " + full + " (" + std::strerror(errno) + ")");
   }
   if (!S_ISREG(info.st_mode)) {
-    throw SceneNameError(quoted + full + " is " + FileKind(info.st_mode) +
+    throw SceneNameError(quoted + full + " is " + FileKindName(info.st_mode) +
                          ", not a regular file");
   }
   if (static_cast<unsigned long long>(info.st_size) > kMaxSceneFileBytes) {

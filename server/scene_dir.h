@@ -9,9 +9,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "scene/scene.h"
+
 namespace snapthread::server {
 
-inline constexpr size_t kMaxSceneFileBytes = 1 << 20;  // 1 MiB
+// The same 1 MiB limit as a scene named on a command line (scene/scene.h).
+using snapthread::kMaxSceneFileBytes;
 
 // The argument of LOAD_SCENE is not an acceptable scene name or file (a policy refusal,
 // counted in rejected_messages; a scene that opens but does not parse is a SceneError).

@@ -1,5 +1,6 @@
 // Scenes: every shipped scene loads; bad scenes are refused naming file, key, expectation.
 #include <fstream>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -55,7 +56,7 @@ TEST(Scenes, BadScenesNameFileKeyAndExpectation) {
   const std::vector<Bad> bad = {
       {"params: {n: 3}\ngrasp: {start: [1,2]}", "model", "missing"},
       {"model: rope\ngrasp: {start: [1,2]}", "model", "expected one of"},
-      {"model: curve2d\nparams: {n: 1}\ngrasp: {start: [9,0]}", "params.n", ">= 2"},
+      {"model: curve2d\nparams: {n: 1}\ngrasp: {start: [9,0]}", "params.n", "in [2, 100000]"},
       {"model: curve2d\nparams: {n: ten}\ngrasp: {start: [9,0]}", "params.n", "an integer"},
       {"model: curve2d\nparams: {n: 10, stretching: -5}\ngrasp: {start: [9,0]}", "params.stretching", "> 0"},
       {"model: curve2d\nparams: {n: 10, bending: .nan}\ngrasp: {start: [9,0]}", "params.bending", "finite"},
@@ -67,12 +68,30 @@ TEST(Scenes, BadScenesNameFileKeyAndExpectation) {
       {"model: zeeman\nparams: {n: 5}\ngrasp: {start: [0,3]}", "params", "no parameters"},
       {"model: curve2d\nparams: {n: 10}\ngrasp: {start: [9,0]}\ndevice: {max_force_n: -1}", "device.max_force_n", "> 0"},
       {"[1, 2", "", "not valid YAML"},
+      {"model: curve2d\nmodel: cusp\nparams: {n: 10}\ngrasp: {start: [9,0]}", "model", "duplicated key"},
+      {"model: curve2d\nparams: {n: 1000000000}\ngrasp: {start: [9,0]}", "params.n", "in [2, 100000]"},
+      {"model: " + std::string(100000, '[') + "\n", "line 1", "nested deeper than 64"},
+      {"model: curve2d\nparams: {n: 10}\ngrasp: {start: [9,0]}\n[1]: 2", "top level", "expected plain names"},
   };
   for (const Bad& b : bad) {
     const std::string e = Error(b.yaml);
     EXPECT_NE(e.find("bad.yaml"), std::string::npos) << b.yaml << " -> " << e;
     EXPECT_NE(e.find(b.key), std::string::npos) << b.yaml << " -> " << e;
     EXPECT_NE(e.find(b.expect), std::string::npos) << b.yaml << " -> " << e;
+  }
+}
+
+// A FIFO, a device or a directory is refused before it is read (an open() of a FIFO
+// would wait for a writer forever; /dev/zero never ends).
+TEST(Scenes, NonRegularFilesAreRefusedWithoutReading) {
+  for (const auto& [path, kind] : {std::pair<std::string, std::string>{"/dev/zero", "a character device"},
+                                   {"/tmp", "a directory"}}) {
+    try {
+      LoadScene(path);
+      FAIL() << path;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ": is " + kind), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -154,6 +154,7 @@ Cell Measure(const std::string& name, const SparseMatrix& a, const Vec& rhs, int
 
 int main(int argc, char** argv) {
   using namespace snapthread;
+  constexpr int kMaxSize = 100000;  // largest matrix size (or thread3d segment count)
   CLI::App app{"Factorize+Solve time of the LDL^T backends on banded SPD matrices"};
   int bandwidth = 8;
   std::vector<int> sizes = {10, 30, 100, 300, 1000, 3000};
@@ -172,6 +173,23 @@ int main(int argc, char** argv) {
   app.add_flag("--thread3d", thread3d, "real thread3d Hessians; --sizes are segment counts");
   app.add_flag("--csv", csv, "print CSV instead of a table");
   CLI11_PARSE(app, argc, argv);
+  // Checked here, naming the flag: CLI11's range checks let "nan" through, and a size of
+  // -5 or 10^9 would end in bad_alloc or minutes of allocation.
+  const auto bad = [](const std::string& message) {
+    std::fprintf(stderr, "snapthread-linear-bench: %s\n", message.c_str());
+    return 2;
+  };
+  const int min_size = thread3d ? 2 : 1;  // thread3d: segments
+  for (int size : sizes) {
+    if (size < min_size || size > kMaxSize) {
+      return bad("--sizes: expected sizes in [" + std::to_string(min_size) + ", " + std::to_string(kMaxSize) +
+                 "], got " + std::to_string(size));
+    }
+  }
+  if (bandwidth > kMaxSize) return bad("--bandwidth: expected at most " + std::to_string(kMaxSize));
+  if (dense_max < 0) return bad("--dense-max: expected an integer >= 0");
+  if (!(min_sample_us > 0.0 && min_sample_us <= 1e7)) return bad("--min-sample-us: expected a number in (0, 1e7]");
+  if (!(budget_s > 0.0 && budget_s <= 3600.0)) return bad("--budget-s: expected seconds in (0, 3600]");
 
   const std::vector<std::string> backends = {"cholmod", "dense", "banded", "auto"};
   if (thread3d && ring) {

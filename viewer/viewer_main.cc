@@ -1,6 +1,8 @@
 // snapthread-viewer: watches a session (thread shape + solver status) over LCM.
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 
@@ -47,6 +49,14 @@ int main(int argc, char** argv) {
   app.add_option("--scene", o.scene_path, "scene YAML (its device mapping; needed by --grasp-mode)")
       ->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
+  // CLI11's range checks let "nan" through (every comparison with NaN is false).
+  for (const auto& [flag, value] : {std::pair<const char*, double>{"--timeout-s", o.timeout_s},
+                                    {"--duration-s", o.duration_s}, {"--max-fps", o.max_fps}}) {
+    if (!std::isfinite(value)) {
+      std::fprintf(stderr, "snapthread-viewer: %s: expected a finite number\n", flag);
+      return snapthread::viewer::kExitSetupFailed;
+    }
+  }
   // A receiver: a kernel buffer that rides out seconds off the CPU (lcm_url.h).
   o.lcm_url = snapthread::transport::WithReceiveBuffer(snapthread::transport::ResolveLcmUrl(o.lcm_url));
   if (!snapthread::transport::IsValidSessionName(o.session)) {

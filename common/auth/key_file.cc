@@ -37,6 +37,17 @@ std::string Named(const KeyLocation& where) {
   return "session key " + where.path + " (" + where.origin + ")";
 }
 
+// The refusal of a directory, FIFO, device or socket where the key file should be.
+KeyFileError NotAKeyFile(const KeyLocation& where, mode_t mode) {
+  if (S_ISDIR(mode)) {
+    return KeyFileError(Named(where) + " is a directory. Fix: pass the key file itself, e.g. --key " +
+                        ShellQuoted(where.path + "/session.key"));
+  }
+  return KeyFileError(Named(where) +
+                      " is not a regular file (a FIFO, device or socket). Fix: point --key or "
+                      "SNAPTHREAD_KEY_FILE at the 32-byte key file made by snapthread-keygen");
+}
+
 std::string HomeDir(const EnvLookup& env) {
   if (const char* home = env("HOME"); home != nullptr && home[0] != '\0') return home;
   std::vector<char> buf(16384);
@@ -162,15 +173,7 @@ SessionKey LoadKey(const KeyLocation& where) {
   if (fstat(fd.get(), &st) != 0) {
     throw KeyFileError("cannot stat " + Named(where) + ": " + Errno(errno));
   }
-  if (S_ISDIR(st.st_mode)) {
-    throw KeyFileError(Named(where) + " is a directory. Fix: pass the key file itself, e.g. --key " +
-                       ShellQuoted(path + "/session.key"));
-  }
-  if (!S_ISREG(st.st_mode)) {
-    throw KeyFileError(Named(where) +
-                       " is not a regular file (a FIFO, device or socket). Fix: point --key or "
-                       "SNAPTHREAD_KEY_FILE at the 32-byte key file made by snapthread-keygen");
-  }
+  if (!S_ISREG(st.st_mode)) throw NotAKeyFile(where, st.st_mode);
   if ((st.st_mode & 077) != 0) {
     char mode[8];
     std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
@@ -234,6 +237,9 @@ void WriteNewKey(const KeyLocation& where, bool overwrite) {
   const int err = errno;
   if (!overwrite || done != 0) unlink(tmp.c_str());
   if (done != 0) {
+    // A directory or a device in the key's place is no key to keep: say what it is.
+    struct stat st {};
+    if (lstat(where.path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) throw NotAKeyFile(where, st.st_mode);
     if (err == EEXIST) {
       throw KeyFileError("refusing to overwrite the existing " + Named(where) +
                          ": every machine of the session holds a copy. Fix: pass --force to "

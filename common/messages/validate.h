@@ -53,6 +53,17 @@ bool DecodeAndValidate(const void* data, int size, T* out, std::string* why) {
       if (why) *why = "empty buffer";
       return false;
     }
+    // The type fingerprint first: another type (or another version of this one) is named
+    // as such, not as a "malformed buffer".
+    int64_t hash = 0;
+    if (__int64_t_decode_array(data, 0, size, &hash, 1) != 8) {
+      if (why) *why = std::string(T::getTypeName()) + " truncated (" + std::to_string(size) + " bytes)";
+      return false;
+    }
+    if (hash != T::getHash()) {
+      if (why) *why = std::string("wrong type fingerprint: not a ") + T::getTypeName() + " of this version";
+      return false;
+    }
     if (!PreDecodeCheck<T>(data, size, why)) return false;
     const int used = out->decode(data, 0, size);
     if (used < 0) {

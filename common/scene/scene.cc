@@ -1,14 +1,45 @@
 #include "scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
+
+#include "scene/input_file.h"
 
 namespace snapthread {
 namespace {
+
+// Deepest [ ] / { } nesting a scene may have. The shipped scenes nest 3 deep; yaml-cpp
+// takes seconds to scan a megabyte of open brackets before its own depth guard fires,
+// so the text is checked first. Brackets inside strings count too (a bound, not a
+// parse), which leaves any real scene far below the limit.
+constexpr int kMaxFlowNesting = 64;
+
+// The deepest bracket nesting of the raw text, and where it first exceeds `limit`.
+int FlowNesting(const std::string& text, int limit, int* line, int* column) {
+  int depth = 0, deepest = 0, l = 1, c = 0;
+  for (const char ch : text) {
+    ++c;
+    if (ch == '\n') {
+      ++l;
+      c = 0;
+    } else if (ch == '[' || ch == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (depth > limit) {
+        *line = l;
+        *column = c;
+        return depth;
+      }
+    } else if ((ch == ']' || ch == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return deepest;
+}
 
 class Reader {
  public:
@@ -55,8 +86,15 @@ class Reader {
   }
   void CheckKeys(const YAML::Node& n, const std::string& key, std::set<std::string> allowed) const {
     if (!n.IsMap()) Fail(key, "expected a mapping, got '" + Dump(n) + "'");
+    std::set<std::string> seen;
     for (const auto& kv : n) {
+      if (!kv.first.IsScalar()) {
+        Fail(key.empty() ? "top level" : key, "expected plain names as keys, got '" + Dump(kv.first) + "'");
+      }
       const std::string k = kv.first.as<std::string>();
+      // yaml-cpp keeps both entries of a repeated key and lookups see the first: refuse
+      // it rather than silently ignore one of the two values.
+      if (!seen.insert(k).second) Fail(key.empty() ? k : key + "." + k, "duplicated key");
       if (!allowed.count(k)) {
         std::string list;
         for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
@@ -157,9 +195,19 @@ SceneOverride ParseOverride(const std::string& text) {
 Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
                  const std::vector<SceneOverride>& overrides) {
   Reader rd(file_label);
+  int line = 0, column = 0;
+  if (FlowNesting(yaml_text, kMaxFlowNesting, &line, &column) > kMaxFlowNesting) {
+    throw SceneError(file_label + ": brackets nested deeper than " + std::to_string(kMaxFlowNesting) +
+                     " levels at line " + std::to_string(line) + ", column " + std::to_string(column) +
+                     " (not a scene)");
+  }
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
+  } catch (const YAML::DeepRecursion& e) {
+    throw SceneError(file_label + ": nested deeper than " + std::to_string(e.depth()) + " levels at line " +
+                     std::to_string(e.mark.line + 1) + ", column " + std::to_string(e.mark.column + 1) +
+                     " (not a scene)");
   } catch (const YAML::Exception& e) {
     throw SceneError(file_label + ": not valid YAML: " + e.what());
   }
@@ -284,11 +332,13 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
 }
 
 Scene LoadScene(const std::string& path, const std::vector<SceneOverride>& overrides) {
-  std::ifstream in(path);
-  if (!in) throw SceneError(path + ": cannot open scene file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ParseScene(ss.str(), path, overrides);
+  std::string text;
+  try {
+    text = ReadInputFile(path, kMaxSceneFileBytes, "scene file");
+  } catch (const InputFileError& e) {
+    throw SceneError(e.what());
+  }
+  return ParseScene(text, path, overrides);
 }
 
 }  // namespace snapthread

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -52,6 +53,12 @@ struct SceneOverride {
   std::string value;
 };
 
+// Largest scene file LoadScene reads (the shipped scenes are under 2 kB): a wrong file
+// (a log, an image, /dev/zero) is refused by its size before any parsing.
+inline constexpr std::size_t kMaxSceneFileBytes = std::size_t{1} << 20;  // 1 MiB
+
+// Reads `path` (a regular file of at most kMaxSceneFileBytes, opened without blocking:
+// a FIFO or a device is refused, scene/input_file.h) and parses it.
 Scene LoadScene(const std::string& path, const std::vector<SceneOverride>& overrides = {});
 Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
                  const std::vector<SceneOverride>& overrides = {});

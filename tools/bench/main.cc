@@ -3,10 +3,12 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 
@@ -29,8 +31,11 @@ std::vector<int> ParseBudgets(const std::string& s) {
 }
 
 std::vector<int> ParseCounts(const std::string& s, const char* what) {
-  return ParseList<int>(s, what, "is not a segment count (integer >= 2)",
-                        [](const std::string& item, int* k) { return ParseWhole(item, k) && *k >= 2; });
+  // At most the models' own limit on n (10^9 would allocate for minutes first).
+  return ParseList<int>(s, what, "is not a segment count (integer in [2, 100000])",
+                        [](const std::string& item, int* k) {
+                          return ParseWhole(item, k) && *k >= 2 && *k <= 100000;
+                        });
 }
 
 std::vector<double> ParseCutoffs(const std::string& s) {
@@ -98,6 +103,12 @@ int main(int argc, char** argv) {
   app.add_option("--reference-n", reference_n, "advise: segments of the reference model (default 2 max(n, ladder max))")
       ->check(CLI::Range(2, 100000));
   return RunTool("snapthread-bench", app, argc, argv, [&]() -> int {
+    // CLI11's range checks let "nan" through (it fails no comparison).
+    for (const auto& [flag, value] : {std::pair<const char*, double>{"--service-duration", service_duration},
+                                      {"--target-force-error", target_force_error},
+                                      {"--target-rate-hz", target_rate_hz}}) {
+      if (!std::isfinite(value)) throw std::invalid_argument(std::string(flag) + ": expected a finite number");
+    }
     const std::string machine = MachineDescription();
     std::cerr << "snapthread-bench: " << machine << (quick ? " (quick)" : "") << '\n';
     const auto t_start = std::chrono::steady_clock::now();
