@@ -2,10 +2,12 @@
 // front, chain resizing, the hand-speed paths, JSON reading, and the advisor's choice.
 // No timed assertions: rates are only checked to be consistent with the choice made.
 #include <cmath>
+#include <random>
 
 #include <gtest/gtest.h>
 
 #include "bench.h"
+#include "path.h"
 #include "models/models.h"
 #include "test_util.h"
 
@@ -367,6 +369,56 @@ TEST(BenchAdvisor, UsesTheTargetsTheSceneStates) {
   EXPECT_DOUBLE_EQ(a.target_force_error, 10.0);
   EXPECT_DOUBLE_EQ(a.target_rate_hz, 1.0);
 }
+
+}  // namespace
+}  // namespace snapthread
+
+namespace snapthread {
+namespace {
+
+// The path benchmark's floor must be a real factor + solve of the same system.
+TEST(BenchPath, PlainBandedFloorSolvesTheThreadHessian) {
+  const Scene base = LoadScene(std::string(SNAPTHREAD_TEST_SOURCE_DIR) + "/scenes/thread3d_loop.yaml");
+  const Scene scene = Thread3dPathScene(base, 12, PathOptions{});
+  const auto model = MakeModel(scene.params);
+  const std::vector<Vec> controls = Thread3dPathControls(scene, 4);
+  ASSERT_EQ(controls.size(), 5u);
+  EXPECT_NEAR(controls.back()[1] - controls.front()[1], 0.3, 1e-15);
+  EXPECT_NEAR(controls.back()[2] - controls.front()[2], 0.2, 1e-15);
+  const Vec x = model->InitialState(controls[0]);
+  SparseMatrix h = model->HessianPattern();
+  model->Hessian(x, controls[0], &h);
+  const Vec rhs = Vec::LinSpaced(model->NumStates(), -1.0, 2.0);
+  Vec solution;
+  ASSERT_TRUE(PlainBandedSolve(h, model->HessianBandwidth(), rhs, &solution));
+  EXPECT_LT((h * solution - rhs).norm() / rhs.norm(), 1e-9);
+}
+
+#ifdef SNAPTHREAD_HAVE_CERES
+// Ceres' residuals carry the same energy as the model: 1/2 sum r^2 + shift = E(x, u)
+// to round-off, at straight, bent and random states (and with a reference bend B).
+TEST(BenchPath, CeresResidualsGiveTheModelsEnergy) {
+  ASSERT_TRUE(CeresBuilt());
+  const Scene base = LoadScene(std::string(SNAPTHREAD_TEST_SOURCE_DIR) + "/scenes/thread3d_loop.yaml");
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.2);
+  for (int n : {3, 10, 100}) {
+    Scene scene = Thread3dPathScene(base, n, PathOptions{});
+    if (n == 10) scene.params.Set("reference_bend", 0.3);
+    const auto model = MakeModel(scene.params);
+    const Vec u = scene.grasp_start;
+    for (int trial = 0; trial < 4; ++trial) {
+      Vec x = model->InitialState(u);
+      if (trial > 0) {
+        for (int i = 0; i < x.size(); ++i) x[i] += trial * noise(rng);
+      }
+      const double e = model->Energy(x, u);
+      const double c = CeresEnergy(scene, x, u);
+      EXPECT_NEAR(c, e, 1e-12 * std::max(1.0, std::abs(e))) << "n = " << n << ", trial " << trial;
+    }
+  }
+}
+#endif
 
 }  // namespace
 }  // namespace snapthread

@@ -3,12 +3,10 @@
 // codes and a malloc-counting guard (after Drake's LimitMalloc) for the
 // "no allocation after the first Factorize()" promise of the interface.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <memory>
-#include <new>
 #include <random>
 #include <string>
 #include <utility>
@@ -17,87 +15,17 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include "allocation_counter.h"
 #include "linalg/linear_solver.h"
 #include "models/models.h"
 #include "solvers/solver.h"
-
-// ---------------------------------------------------------------------------------
-// Allocation counting. glibc lets a program replace malloc; the replacements forward
-// to __libc_* and count while the calling thread has counting switched on. This sees
-// every heap allocation: operator new (the replacement below calls malloc), Eigen's aligned_malloc
-// (std::malloc, which operator new alone would miss) and CHOLMOD's SuiteSparse_malloc.
-// operator new/delete are replaced as well, with their own counter, so the test can
-// also say "no C++ allocation" independently of the malloc interposition.
-namespace {
-std::atomic<long> g_mallocs{0};
-std::atomic<long> g_news{0};
-thread_local bool t_counting = false;
-}  // namespace
-// Under AddressSanitizer the sanitizer owns malloc: no interposition there, and the
-// allocation-counting tests run in the Release build only (deploy/test.sh).
-#if !defined(__SANITIZE_ADDRESS__)
-extern "C" void* __libc_malloc(size_t size);
-extern "C" void* __libc_calloc(size_t count, size_t size);
-extern "C" void* __libc_realloc(void* ptr, size_t size);
-extern "C" void __libc_free(void* ptr);
-
-
-extern "C" void* malloc(size_t size) {
-  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
-extern "C" void* calloc(size_t count, size_t size) {
-  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(count, size);
-}
-extern "C" void* realloc(void* ptr, size_t size) {
-  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(ptr, size);
-}
-extern "C" void free(void* ptr) { __libc_free(ptr); }
-
-void* operator new(size_t size) {
-  if (t_counting) g_news.fetch_add(1, std::memory_order_relaxed);
-  void* p = malloc(size == 0 ? 1 : size);  // counted by malloc too
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-void* operator new[](size_t size) { return operator new(size); }
-void* operator new(size_t size, const std::nothrow_t&) noexcept {
-  if (t_counting) g_news.fetch_add(1, std::memory_order_relaxed);
-  return malloc(size == 0 ? 1 : size);
-}
-void* operator new[](size_t size, const std::nothrow_t& tag) noexcept {
-  return operator new(size, tag);
-}
-void operator delete(void* p) noexcept { __libc_free(p); }
-void operator delete[](void* p) noexcept { __libc_free(p); }
-void operator delete(void* p, size_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, size_t) noexcept { __libc_free(p); }
-#endif  // !__SANITIZE_ADDRESS__
+#include "tracking/tracker.h"
 
 namespace snapthread {
 namespace {
 
-// Counts heap allocations of this thread between construction and Stop().
-class AllocationCounter {
- public:
-  AllocationCounter() : mallocs0_(g_mallocs.load()), news0_(g_news.load()) {
-    t_counting = true;
-  }
-  ~AllocationCounter() { t_counting = false; }
-  void Stop() {
-    t_counting = false;
-    mallocs_ = g_mallocs.load() - mallocs0_;
-    news_ = g_news.load() - news0_;
-  }
-  long mallocs() const { return mallocs_; }
-  long news() const { return news_; }
-
- private:
-  long mallocs0_, news0_;
-  long mallocs_ = -1, news_ = -1;
-};
+// Allocation counting: tests/support/allocation_counter.h.
+using test_support::AllocationCounter;
 
 // ---------------------------------------------------------------------------------
 // Matrices.
@@ -539,6 +467,74 @@ TEST_P(LinearSolverTest, EquilibriumSolvesAfterTheFirstDoNotAllocate) {
     for (int k = 0; k < 10; ++k) {
       u[1] += 0.01;
       terminations[k] = solver->Solve(u, &x).termination;
+    }
+    counter.Stop();
+    for (Termination t : terminations) EXPECT_EQ(t, Termination::kConverged) << method;
+    EXPECT_EQ(counter.mallocs(), 0) << method;
+    EXPECT_EQ(counter.news(), 0) << method;
+  }
+}
+
+// SolveMany() runs several right-hand sides at once (the implicit differentiation's
+// E_xu columns): each column is Solve() of that column to the last bit, and repeated
+// calls with the result already sized do not allocate.
+TEST_P(LinearSolverTest, SolveManyEqualsSolvePerColumnWithoutAllocating) {
+  std::mt19937 rng(11);
+  for (int n : {1, 5, 9, 300}) {
+    const int b = std::min(8, n - 1);
+    Mat dense = RandomSpdBand(n, b, &rng);
+    dense.diagonal().array() -= 0.3 * dense.diagonal().mean();  // indefinite
+    const SparseMatrix a = BandToSparse(dense, b);
+    auto solver = Make();
+    ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess);
+    ASSERT_EQ(solver->Factorize(a), LinearSolverStatus::kSuccess) << solver->message();
+    Mat rhs(n, 3);
+    for (int j = 0; j < 3; ++j) rhs.col(j) = RandomVector(n, &rng);
+    Mat x;
+    ASSERT_EQ(solver->SolveMany(rhs, &x), LinearSolverStatus::kSuccess);
+    ASSERT_EQ(x.rows(), n);
+    ASSERT_EQ(x.cols(), 3);
+    for (int j = 0; j < 3; ++j) {
+      Vec column;
+      ASSERT_EQ(solver->Solve(rhs.col(j), &column), LinearSolverStatus::kSuccess);
+      for (int i = 0; i < n; ++i) ASSERT_EQ(x(i, j), column[i]) << "n = " << n << ", column " << j << ", row " << i;
+    }
+    EXPECT_EQ(solver->SolveMany(rhs, &rhs), LinearSolverStatus::kInvalidInput);
+    LinearSolverStatus again = LinearSolverStatus::kInvalidInput;
+    AllocationCounter counter;
+    again = solver->SolveMany(rhs, &x);
+    counter.Stop();
+    EXPECT_EQ(again, LinearSolverStatus::kSuccess);
+    EXPECT_EQ(counter.mallocs(), 0) << "n = " << n;
+  }
+}
+
+// A whole tracker update (predictor, solve, F and K by implicit differentiation) does
+// not touch the heap once the tracker has run its first updates, for every method and
+// backend (the 1 kHz device never waits on it, but the server's solve loop should not
+// allocate per pose either).
+TEST_P(LinearSolverTest, TrackerUpdatesAfterTheFirstDoNotAllocate) {
+  ModelParams p;
+  p.model = "thread3d";
+  p.Set("n", 12);
+  for (const char* method : {"newton", "newton-ls", "higher-order"}) {
+    SolverOptions o;
+    o.method = method;
+    o.linear_solver = GetParam();
+    EquilibriumTracker tracker(MakeModel(p), o);
+    Vec u = Vec::Zero(3);
+    u << 0.8 * p.Integer("n"), 0.5, 0.1;
+    tracker.Reset(u);
+    for (int k = 0; k < 3; ++k) {
+      u[1] += 0.01;
+      tracker.Update(u);
+    }
+    std::vector<Termination> terminations(20);
+    AllocationCounter counter;
+    for (int k = 0; k < 20; ++k) {
+      u[1] += 0.01;
+      u[2] -= 0.005;
+      terminations[k] = tracker.Update(u).summary.termination;
     }
     counter.Stop();
     for (Termination t : terminations) EXPECT_EQ(t, Termination::kConverged) << method;

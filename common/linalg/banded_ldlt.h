@@ -6,6 +6,12 @@
 // triangular solves run over contiguous memory. O(n b^2) factorisation, O(n b) solve,
 // no allocation after Analyze() (Solve() allocates only if *x has the wrong size).
 //
+// Analyze() also records where each stored lower-triangle value of the pattern goes in
+// the band (scatter_) and which band slots inside the matrix the pattern leaves empty
+// (holes_, they take fill-in): Factorize() of a compressed matrix is then one pass over
+// the values without per-column bookkeeping, and the band is never cleared as a whole.
+// SolveMany() runs the right-hand sides through one pass over the factor.
+//
 // Without pivoting the factorisation exists iff every leading principal minor is
 // non-zero; for a symmetric matrix this is enough for indefinite Hessians (the
 // higher-order solver needs their inertia), and a zero / non-finite pivot is reported
@@ -13,6 +19,7 @@
 #pragma once
 
 #include <string_view>
+#include <vector>
 
 #include "linalg/ldlt_support.h"
 #include "linalg/linear_solver.h"
@@ -25,6 +32,7 @@ class BandedLdlt final : public SymmetricLinearSolver {
   LinearSolverStatus Analyze(const SparseMatrix& a) override;
   LinearSolverStatus Factorize(const SparseMatrix& a) override;
   LinearSolverStatus Solve(const Vec& b, Vec* x) const override;
+  LinearSolverStatus SolveMany(const Mat& b, Mat* x) const override;
 
   // Half-bandwidth max |i - j| of the analysed pattern (-1 before Analyze()).
   int HalfBandwidth() const { return bandwidth_; }
@@ -34,6 +42,14 @@ class BandedLdlt final : public SymmetricLinearSolver {
   int n_ = 0;
   int bandwidth_ = -1;
   Mat band_;  // (b+1) x n, see the file comment
+  // Each stored lower-triangle entry of a compressed matrix: its index in valuePtr()
+  // and its slot in band_ (strictly upper entries are not read: A is symmetric).
+  struct Scatter {
+    int value;
+    int slot;
+  };
+  std::vector<Scatter> scatter_;
+  std::vector<int> holes_;  // band slots inside the matrix that the pattern leaves empty
   bool factorized_ = false;
 };
 

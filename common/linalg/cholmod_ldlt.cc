@@ -167,6 +167,22 @@ LinearSolverStatus CholmodLdlt::Analyze(const SparseMatrix& a) {
     return LinearSolverStatus::kInvalidInput;
   }
   permuted_rhs_.setZero(n);
+  // Warm-up: one numeric factorisation (the identity on S's pattern) and one solve
+  // allocate the factor's numeric storage and cholmod_solve2's workspaces now, so that
+  // a backend used only now and then (the solvers' second factorisation, of shifted or
+  // restricted Hessians) does not allocate on its first use in the middle of a path.
+  for (int j = 0; j < n; ++j) {
+    for (int q = s_outer_[j]; q < s_outer_[j + 1]; ++q) s_values_[q] = s_inner_[q] == j ? 1.0 : 0.0;
+  }
+  cc_.status = CHOLMOD_OK;
+  if (cholmod_factorize(&s, factor_, &cc_) && cc_.status == CHOLMOD_OK) {
+    factorized_ = true;
+    const Vec zero = Vec::Zero(n);
+    Vec x;
+    Solve(zero, &x);
+    factorized_ = false;
+  }
+  std::fill(s_values_.begin(), s_values_.end(), 0.0);
   message_.clear();
   return LinearSolverStatus::kSuccess;
 }

@@ -66,6 +66,10 @@ class PatternCopy {
     if (Empty() || a.rows() != rows_ || a.cols() != cols() || a.nonZeros() != nonzeros()) {
       return false;
     }
+    if (a.isCompressed()) {  // two contiguous comparisons (the per-step case)
+      return std::equal(outer_.begin(), outer_.end(), a.outerIndexPtr()) &&
+             std::equal(inner_.begin(), inner_.end(), a.innerIndexPtr());
+    }
     for (int j = 0; j < cols(); ++j) {
       const int count = ColumnCount(a, j);
       if (count != outer_[j + 1] - outer_[j]) return false;

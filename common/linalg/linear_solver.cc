@@ -15,6 +15,18 @@ const char* ToString(LinearSolverStatus s) {
   return "unknown";
 }
 
+LinearSolverStatus SymmetricLinearSolver::SolveMany(const Mat& b, Mat* x) const {
+  if (x == nullptr || x == &b) return LinearSolverStatus::kInvalidInput;
+  if (x->rows() != b.rows() || x->cols() != b.cols()) x->resize(b.rows(), b.cols());
+  for (int j = 0; j < b.cols(); ++j) {
+    many_rhs_ = b.col(j);
+    const LinearSolverStatus st = Solve(many_rhs_, &many_x_);
+    if (st != LinearSolverStatus::kSuccess) return st;
+    x->col(j) = many_x_;
+  }
+  return LinearSolverStatus::kSuccess;
+}
+
 std::vector<std::string> LinearSolverNames() { return {"auto", "cholmod", "dense", "banded"}; }
 
 // "auto", measured with snapthread-linear-bench (Release, 2 cores shared with other

@@ -35,6 +35,12 @@ class SymmetricLinearSolver {
   virtual LinearSolverStatus Factorize(const SparseMatrix& a) = 0;
   // x = A^-1 b with the last successful factorisation. x may alias nothing.
   virtual LinearSolverStatus Solve(const Vec& b, Vec* x) const = 0;
+  // X = A^-1 B for every column of B in one call: the implicit differentiation's
+  // right-hand sides (E_xu, one column per control) share one pass over the factor in
+  // the banded backend. Column j equals Solve(B.col(j)) to the last bit. x may alias
+  // nothing; no allocation once *x has B's size (this default version copies each column
+  // through two scratch vectors, sized on the first call).
+  virtual LinearSolverStatus SolveMany(const Mat& b, Mat* x) const;
 
   // Inertia from the pivots of D in A = L D L^T (Sylvester's law of inertia): the
   // number of negative eigenvalues of A (valid after a successful Factorize()).
@@ -49,6 +55,8 @@ class SymmetricLinearSolver {
  protected:
   std::string message_;
   int negative_pivots_ = 0;
+  // SolveMany()'s scratch columns (default version only).
+  mutable Vec many_rhs_, many_x_;
   double min_abs_pivot_ = 0.0;
 };
 

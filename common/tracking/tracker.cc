@@ -21,6 +21,7 @@ EquilibriumTracker::EquilibriumTracker(std::unique_ptr<Model> model, const Solve
   exu_.resize(n, m);
   euu_.resize(m, m);
   sol_.resize(n, m);
+  du_.resize(m);
   result_.force = Vec::Zero(m);
   result_.stiffness = Mat::Zero(m, m);
 }
@@ -68,6 +69,28 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   return result_;
 }
 
+const TrackResult& EquilibriumTracker::Resume(const Vec& x, const Vec& u) {
+  if (u.size() != model_->NumControls() || x.size() != model_->NumStates())
+    throw std::invalid_argument("EquilibriumTracker::Resume: state or control size mismatch");
+  if (!x.allFinite() || !u.allFinite())
+    throw std::invalid_argument("EquilibriumTracker::Resume: non-finite state or controls");
+  solver_->Reset();
+  x_ = x;
+  u_ = u;
+  // Lagged data (the rod's reference frames) from the model's start to the saved state,
+  // so E(x, u) is the energy the state was accepted under.
+  model_->AcceptState(x_, u_);
+  result_.summary = solver_->Solve(u_, &x_);
+  result_.snapped = false;
+  have_prev_ = false;
+  have_tangent_ = false;
+  x_prev_ = x_;
+  u_prev_ = u_;
+  ComputeForces();
+  model_->AcceptState(x_, u_);
+  return result_;
+}
+
 const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   if (u.size() != model_->NumControls())
     throw std::invalid_argument("EquilibriumTracker::Update: control size mismatch");
@@ -82,7 +105,8 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   const bool tangent_ok = have_tangent_ && !result_.stiffness_regularized &&
                           result_.summary.status != EquilibriumStatus::kNearFold;
   if (options_.secant_predictor && tangent_ok) {
-    scratch_.noalias() = sol_ * (u - u_);
+    du_ = u - u_;
+    scratch_.noalias() = sol_ * du_;
     const double step = scratch_.lpNorm<Eigen::Infinity>();
     const double cap = 5.0 * snap_threshold_;
     x_pred_ -= (step > cap ? cap / step : 1.0) * scratch_;
@@ -124,13 +148,9 @@ void EquilibriumTracker::ComputeForces() {
   m.ControlHessian(x_, u_, &euu_);
   m.MixedHessian(x_, u_, &exu_);
   result_.stiffness_regularized = false;
+  // All columns of E_xx^-1 E_xu in one pass over the factor the solver returned.
   const SymmetricLinearSolver* f = solver_->Factorization();
-  bool ok = f != nullptr;
-  for (int j = 0; ok && j < exu_.cols(); ++j) {
-    scratch_ = exu_.col(j);
-    ok = f->Solve(scratch_, &x_pred_) == LinearSolverStatus::kSuccess && x_pred_.allFinite();
-    sol_.col(j) = x_pred_;
-  }
+  const bool ok = f != nullptr && f->SolveMany(exu_, &sol_) == LinearSolverStatus::kSuccess && sol_.allFinite();
   const double lambda0 = result_.summary.lambda_min;
   const bool regular_state = ok && result_.summary.negative_pivots == 0 &&
                              result_.summary.status == EquilibriumStatus::kRegular;
@@ -148,15 +168,21 @@ void EquilibriumTracker::ComputeForces() {
     }
   }
   have_tangent_ = ok;
+  Mat& k = result_.stiffness;
   if (ok) {
-    result_.stiffness = -(euu_ - exu_.transpose() * sol_);
+    // -(E_uu - E_ux sol), written without temporaries (no allocation per update).
+    k.noalias() = exu_.transpose() * sol_;
+    k -= euu_;
   }
-  if (!ok || !result_.stiffness.allFinite()) {
+  if (!ok || !k.allFinite()) {
     // No usable factorisation: the stiffness with the state held (no response), finite.
-    result_.stiffness = -euu_;
+    k = -euu_;
     result_.stiffness_regularized = true;
   }
-  result_.stiffness = 0.5 * (result_.stiffness + result_.stiffness.transpose()).eval();
+  // Symmetric part, in place: (K + K^T) / 2.
+  for (int j = 0; j < k.cols(); ++j) {
+    for (int i = j + 1; i < k.rows(); ++i) k(i, j) = k(j, i) = 0.5 * (k(i, j) + k(j, i));
+  }
 }
 
 }  // namespace snapthread

@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench.h"
+#include "path.h"
 #include "solvers/registry.h"
 #include "tool_main.h"
 
@@ -58,15 +59,15 @@ std::string ExeDir() {
 int main(int argc, char** argv) {
   CLI::App app{"snapthread-bench: speed against accuracy (Pareto), scaling with n, service latency; "
                "--advise SCENE picks the smallest model and cheapest solver meeting the scene's targets"};
-  std::string scenes_dir = SNAPTHREAD_SCENES_DIR, out_dir = "out/bench", only = "accuracy,scaling,service",
+  std::string scenes_dir = SNAPTHREAD_SCENES_DIR, out_dir = "out/bench", only = "accuracy,scaling,service,path",
               bin_dir = ExeDir(), advise, methods_text, cutoffs_text, budgets_text, ns_text, backends_text,
-              sweeps_text, ladder_text, service_scenes;
+              sweeps_text, ladder_text, service_scenes, path_ns_text;
   std::vector<std::string> sets;
   bool quick = false, no_plot = false, fixed_length = false;
-  int repetitions = 0, reference_n = 0;
+  int repetitions = 0, reference_n = 0, path_steps = 0;
   double service_duration = 0.0, target_force_error = 0.0, target_rate_hz = 0.0;
   app.add_flag("--quick", quick, "small grids, one repetition, short service run (for development)");
-  app.add_option("--only", only, "benchmarks to run: accuracy,scaling,service,rod (comma-separated)");
+  app.add_option("--only", only, "benchmarks to run: accuracy,scaling,service,path,rod (comma-separated)");
   app.add_option("--out", out_dir, "output folder (CSV, gnuplot scripts, PNG charts, summary.txt)");
   app.add_option("--scenes", scenes_dir, "folder with the scene files");
   app.add_option("--bin-dir", bin_dir, "folder with snapthread-server and snapthread-device (service)");
@@ -80,6 +81,9 @@ int main(int argc, char** argv) {
   app.add_flag("--fixed-length", fixed_length,
                "scaling: keep the thread's total length (finer segments) instead of n segments of length L");
   app.add_option("--backends", backends_text, "scaling: linear solvers (default auto,banded,cholmod,dense)");
+  app.add_option("--path-ns", path_ns_text, "path: segment counts (default 10,100,1000)");
+  app.add_option("--path-steps", path_steps, "path: control steps per n (default 1000, quick 200)")
+      ->check(CLI::Range(1, 1000000));
   app.add_option("--service-scenes", service_scenes, "service: scene names (default curve2d_snap,thread3d_loop)");
   app.add_option("--service-duration", service_duration, "service: seconds per run (default 10, quick 3)")
       ->check(CLI::Range(1.0, 600.0));
@@ -127,8 +131,8 @@ int main(int argc, char** argv) {
     const auto parts = SplitList(only);
     auto want = [&](const char* p) { return std::find(parts.begin(), parts.end(), p) != parts.end(); };
     for (const auto& p : parts)
-      if (p != "accuracy" && p != "scaling" && p != "service" && p != "rod")
-        throw std::invalid_argument("--only: unknown benchmark '" + p + "' (accuracy, scaling, service, rod)");
+      if (p != "accuracy" && p != "scaling" && p != "service" && p != "path" && p != "rod")
+        throw std::invalid_argument("--only: unknown benchmark '" + p + "' (accuracy, scaling, service, path, rod)");
     fs::create_directories(out_dir);
     const std::string out_abs = fs::absolute(out_dir).string();
     std::ofstream summary(fs::path(out_dir) / "summary.txt");
@@ -202,6 +206,27 @@ int main(int argc, char** argv) {
         std::ofstream(script) << ScalingGnuplot(rows, fits, out_abs, out_abs + "/bench_scaling.png", fixed_length);
         plots_ok = RunGnuplot(script) && plots_ok;
       }
+    }
+
+    if (want("path")) {
+      PathOptions o;
+      if (quick) {
+        o.steps = 200;
+        o.floor_samples = 51;
+      }
+      if (!path_ns_text.empty()) o.ns = ParseCounts(path_ns_text, "--path-ns");
+      if (path_steps > 0) o.steps = path_steps;
+      const auto rows = RunPathBench(scenes_dir, o, &std::cerr);
+      std::ostringstream table;
+      table << "== path: thread3d (n - 0.5, 0.5, 0) -> (n - 0.5, 0.8, 0.2), " << o.steps << " steps, " << o.method
+            << "/" << o.backend << ", cutoff " << o.cutoff
+            << "; medians over the updates; floor = plain banded LDL^T factor + solve of the last row's E_xx\n";
+      PrintPathTable(rows, table);
+      std::cout << table.str();
+      summary << table.str() << '\n';
+      const std::string script = (fs::path(out_dir) / "bench_path.gp").string();
+      std::ofstream(script) << PathGnuplot(rows, out_abs, out_abs + "/bench_path.png");
+      if (!no_plot) plots_ok = RunGnuplot(script) && plots_ok;
     }
 
     if (want("service")) {
