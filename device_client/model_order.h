@@ -8,11 +8,12 @@
 //  * the server's solve. A server that answered a late pose after a newer one sends a
 //    model for a newer pose from an older state; across a snap that is the old branch.
 //    Signed sessions get the solve order from auth_seq (common/auth refuses a model whose
-//    auth_seq is not above the last accepted one), which continues across a server resumed
-//    from its checkpoint with the same epoch. Unsigned (in-process) sessions have no
-//    auth_seq, so the solve number `seq` is used within one epoch; it is not used when
-//    signed because a resumed server numbers its models afresh under the same epoch and a
-//    floor on seq would hold the device in its fade until it caught up.
+//    auth_seq is not above the last accepted one within the server's epoch; a restarted
+//    or resumed server starts a new epoch, which the device learns from its authenticated
+//    status). Unsigned (in-process) sessions have no auth_seq, so the solve number `seq`
+//    is used within one epoch. It is not used when signed: auth_seq already orders the
+//    solves, and two counters for one order would be one more way to hold the device in
+//    its fade.
 // The real server solves only the newest pose and its auth_seq filter refuses a late one,
 // so its models come in pose order; the rule still holds for any sender.
 //

@@ -148,7 +148,7 @@ void ForceSafety::Step(const double position_m[3], bool pose_ok, const LocalMode
   gain_ = std::clamp(stale ? gain_ - dgain : gain_ + dgain, 0.0, 1.0);
   out->gain = gain_;
 
-  // A pose we cannot trust gets zero force at once (releasing force is always safe).
+  // A pose we cannot trust: no force from the model (fades below, at the slew limit).
   bool pose_good = pose_ok;
   if (pose_good) {
     double r2 = 0.0;
@@ -163,7 +163,18 @@ void ForceSafety::Step(const double position_m[3], bool pose_ok, const LocalMode
   if (!pose_good) {
     out->pose_rejected = true;
     Bump(counters_.poses_rejected);
-    for (double& f : last_force_n_) f = 0.0;
+    // No trusted position to evaluate the model at: the force only fades, toward zero at
+    // the slew limit (the envelope |F(t) - F(t-1)| <= max rate x tick holds here too), so a
+    // glitching encoder neither pushes on nor jerks the hand.
+    const double step = limits_.max_force_rate_n_per_s * limits_.tick_period_s;
+    const double n = std::sqrt(last_force_n_[0] * last_force_n_[0] +
+                               last_force_n_[1] * last_force_n_[1] +
+                               last_force_n_[2] * last_force_n_[2]);
+    const double keep = (std::isfinite(n) && n > step) ? (n - step) / n : 0.0;
+    for (int k = 0; k < 3; ++k) {
+      last_force_n_[k] *= keep;
+      out->force_n[k] = last_force_n_[k];
+    }
     return;
   }
 

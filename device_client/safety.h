@@ -5,7 +5,8 @@
 //    and clamps its stiffness to the stable range. The servo tick then only evaluates.
 //  * ForceSafety::Step, on the servo thread every tick (no allocation, no locks):
 //    evaluates F = f0 + K (u - u0), fades it when the model is stale, clamps |F|,
-//    slew-limits it, zeroes it for a bad pose, and guarantees a finite output.
+//    slew-limits it, fades it to zero at the slew limit for a bad pose, and guarantees a
+//    finite output.
 //
 // Sign convention: K = dF/du (force_model_t), so a passive spring has K negative
 // semi-definite. The *stiffness* S = -sym(K) is what a haptic loop can render stably

@@ -5,9 +5,9 @@
 // message to the subscription's queue, and when that queue is full it drops the message.
 // lcm-logger keeps LCM's default of 30 messages, which is 15 ms of a session (~2,100
 // messages/s); on a loaded machine its handler thread is off the CPU longer than that, and
-// the reader thread drops the burst that arrives meanwhile (measured: 200-550 messages lost
-// per minute with 4 viewers at load 19 on 2 cores, none of them in the kernel: the socket's
-// drop counter stayed 0, also with recv_buf_size=4 MiB). This logger gives its subscription
+// the reader thread drops the burst that arrives meanwhile (measured: 211-545 messages lost
+// per minute with 4 viewers at load 13-19 on 2 cores, none of them in the kernel: the
+// socket's drop counter stayed 0, also with recv_buf_size=4 MiB; docs/lab-setup.md). This logger gives its subscription
 // a queue of kQueueMessages (a minute of traffic) and writes from the handler thread, so a
 // stall only delays the writing.
 #pragma once

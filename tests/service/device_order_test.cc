@@ -50,7 +50,7 @@ TEST(DeviceModelOrderTest, OnlyNewerPosesAndSolvesPass) {
     EXPECT_FALSE(order.IsNewer(7, 11, 100));  // the same pose again (a duplicate)
     EXPECT_FALSE(order.IsNewer(7, 12, 99));   // a late pose answered after a newer one
     // A newer pose from an older solve: refused by seq when unsigned; signed sessions
-    // leave the solve order to auth_seq (a resumed server restarts seq, same epoch).
+    // leave the solve order to auth_seq (auth_seq orders the solves when signed).
     EXPECT_EQ(order.IsNewer(7, 9, 105), !check_solve_seq);
     EXPECT_EQ(order.IsNewer(7, 10, 105), !check_solve_seq);
     // Another server session numbers its solves afresh; the pose order still holds.

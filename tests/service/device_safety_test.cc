@@ -318,8 +318,10 @@ TEST_F(DeviceForceSafetyTest, FadeOutOnStopReachesZeroWithinTheRamp) {
   EXPECT_EQ(out_.force_n[0], 0.0);
 }
 
-TEST_F(DeviceForceSafetyTest, BadPosesGetZeroForceAtOnce) {
-  ForceSafety s(TestLimits(), false);
+TEST_F(DeviceForceSafetyTest, BadPosesFadeTheForceToZeroAtTheSlewLimit) {
+  const SafetyLimits limits = TestLimits();
+  const double step = limits.max_force_rate_n_per_s * limits.tick_period_s;
+  ForceSafety s(limits, false);
   const double good[3] = {0.01, 0, 0};
   int64_t now = 0;
   SafetyOutput out;
@@ -330,17 +332,25 @@ TEST_F(DeviceForceSafetyTest, BadPosesGetZeroForceAtOnce) {
     now += kTickUs;
   }
   ASSERT_NEAR(out.force_n[0], 1.5, 1e-12);
+  ASSERT_LT(step, 1.5);  // so the fade takes more than one tick
   const double outside[3] = {0.0, 0.0, 0.081};
   const double nan_pose[3] = {0.0, kNaN, 0.0};
   const double inf_pose[3] = {kInf, 0.0, 0.0};
   const uint64_t before = s.counters().poses_rejected.load();
+  double previous = 1.5;
   for (const double* p : {outside, nan_pose, inf_pose}) {
     m.receive_us = now;
     s.Step(p, true, &m, now, &out);
     now += kTickUs;
     EXPECT_TRUE(out.pose_rejected);
-    EXPECT_EQ(Norm(out.force_n), 0.0);
+    // Toward zero, never up, never faster than the slew limit, never away from the last
+    // direction.
+    EXPECT_NEAR(Norm(out.force_n), std::max(previous - step, 0.0), 1e-12);
+    EXPECT_GE(out.force_n[0], 0.0);
+    EXPECT_EQ(out.force_n[1], 0.0);
+    previous = Norm(out.force_n);
   }
+  EXPECT_EQ(previous, 0.0);
   m.receive_us = now;
   s.Step(good, false, &m, now, &out);  // the device could not be read
   EXPECT_TRUE(out.pose_rejected);
@@ -351,7 +361,7 @@ TEST_F(DeviceForceSafetyTest, BadPosesGetZeroForceAtOnce) {
   m.receive_us = now;
   s.Step(good, true, &m, now, &out);
   EXPECT_FALSE(out.pose_rejected);
-  EXPECT_NEAR(out.force_n[0], 1.0, 1e-12);
+  EXPECT_NEAR(out.force_n[0], step, 1e-12);
 }
 
 TEST_F(DeviceForceSafetyTest, FuzzOutputAlwaysFiniteAndBounded) {
