@@ -63,6 +63,20 @@ std::vector<Case> AllCases() {
       cases.push_back({"thread3d_n" + std::to_string(n) + (grip ? "_grip" : ""), p});
     }
   }
+  // The rod: a ribbon (B2 != B1) with natural curvature in both directions.
+  for (int n : {3, 5, 12}) {
+    ModelParams p;
+    p.model = "rod";
+    p.Set("n", n);
+    p.Set("length", 1.3);
+    p.Set("stretch_stiffness", 80.0);
+    p.Set("bend_stiffness", 1.1);
+    p.Set("bend_stiffness_2", 2.3);
+    p.Set("twist_stiffness", 0.7);
+    p.Set("natural_curvature", 0.4);
+    p.Set("natural_curvature_2", -0.3);
+    cases.push_back({"rod_n" + std::to_string(n), p});
+  }
   return cases;
 }
 
@@ -89,6 +103,14 @@ std::vector<Point> RandomPoints(const Model& model, const ModelParams& p, int co
     } else if (p.model == "cusp") {
       pt.u << 2.0 * unit(rng), 2.0 * unit(rng);
       pt.x = Vec::Constant(1, 2.0 * unit(rng));
+    } else if (p.model == "rod") {
+      // The grasp 0.8 L from the clamp, tilted and rolled (|φ| up to ~1 rad), the nodes
+      // and angles of the initial state perturbed by ~0.1 of an edge / radian.
+      const double edge = p.Number("length") / p.Integer("n");
+      pt.u << 0.8 * p.Number("length"), 0.2 * unit(rng), 0.2 * unit(rng), 0.6 * unit(rng),
+          0.3 * unit(rng), 0.3 * unit(rng);
+      pt.x = model.InitialState(pt.u);
+      for (int i = 0; i < pt.x.size(); ++i) pt.x[i] += 0.1 * edge * unit(rng);
     } else {
       const double total = p.Integer("n") * p.Number("segment_length");
       Eigen::Vector3d dir(1.0, 0.4 * unit(rng), 0.4 * unit(rng));
@@ -187,6 +209,9 @@ TEST_P(ModelDerivativeTest, SizesAndPatternAreConsistent) {
   } else if (p.model == "thread3d") {
     EXPECT_EQ(m.NumStates(), GraspLayoutOf(p).grip_direction ? 3 * p.Integer("n") - 7 : 3 * p.Integer("n") - 5);
     EXPECT_EQ(m.NumControls(), GraspLayoutOf(p).grip_direction ? 6 : 3);
+  } else if (p.model == "rod") {
+    EXPECT_EQ(m.NumStates(), 4 * p.Integer("n") - 11);  // nodes 2..n-2 and angles 1..n-2
+    EXPECT_EQ(m.NumControls(), 6);
   } else {
     EXPECT_EQ(m.NumStates(), 1);
     EXPECT_EQ(m.NumControls(), 2);
@@ -207,8 +232,9 @@ TEST_P(ModelDerivativeTest, SizesAndPatternAreConsistent) {
   }
   EXPECT_EQ(m.HessianBandwidth(), bandwidth);
   // O(n) non-zeros for chains: at most 3 nodes per term, so a row couples at most 5
-  // nodes' coordinates.
-  EXPECT_LE(pattern.nonZeros(), 5L * m.SpatialDimension() * m.NumStates());
+  // nodes' coordinates (the rod: at most its band, 2 x 10 + 1 entries a row).
+  const long per_row = p.model == "rod" ? 2L * m.HessianBandwidth() + 1 : 5L * m.SpatialDimension();
+  EXPECT_LE(pattern.nonZeros(), per_row * m.NumStates());
 }
 
 TEST_P(ModelDerivativeTest, DerivativesMatchFiniteDifferences) {
@@ -367,6 +393,17 @@ TEST_P(ModelDerivativeTest, NodesProbeAndInitialStateAreConsistent) {
         EXPECT_GT((n0.col(i) - expected).norm(), 0.0) << "no symmetry-breaking bump at " << i;
       }
     }
+  } else if (p.model == "rod") {
+    ASSERT_EQ(nodes.cols(), p.Integer("n") + 1);
+    EXPECT_EQ(nodes.col(0).norm(), 0.0);                                    // clamped at 0
+    EXPECT_EQ((nodes.col(p.Integer("n")) - pt.u.head<3>()).norm(), 0.0);  // held at the grasp
+    // Probe: the largest distance of a node from the clamp-grasp line.
+    const Eigen::Vector3d d = pt.u.head<3>().normalized();
+    double probe = 0.0;
+    for (int k = 0; k < nodes.cols(); ++k) {
+      probe = std::max(probe, (nodes.col(k) - nodes.col(k).dot(d) * d).norm());
+    }
+    EXPECT_NEAR(m.Probe(pt.x, pt.u), probe, 1e-12);
   } else if (p.model == "zeeman") {
     ASSERT_EQ(nodes.cols(), 4);
     EXPECT_NEAR(nodes.col(1).norm(), 1.0, 1e-15);               // wheel point on the unit wheel

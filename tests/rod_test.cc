@@ -303,7 +303,26 @@ TEST(RodModel, EnergyIsInvariantUnderRigidMotion) {
 
 
 // The torque convention of rod_model.h: the world torque on the hand, -dE/dδ for a small
-// rotation exp([δ]×) applied to the grasp orientation, is -J_l(φ)^{-T} E_φ (and -E_φ at φ = 0).
+// rotation exp([δ]×) applied to the grasp orientation, is -J_l(φ)^{-T} E_φ (and -E_φ at φ = 0),
+// and Model::GraspTorque gives it directly, also at |φ| = 2π where J_l is singular.
+V3 CentralDifferenceTorque(const Model& model, const Vec& x, const Vec& u) {
+  const M3 r = rod::ExpMap(u.segment<3>(3));
+  const double h = 1e-6;
+  V3 torque;
+  for (int c = 0; c < 3; ++c) {
+    double e[2];
+    for (int side = 0; side < 2; ++side) {
+      const V3 delta = (side == 0 ? h : -h) * V3::Unit(c);
+      const Eigen::AngleAxisd rotated(rod::ExpMap(delta) * r);
+      Vec v = u;
+      v.segment<3>(3) = rotated.angle() * rotated.axis();
+      e[side] = model.Energy(x, v);
+    }
+    torque[c] = -(e[0] - e[1]) / (2 * h);
+  }
+  return torque;
+}
+
 TEST(RodModel, TorqueIsTheConvertedRotationGradient) {
   std::mt19937 rng(11);
   RodModel model(BentParams(6));
@@ -316,20 +335,25 @@ TEST(RodModel, TorqueIsTheConvertedRotationGradient) {
   const M3 jl = M3::Identity() + (1.0 - std::cos(a)) / (a * a) * k +
                 (a - std::sin(a)) / (a * a * a) * k * k;
   const V3 torque = -jl.transpose().inverse() * eu.segment<3>(3);
-  const M3 r = rod::ExpMap(phi);
-  const double h = 1e-6;
+  const V3 fd = CentralDifferenceTorque(model, s.x, s.u);
+  V3 direct;
+  ASSERT_TRUE(model.GraspTorque(s.x, s.u, &direct));
   for (int c = 0; c < 3; ++c) {
-    double e[2];
-    for (int side = 0; side < 2; ++side) {
-      const V3 delta = (side == 0 ? h : -h) * V3::Unit(c);
-      const Eigen::AngleAxisd rotated(rod::ExpMap(delta) * r);
-      Vec u = s.u;
-      u.segment<3>(3) = rotated.angle() * rotated.axis();
-      e[side] = model.Energy(s.x, u);
-    }
-    EXPECT_NEAR(torque[c], -(e[0] - e[1]) / (2 * h), 1e-6 * std::max(1.0, torque.norm()));
+    EXPECT_NEAR(torque[c], fd[c], 1e-6 * std::max(1.0, torque.norm()));
+    EXPECT_NEAR(direct[c], fd[c], 1e-6 * std::max(1.0, torque.norm()));
   }
   EXPECT_GT(torque.norm(), 1e-2);
+  // The same orientation written as φ + 2π φ/|φ|: J_l(φ) is singular at |φ| = 2π, so
+  // E_φ has lost the torque across the axis; GraspTorque has not.
+  Vec turned = s.u;
+  turned.segment<3>(3) = (1.0 + 2.0 * std::numbers::pi / a) * phi;
+  ASSERT_TRUE(model.GraspTorque(s.x, turned, &direct));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(direct[c], fd[c], 1e-6 * std::max(1.0, fd.norm()));
+  Vec at_turn = s.u;
+  at_turn.segment<3>(3) = 2.0 * std::numbers::pi * phi / a;
+  const V3 fd_turn = CentralDifferenceTorque(model, s.x, at_turn);
+  ASSERT_TRUE(model.GraspTorque(s.x, at_turn, &direct));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(direct[c], fd_turn[c], 1e-6 * std::max(1.0, fd_turn.norm()));
 }
 
 // Accepting a state moves the reference frames without changing the energy there, and an

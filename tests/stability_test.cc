@@ -57,7 +57,7 @@ TEST_P(StandardSweepTest, HigherOrderIsChatterFreeAndSnapsWhereTheReferenceDoes)
   EXPECT_LT(inf.force_error_rms, sw.name == "cusp_through" ? 1e-3 : 1e-4);
 }
 
-INSTANTIATE_TEST_SUITE_P(All, StandardSweepTest, ::testing::Range(0, 9), [](const auto& info) {
+INSTANTIATE_TEST_SUITE_P(All, StandardSweepTest, ::testing::Range(0, 10), [](const auto& info) {
   return Sweeps()[info.param].name;
 });
 

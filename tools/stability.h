@@ -21,7 +21,7 @@ struct StandardSweep {
 
 // The standard sweeps of the issue: zeeman across its folds and looping around the
 // cusp both ways; cusp through and around (0,0); curve2d_snap up and down; thread3d
-// loop formation. `scenes_dir` is the folder holding the scene files.
+// loop formation; the rod's Greenhill buckle. `scenes_dir` is the folder holding the scene files.
 std::vector<StandardSweep> StandardSweeps(const std::string& scenes_dir);
 
 struct StabilityRow {

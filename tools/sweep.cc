@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -61,6 +62,8 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
     row.iterations = r.summary.iterations;
     row.gradient_evaluations = r.summary.gradient_evaluations;
     row.hessian_evaluations = r.summary.hessian_evaluations;
+    row.negative_pivots = r.summary.negative_pivots;
+    if (!tracker->model().GraspTorque(row.state, row.u, &row.torque)) row.torque.setZero();
     row.snapped = i > 0 && r.snapped;
     row.status = r.summary.status;
     row.termination = r.summary.termination;
@@ -69,9 +72,12 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
   return rows;
 }
 
-void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out) {
+void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out,
+                   const GraspLayout& layout) {
+  const bool rotation = layout.grip_rotation;
   out << "step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,"
-         "solve_us,status,termination,gradient_evals,hessian_evals\n";
+         "solve_us,status,termination,gradient_evals,hessian_evals"
+      << (rotation ? ",roll_deg,t_x,t_y,t_z,negative_pivots" : "") << '\n';
   out << std::setprecision(12);
   for (const SweepRow& r : rows) {
     auto comp = [](const Vec& v, int i) { return i < v.size() ? v[i] : 0.0; };
@@ -81,7 +87,23 @@ void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method,
         << r.probe << ',' << r.energy << ',' << r.residual << ',' << r.iterations << ',' << method
         << ',' << r.lambda_min << ',' << (r.snapped ? 1 : 0) << ',' << std::setprecision(4) << r.solve_us
         << std::setprecision(12) << ',' << ToString(r.status) << ',' << ToString(r.termination) << ','
-        << r.gradient_evaluations << ',' << r.hessian_evaluations << '\n';
+        << r.gradient_evaluations << ',' << r.hessian_evaluations;
+    if (rotation) {
+      out << ',' << comp(r.u, 3) * 180.0 / std::numbers::pi << ',' << r.torque.x() << ',' << r.torque.y()
+          << ',' << r.torque.z() << ',' << r.negative_pivots;
+    }
+    out << '\n';
+  }
+}
+
+void WriteShapeCsv(const std::vector<SweepRow>& rows, const Model& model, std::ostream& out) {
+  out << "step,node,x,y,z\n" << std::setprecision(9);
+  Eigen::Matrix3Xd nodes;
+  for (const SweepRow& r : rows) {
+    model.NodePositions(r.state, r.u, &nodes);
+    for (Eigen::Index k = 0; k < nodes.cols(); ++k) {
+      out << r.step << ',' << k << ',' << nodes(0, k) << ',' << nodes(1, k) << ',' << nodes(2, k) << '\n';
+    }
   }
 }
 

@@ -27,6 +27,8 @@ struct SweepRow {
   Vec state;             // the equilibrium x
   double probe = 0.0, energy = 0.0, residual = 0.0, lambda_min = 0.0, solve_us = 0.0;
   int iterations = 0, gradient_evaluations = 0, hessian_evaluations = 0;
+  int negative_pivots = 0;  // of E_xx at the equilibrium (its inertia)
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();  // Model::GraspTorque, 0 without one
   bool snapped = false;
   EquilibriumStatus status = EquilibriumStatus::kRegular;
   Termination termination = Termination::kConverged;
@@ -46,7 +48,15 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
 
 // The CSV of snapthread-sweep: header, then one line per row. The first columns are
 // step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,solve_us
-void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out);
+// A grasp that holds its orientation (layout.grip_rotation, the rod) adds, at the end,
+// roll_deg (the x component of the grasp's rotation vector, degrees: the roll about the
+// start tangent), t_x,t_y,t_z (Model::GraspTorque: the torque of the model on the hand
+// about the grasp point, world frame) and negative_pivots (the inertia of E_xx: an unstable equilibrium has > 0).
+void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out,
+                   const GraspLayout& layout = {});
+
+// Node positions of every row (Model::NodePositions): step,node,x,y,z, for drawing.
+void WriteShapeCsv(const std::vector<SweepRow>& rows, const Model& model, std::ostream& out);
 
 // Line colour of a registered method in the gnuplot charts (by registration order).
 const char* MethodColor(std::string_view method);

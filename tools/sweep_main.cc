@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
                  "termination 'snapping')");
   app.add_option("--set", sets, "override a scene key, e.g. --set params.n=20 (repeatable)");
   app.add_option("--out", out_file, "CSV output file (default: standard output)");
+  std::string shape_file;
+  app.add_option("--shape-out", shape_file, "also write every row's node positions (step,node,x,y,z) to this CSV");
   // The models a scene may name, with their parameters (--set params.<name>=...).
   app.footer("Models (scene key `model:`):\n" + ModelHelp());
   const auto run = [&]() -> int {
@@ -79,12 +81,17 @@ int main(int argc, char** argv) {
     }
     auto tracker = MakeTracker(scene);
     const auto rows = RunSweep(tracker.get(), controls);
+    if (!shape_file.empty()) {
+      std::ofstream shapes(shape_file);
+      if (!shapes) throw std::runtime_error("--shape-out: cannot write '" + shape_file + "'");
+      WriteShapeCsv(rows, tracker->model(), shapes);
+    }
     if (out_file.empty()) {
-      WriteSweepCsv(rows, scene.solver.method, std::cout);
+      WriteSweepCsv(rows, scene.solver.method, std::cout, scene.grasp_layout);
     } else {
       std::ofstream out(out_file);
       if (!out) throw std::runtime_error("--out: cannot write '" + out_file + "'");
-      WriteSweepCsv(rows, scene.solver.method, out);
+      WriteSweepCsv(rows, scene.solver.method, out, scene.grasp_layout);
     }
     return 0;
   };

@@ -25,12 +25,15 @@ namespace snapthread {
 
 // What a grasp is, as a device sees it: a position with `spatial_dimension` coordinates
 // (2 for planar models, 3 in space), followed by a unit grip direction (3 numbers) when
-// the model constrains the direction of the held end. The scene carries it so the device
-// client and the viewers can map poses without building a model.
+// the model constrains the direction of the held end, or by a rotation vector φ (3
+// numbers, rad: the grasp's orientation is exp([φ]×) times its start orientation) when
+// the model holds the full pose of the held end (the rod). The scene carries it so the
+// device client and the viewers can map poses without building a model.
 struct GraspLayout {
   int spatial_dimension = 2;
   bool grip_direction = false;
-  int NumControls() const { return spatial_dimension + (grip_direction ? 3 : 0); }
+  bool grip_rotation = false;
+  int NumControls() const { return spatial_dimension + (grip_direction || grip_rotation ? 3 : 0); }
 };
 
 class Model {
@@ -56,6 +59,13 @@ class Model {
   virtual void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const = 0;
   // E_uu, NumControls() x NumControls().
   virtual void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const = 0;
+  // A grasp that holds its orientation (GraspLayout::grip_rotation): the torque of the
+  // model on the hand about the grasp point, world frame, -dE/dδ for a small world
+  // rotation exp([δ]×) of the grasp (the rotation part of -E_u is that torque only while
+  // the rotation vector stays on one axis, and loses it at whole turns). false: none.
+  virtual bool GraspTorque(const Vec& /*x*/, const Vec& /*u*/, Eigen::Vector3d* /*torque*/) const {
+    return false;
+  }
 
   // A natural starting state for controls u (straight thread, wheel at theta = 0, ...).
   virtual Vec InitialState(const Vec& u) const = 0;
@@ -76,6 +86,10 @@ class Model {
   // moves that data to the accepted state here; at x itself E and the equilibrium do not
   // change. Models without history (zeeman, cusp, curve2d, thread3d) have nothing to do.
   virtual void AcceptState(const Vec& /*x*/, const Vec& /*u*/) {}
+  // Called by the tracker's Reset before InitialState: forget the lagged data, so a
+  // reset starts from the same model a fresh one would be (the rod untwists: its grasp
+  // turn count goes back to the rest frames').
+  virtual void ResetHistory() {}
 
   // Continuous symmetries: one-parameter groups of rotations x -> S_k(t) x (period 2 pi)
   // that leave E(., u) unchanged for controls on the rotation's axis and nearly so near

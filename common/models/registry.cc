@@ -16,7 +16,8 @@ namespace snapthread {
   X(Zeeman)                          \
   X(Cusp)                            \
   X(Curve2d)                         \
-  X(Thread3d)
+  X(Thread3d)                        \
+  X(Rod)
 
 #define SNAPTHREAD_DECLARE_MODEL(Name) ModelRegistration Name##Registration();
 SNAPTHREAD_BUILTIN_MODELS(SNAPTHREAD_DECLARE_MODEL)

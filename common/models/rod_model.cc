@@ -1,8 +1,11 @@
 #include "models/rod_model.h"
 
+#include "models/registry.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace snapthread {
@@ -62,7 +65,11 @@ RodModel::RodModel(const RodParams& params) : p_(params) {
   stiffness_.kappa2_bar = p_.natural_curvature_2 * rest_;
   assembly_ = internal::HessianAssembly(nx_, 6);
   BuildTerms();
-  // Reference frames of the rest rod: straight along the clamp.
+  ResetHistory();
+}
+
+void RodModel::ResetHistory() {
+  // Reference frames of the rest rod: straight along the clamp, no turns at the grasp.
   sources_.assign(n_, FrameSource{p_.clamp_rotation.col(0), p_.clamp_rotation.col(1)});
   twist_near_.assign(n_, 0.0);
   grasp_theta_near_ = 0.0;
@@ -137,7 +144,7 @@ void RodModel::BuildTerms() {
   }
 }
 
-RodModel::GraspMap RodModel::Grasp(const Vec& u, bool derivatives) const {
+RodModel::GraspMap RodModel::Grasp(const Vec& u, bool derivatives, bool world_rotation) const {
   GraspMap gm;
   const V3 pos = u.head<3>();
   const V3 phi = u.segment<3>(3);
@@ -152,8 +159,12 @@ RodModel::GraspMap RodModel::Grasp(const Vec& u, bool derivatives) const {
     gm.theta = rod::AngleAbout(t, a, r.col(1), grasp_theta_near_);
     return gm;
   }
-  const JetVec t = rod::RotateJet(phi, p_.grasp_rotation.col(0));
-  const JetVec m1 = rod::RotateJet(phi, p_.grasp_rotation.col(1));
+  // Derivatives in φ, or in a world rotation δ of the current orientation
+  // (exp([δ]×) R(u), δ = 0) for the torque.
+  const M3 rot = world_rotation ? M3(rod::ExpMap(phi) * p_.grasp_rotation) : p_.grasp_rotation;
+  const V3 at = world_rotation ? V3::Zero() : phi;
+  const JetVec t = rod::RotateJet(at, rot.col(0));
+  const JetVec m1 = rod::RotateJet(at, rot.col(1));
   gm.xn = pos;
   gm.xn1 = pos - rest_ * t.Value();
   // θ_{n-1}: the angle of m1 about t from the time-parallel reference director
@@ -331,6 +342,21 @@ void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
   }
 }
 
+bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const {
+  // The E_u of a grasp map differentiated in a world rotation δ instead of φ: the
+  // rotation-vector gradient E_φ = J_l(φ)ᵀ E_δ loses the torque where J_l is singular
+  // (|φ| = 2π, 4π: two turns of a roll).
+  const GraspMap gm = Grasp(u, true, true);
+  Eigen::Matrix<double, 6, 1> e = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int t : control_terms_) {
+    Local(t, x, gm, false, [&](const double* lg, const double*, int) {
+      assembly_.AddControlGradient(t, lg, e.data());
+    });
+  }
+  *torque = -e.tail<3>();
+  return true;
+}
+
 void RodModel::MixedHessian(const Vec& x, const Vec& u, Mat* exu) const {
   if (exu->rows() != nx_ || exu->cols() != 6) exu->resize(nx_, 6);
   exu->setZero();
@@ -357,8 +383,23 @@ Vec RodModel::InitialState(const Vec& u) const {
   const GraspMap gm = Grasp(u, false);
   Vec x = Vec::Zero(nx_);
   const V3 x1 = Node(1, x, gm);
+  // A slack rod starts bowed out towards the clamp's m1 (a compressed straight rod is a
+  // saddle whose bending modes the start solve cannot pick between): the free span
+  // x_1 .. x_{n-1} of chord D and rest length L' follows y = A/2 (1 - cos 2πs) with
+  // A = (2/π) sqrt(D (L' - D)), the arc of length ≈ L'.
+  const V3 chord = gm.xn1 - x1;
+  const double d = chord.norm(), free = (n_ - 2) * rest_;
+  V3 side = V3::Zero();
+  if (d > 0.0 && free - d > 1e-9 * p_.length) {
+    const V3 t = chord / d;
+    for (int c = 1; c <= 2 && side.norm() < 0.5; ++c) {
+      side = p_.clamp_rotation.col(c) - p_.clamp_rotation.col(c).dot(t) * t;
+    }
+    side *= (2.0 / std::numbers::pi) * std::sqrt(d * (free - d)) / side.norm();
+  }
   for (int k = 2; k <= n_ - 2; ++k) {
-    x.segment<3>(NodeIndex(k)) = x1 + (static_cast<double>(k - 1) / (n_ - 2)) * (gm.xn1 - x1);
+    const double s = static_cast<double>(k - 1) / (n_ - 2);
+    x.segment<3>(NodeIndex(k)) = x1 + s * chord + 0.5 * (1.0 - std::cos(2.0 * std::numbers::pi * s)) * side;
   }
   for (int j = 1; j <= n_ - 2; ++j) x[ThetaIndex(j)] = gm.theta * j / (n_ - 1);
   return x;
@@ -422,6 +463,57 @@ void RodModel::AcceptState(const Vec& x, const Vec& u) {
     sources_[j].t = t;
     sources_[j].a = (a - a.dot(t) * t).normalized();
   }
+}
+
+// ---------------------------------------------------------------------------------
+// Registration: the scene's `model: rod`. The clamp sits at the origin with its body
+// axes along the world's (the rod leaves along +x); the grasp starts with the same
+// orientation, so u = (X, Y, Z, φ) with φ = 0 holds the last edge along +x and a roll
+// about the tangent is φ = (roll, 0, 0).
+ModelRegistration RodRegistration() {
+  ModelRegistration r;
+  r.name = "rod";
+  r.doc = "discrete elastic rod that twists (Bergou et al. 2008/2010): full-pose clamp at the origin "
+          "along +x and grasp u = (X, Y, Z, rotation vector)";
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  auto positive = [&](const char* name, double def, const char* units, const char* doc) {
+    return ParamSpec{.name = name, .default_value = def, .min = 0.0, .min_inclusive = false,
+                     .max = kInf, .units = units, .doc = doc};
+  };
+  r.params = {
+      {.name = "n", .kind = ParamKind::kInteger, .default_value = 20, .min = 3,
+       .doc = "number of edges (the clamp and the grasp hold one each)"},
+      positive("length", 1.0, "m", "rest length L (every edge L / n)"),
+      positive("stretch_stiffness", 1000.0, "N", "EA in 1/2 EA (|e|/l - 1)^2 l per edge"),
+      positive("bend_stiffness", 1.0, "N m^2", "B1 = EI for bending towards m1 (kappa1) [DER (4)]"),
+      {.name = "bend_stiffness_2", .default_value = 0.0, .min = 0.0, .units = "N m^2",
+       .doc = "B2 for bending towards m2 (kappa2); 0 = bend_stiffness (a round rod), >> B1 a ribbon"},
+      positive("twist_stiffness", 1.0, "N m^2", "GJ in 1/2 GJ (twist)^2 / l [DVT (4)]"),
+      {.name = "natural_curvature", .default_value = 0.0, .units = "1/m",
+       .doc = "natural material curvature kappa1-bar (bending towards m1)"},
+      {.name = "natural_curvature_2", .default_value = 0.0, .units = "1/m",
+       .doc = "natural material curvature kappa2-bar (bending towards m2)"},
+      {.name = "radius", .default_value = 0.01, .min = 0.0, .units = "m",
+       .doc = "tube radius (drawing only; contact is not modelled)"},
+  };
+  r.factory = [](const ModelParams& mp) -> std::unique_ptr<Model> {
+    RodParams p;
+    p.n = mp.Integer("n");
+    p.length = mp.Number("length");
+    p.stretch_stiffness = mp.Number("stretch_stiffness");
+    p.bend_stiffness = mp.Number("bend_stiffness");
+    const double b2 = mp.Number("bend_stiffness_2");
+    p.bend_stiffness_2 = b2 > 0.0 ? b2 : p.bend_stiffness;
+    p.twist_stiffness = mp.Number("twist_stiffness");
+    p.natural_curvature = mp.Number("natural_curvature");
+    p.natural_curvature_2 = mp.Number("natural_curvature_2");
+    p.radius = mp.Number("radius");
+    return std::make_unique<RodModel>(p);
+  };
+  r.capabilities.grasp_layout = [](const ModelParams&) {
+    return GraspLayout{.spatial_dimension = 3, .grip_rotation = true};
+  };
+  return r;
 }
 
 }  // namespace snapthread

@@ -65,6 +65,8 @@ class RodModel final : public Model {
   void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override;
   void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override;
   void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override;
+  // -dE/dδ for a world rotation exp([δ]×) of the grasp: the torque about x_n (N m).
+  bool GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const override;
 
   // Nodes evenly spaced on the segment x_1 .. x_{n-1}, twist spread evenly.
   Vec InitialState(const Vec& u) const override;
@@ -77,6 +79,8 @@ class RodModel final : public Model {
   // Moves the time-parallel reference frames (and the continued reference twists and
   // grasp angle) to the accepted state.
   void AcceptState(const Vec& x, const Vec& u) override;
+  // Back to the rest frames (straight along the clamp, no turns at the grasp).
+  void ResetHistory() override;
 
   // Layout, for tests and scene code: the state index of coordinate 0 of node k and of
   // θ_j, or -1 when the clamp or the grasp sets it.
@@ -103,7 +107,7 @@ class RodModel final : public Model {
     std::array<int, kMaxLocal> pos{};  // grasp terms: assembly position of state coordinates
   };
   void BuildTerms();
-  GraspMap Grasp(const Vec& u, bool derivatives) const;
+  GraspMap Grasp(const Vec& u, bool derivatives, bool world_rotation = false) const;
   Eigen::Vector3d Node(int k, const Vec& x, const GraspMap& gm) const;
   double Theta(int j, const Vec& x, const GraspMap& gm) const;
   // Calls f(local gradient, local Hessian, leading dimension) for term t in its

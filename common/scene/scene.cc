@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -154,6 +155,25 @@ void ReadParams(const YAML::Node& p, const ModelRegistration& model, const Reade
   }
 }
 
+// A waypoint of a grasp that holds its full orientation (GraspLayout::grip_rotation):
+// [X, Y, Z] (start orientation), or {position: [X, Y, Z], roll_deg: r}, a roll by r
+// degrees about the grasp's x axis, the rod's tangent at the start (u = (X, Y, Z, r, 0, 0)
+// in radians). Legs between waypoints interpolate the rotation vector linearly, so a
+// leg from roll 0 to roll 720 turns the grasp twice.
+Vec RotationWaypoint(const YAML::Node& point, const std::string& key, const Reader& rd) {
+  Vec p = Vec::Zero(6);
+  if (point.IsSequence()) {
+    p.head(3) = rd.Vector(point, key, 3);
+    return p;
+  }
+  if (!point.IsMap()) rd.Fail(key, "expected [X, Y, Z] or {position: [X, Y, Z], roll_deg: r}, got '" + Reader::Dump(point) + "'");
+  rd.CheckKeys(point, key, {"position", "roll_deg"});
+  if (!point["position"]) rd.Fail(key + ".position", "missing (expected a list of 3 numbers)");
+  p.head(3) = rd.Vector(point["position"], key + ".position", 3);
+  p[3] = rd.Number(point, "roll_deg", key + ".roll_deg", 0.0) * std::numbers::pi / 180.0;
+  return p;
+}
+
 void ApplyOverrides(YAML::Node root, const std::vector<SceneOverride>& overrides, const Reader& rd) {
   for (const auto& o : overrides) {
     YAML::Node value;
@@ -236,7 +256,8 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
   if (!sc.params.IsValid(&error)) throw SceneError(file_label + ": " + error);
 
   // Controls: the grasp position (2 or 3 numbers), then a unit grip direction if the
-  // model holds one (see GraspLayout).
+  // model holds one, or a rotation vector (start: 0) if it holds the full orientation
+  // (see GraspLayout).
   sc.grasp_layout = model->capabilities.grasp_layout(sc.params);
   const int pos_dim = sc.grasp_layout.spatial_dimension;
   const bool grip = sc.grasp_layout.grip_direction;
@@ -255,7 +276,7 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
   } else if (g["direction"]) {
     rd.Fail("grasp.direction", "only allowed with params.grip_direction: true");
   }
-  sc.grasp_start.resize(m);
+  sc.grasp_start = Vec::Zero(m);
   sc.grasp_start.head(pos_dim) = start;
   if (grip) sc.grasp_start.tail(3) = dir;
   if (g["path"]) {
@@ -265,7 +286,9 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
       const std::string key = "grasp.path[" + std::to_string(i) + "]";
       Vec p(m);
       // With a grip direction a waypoint may also turn the grip: X,Y,Z,dx,dy,dz.
-      if (grip && path[i].IsSequence() && path[i].size() == 6) {
+      if (sc.grasp_layout.grip_rotation) {
+        p = RotationWaypoint(path[i], key, rd);
+      } else if (grip && path[i].IsSequence() && path[i].size() == 6) {
         p = rd.Vector(path[i], key, 6);
         if (!(p.tail(3).norm() > 1e-9)) rd.Fail(key, "expected a non-zero grip direction");
         p.tail(3).normalize();

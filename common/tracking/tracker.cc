@@ -37,6 +37,7 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   if (u.size() != model_->NumControls())
     throw std::invalid_argument("EquilibriumTracker::Reset: control size mismatch");
   solver_->Reset();
+  model_->ResetHistory();
   x_ = model_->InitialState(u);
   u_ = u;
   // A reset must start on an equilibrium: unlimited, globalised solve.

@@ -68,6 +68,17 @@ struct TimedSweep {
 };
 TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int repetitions, double min_time_s = 0.0);
 
+// ---------------------------------------------------------------- rod speed
+
+// Updates per second along scenes/rod_greenhill.yaml's path (2000 steps) at each n,
+// logged one line per n (issue 14's targets: n = 10 >= 50 k, n = 100 >= 10 k).
+struct RodSpeedRow {
+  int n = 0;
+  Spread rate_hz;
+};
+std::vector<RodSpeedRow> RunRodSpeedBench(const std::string& scenes_dir, const std::vector<int>& ns,
+                                          int repetitions, std::ostream& log);
+
 // ---------------------------------------------------------------- accuracy
 
 struct AccuracyOptions {

@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
   int repetitions = 0, reference_n = 0, path_steps = 0;
   double service_duration = 0.0, target_force_error = 0.0, target_rate_hz = 0.0;
   app.add_flag("--quick", quick, "small grids, one repetition, short service run (for development)");
-  app.add_option("--only", only, "benchmarks to run: accuracy,scaling,service,path (comma-separated)");
+  app.add_option("--only", only, "benchmarks to run: accuracy,scaling,service,path,rod (comma-separated)");
   app.add_option("--out", out_dir, "output folder (CSV, gnuplot scripts, PNG charts, summary.txt)");
   app.add_option("--scenes", scenes_dir, "folder with the scene files");
   app.add_option("--bin-dir", bin_dir, "folder with snapthread-server and snapthread-device (service)");
@@ -142,8 +142,8 @@ int main(int argc, char** argv) {
     const auto parts = SplitList(only);
     auto want = [&](const char* p) { return std::find(parts.begin(), parts.end(), p) != parts.end(); };
     for (const auto& p : parts)
-      if (p != "accuracy" && p != "scaling" && p != "service" && p != "path")
-        throw std::invalid_argument("--only: unknown benchmark '" + p + "' (accuracy, scaling, service, path)");
+      if (p != "accuracy" && p != "scaling" && p != "service" && p != "path" && p != "rod")
+        throw std::invalid_argument("--only: unknown benchmark '" + p + "' (accuracy, scaling, service, path, rod)");
     fs::create_directories(out_dir);
     const std::string out_abs = fs::absolute(out_dir).string();
     std::ofstream summary(fs::path(out_dir) / "summary.txt");
@@ -178,6 +178,15 @@ int main(int argc, char** argv) {
         std::ofstream(script) << ParetoGnuplot(rows, out_abs, out_abs + "/bench_pareto.png");
         plots_ok = RunGnuplot(script) && plots_ok;
       }
+    }
+
+    if (want("rod")) {
+      // Issue 14's targets: n = 10 >= 50 k and n = 100 >= 10 k updates/s.
+      std::ostringstream table;
+      table << "== rod: updates/s along rod_greenhill's path (median of " << std::max(repetitions, 3) << " runs)\n";
+      RunRodSpeedBench(scenes_dir, {10, 100}, std::max(repetitions, 3), table);
+      std::cout << table.str();
+      summary << table.str() << '\n';
     }
 
     if (want("scaling")) {
