@@ -13,6 +13,8 @@
 # exit: 0 ok, 1 a process failed / multicast route missing, 2 bad arguments
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+# make_session_key
+source "$here/deploy/lib/session_key.sh"
 
 scene="$here/scenes/curve2d_snap.yaml"
 duration=10
@@ -51,11 +53,7 @@ session="DEMO_$$_${RANDOM}"
 [ -n "$out" ] || out=$(mktemp -d "${TMPDIR:-/tmp}/snapthread-demo.XXXXXX")
 mkdir -p "$out"
 key="${key:-${SNAPTHREAD_KEY_FILE:-}}"
-if [ -z "$key" ]; then
-  key="$out/session.key"
-  "$bin/snapthread-keygen" --key "$key" > "$out/keygen.log" 2>&1 ||
-    { echo "run_demo: could not make a session key:" >&2; cat "$out/keygen.log" >&2; exit 1; }
-fi
+make_session_key run_demo "$out/session.key" "$out/keygen.log"
 server_pid=""
 device_pid=""
 cleanup() {

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The full local session on loopback: lcm-logger, snapthread-server, snapthread-device
+# The full local session on loopback: snapthread-logger, snapthread-server, snapthread-device
 # (virtual-hand backend) and a viewer (a window when $DISPLAY is set, otherwise under
 # xvfb-run taking a screenshot), for ~10 s; then snapthread-report on the log.
 # Outputs: out/session-<UTC time>/ (log, report/, summaries, viewer.png, process logs).
@@ -10,6 +10,8 @@
 #                              [--lcm-url URL] [--bin-dir DIR] [--out-root DIR] [--key FILE]
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+# make_session_key
+source "$here/deploy/lib/session_key.sh"
 
 duration=10
 scene="$here/scenes/curve2d_snap.yaml"
@@ -31,20 +33,15 @@ while (($#)); do
     *) echo "run_session: unknown argument $1" >&2; exit 2 ;;
   esac
 done
-for b in snapthread-server snapthread-device snapthread-viewer snapthread-report snapthread-keygen; do
+for b in snapthread-server snapthread-device snapthread-viewer snapthread-logger snapthread-report snapthread-keygen; do
   [ -x "$bin/$b" ] || { echo "run_session: $bin/$b missing (build first: deploy/setup.sh)" >&2; exit 1; }
 done
-command -v lcm-logger >/dev/null || { echo "run_session: lcm-logger missing (liblcm-bin)" >&2; exit 1; }
 "$here/deploy/multicast-route.sh" >/dev/null 2>&1 || true
 
 out="$out_root/session-$(date -u +%Y%m%d-%H%M%S)"
 mkdir -p "$out"
 log="$out/session.lcmlog"
-if [ -z "$key" ]; then
-  key="$out/session.key"
-  "$bin/snapthread-keygen" --key "$key" > "$out/keygen.txt" 2>&1 ||
-    { echo "run_session: could not make a session key:" >&2; cat "$out/keygen.txt" >&2; exit 1; }
-fi
+make_session_key run_session "$out/session.key" "$out/keygen.txt"
 pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
@@ -52,11 +49,9 @@ cleanup() {
 trap cleanup EXIT
 
 echo "run_session: session $session on $url, ${duration} s, outputs in $out"
-# Logger first, so the log holds every sequence number from 1.
-# As root, SCHED_FIFO (like the systemd unit): a logger stalled ~30 ms drops messages.
-logger_prio=()
-[ "$(id -u)" -eq 0 ] && command -v chrt >/dev/null && logger_prio=(chrt -f 10)
-"${logger_prio[@]}" lcm-logger -q -c "${session}_.*" --lcm-url="$url" -f "$log" > "$out/logger.txt" 2>&1 &
+# Logger first, so the log holds every sequence number from 0. No raised priority:
+# snapthread-logger queues what arrives while it is off the CPU (logger/session_logger.h).
+"$bin/snapthread-logger" -q -c "${session}_.*" --lcm-url "$url" -f "$log" > "$out/logger.txt" 2>&1 &
 logger_pid=$!
 pids+=("$logger_pid")
 sleep 0.3

@@ -13,7 +13,7 @@
 namespace snapthread::device {
 
 ModelReceiver::ModelReceiver(const SafetyLimits& limits, ModelSlot* slot, ModelAuth auth)
-    : limits_(limits), slot_(slot), auth_(std::move(auth)) {}
+    : limits_(limits), slot_(slot), auth_(std::move(auth)), order_(auth_.key == nullptr) {}
 
 void ModelReceiver::LogAuth(auth::FreshnessFilter* filter, int64_t now_us) {
   std::string line;
@@ -62,6 +62,13 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
         return false;
       }
     }
+    // Never an older model after a newer one. Counted apart (part of models_rejected, as
+    // the signed session's stale auth_seq is) and not logged: reordering is what a lossy
+    // network does, not an attack.
+    if (!order_.IsNewer(msg.epoch, msg.seq, msg.device_seq)) {
+      out_of_order_.fetch_add(1);
+      return false;
+    }
     LocalModel model;
     const ModelVerdict verdict = PrepareModel(msg, now_us, limits_, &model, &why);
     if (verdict == ModelVerdict::kRejected) {
@@ -72,6 +79,7 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
     if (verdict == ModelVerdict::kInvalidStatus) invalid_models_.fetch_add(1);
     if (msg.status == force_model_t::STATUS_SNAPPED) snaps_felt_.fetch_add(1);
     slot_->Write(model);
+    order_.Applied(msg.epoch, msg.seq, msg.device_seq);
     received_.fetch_add(1);
     // Round trip on the device's own clock: pose time echoed back by the server.
     const int64_t rt = now_us - msg.device_utime;

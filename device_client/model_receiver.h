@@ -13,6 +13,7 @@
 #include "auth/freshness_filter.h"
 #include "auth/pose_echo_window.h"
 #include "auth/session_key.h"
+#include "model_order.h"
 #include "realtime/percentiles.h"
 #include "safety.h"
 #include "servo_loop.h"
@@ -48,8 +49,13 @@ class ModelReceiver {
   transport::PercentileSummary RoundTrip(bool whole_run) const;
 
   uint64_t received() const { return received_.load(); }
-  // Malformed or unsafe models plus those refused by authentication.
-  uint64_t rejected() const { return rejected_.load() + model_filter_.rejected(); }
+  // Malformed or unsafe models, those refused by authentication and those older than
+  // the applied one (ModelOrder).
+  uint64_t rejected() const {
+    return rejected_.load() + model_filter_.rejected() + out_of_order_.load();
+  }
+  // Models dropped because a newer one was already applied (reordering on the network).
+  uint64_t out_of_order() const { return out_of_order_.load(); }
   uint64_t auth_rejected() const { return model_filter_.rejected(); }
   uint64_t stiffness_clamps() const { return stiffness_clamps_.load(); }
   uint64_t invalid_models() const { return invalid_models_.load(); }
@@ -62,11 +68,12 @@ class ModelReceiver {
   SafetyLimits limits_;
   ModelSlot* slot_;
   ModelAuth auth_;
+  ModelOrder order_;  // receive thread only
   auth::FreshnessFilter status_filter_{"SOLVER_STATUS",
                                        auth::FreshnessFilter::EpochPolicy::kAdopt};
   auth::FreshnessFilter model_filter_{"FORCE_MODEL"};
   std::atomic<uint64_t> received_{0}, rejected_{0}, stiffness_clamps_{0}, invalid_models_{0},
-      snaps_felt_{0};
+      snaps_felt_{0}, out_of_order_{0};
   mutable std::mutex mutex_;  // the round-trip windows (receiver and status threads)
   transport::SampleWindow round_trip_window_{2000};
   transport::SampleWindow round_trip_run_{200000};

@@ -75,9 +75,11 @@ ModelVerdict PrepareModel(const force_model_t& msg, int64_t receive_us,
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) K(i, j) = msg.K[i][j];
   }
-  const Eigen::Matrix3d S = -0.5 * (K + K.transpose());
+  // Halved before adding: K + K^T overflows for entries above half the double range.
+  const Eigen::Matrix3d S = -(0.5 * K + 0.5 * K.transpose());
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(S);
-  if (eig.info() != Eigen::Success) {
+  if (eig.info() != Eigen::Success || !eig.eigenvalues().allFinite() ||
+      !eig.eigenvectors().allFinite()) {
     if (why) *why = "stiffness eigen-decomposition failed";
     return ModelVerdict::kRejected;
   }
@@ -94,6 +96,15 @@ ModelVerdict PrepareModel(const force_model_t& msg, int64_t receive_us,
       eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) m.K_n_per_m[i][j] = -0.5 * (S_clamped(i, j) + S_clamped(j, i));
+  }
+  // The servo trusts K to be finite (an absurd K must never become a NaN force).
+  for (const auto& row : m.K_n_per_m) {
+    for (double k : row) {
+      if (!std::isfinite(k)) {
+        if (why) *why = "K is not finite after clamping its stiffness";
+        return ModelVerdict::kRejected;
+      }
+    }
   }
   *out = m;
   return clamped ? ModelVerdict::kStiffnessClamped : ModelVerdict::kAccepted;

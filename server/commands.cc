@@ -108,7 +108,9 @@ void Server::StartSceneLoad(const std::string& name) {
         if (hooks_.before_load) hooks_.before_load();
         std::string path;
         const std::string text = ReadSceneByName(dir, name, &path);
-        return MakeSession(ParseScene(text, path));
+        std::unique_ptr<Session> session = MakeSession(ParseScene(text, path));
+        session->scene_text = text;  // for checkpoints
+        return session;
       },
       limit);
 }

@@ -84,6 +84,7 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
   Scene scene = LoadScene(params_.scene_path);
   session_ = MakeSession(scene);
   SetInfo(session_->scene.name, session_->tracker->options().method, nullptr);
+  SetUpCheckpoints();  // may resume another scene and method: after the start scene loaded
 
   if (lcm != nullptr) {
     lcm_ = lcm;
@@ -159,6 +160,10 @@ void Server::Stop() {
   inbox_.RequestStop();
   if (receive_thread_.joinable()) receive_thread_.join();
   if (solve_thread_.joinable()) solve_thread_.join();
+  if (checkpoint_writer_) {
+    OfferCheckpoint();  // the state at the stop, so a restart resumes exactly here
+    checkpoint_writer_->Flush();
+  }
   load_.Join();  // a scene load still running (bounded by its file size and the parser)
   if (state_sub_ != nullptr) lcm_->unsubscribe(state_sub_);
   if (command_sub_ != nullptr) lcm_->unsubscribe(command_sub_);
@@ -270,12 +275,14 @@ bool Server::SignForChannel(Msg* msg, const std::string& channel) {
 void Server::SolveLoop() {
   const auto shape_period = Period(params_.shape_rate_hz);
   const auto status_period = Period(params_.status_rate_hz);
+  const auto checkpoint_period = Period(params_.checkpoint_rate_hz);
   auto now = SteadyClock::now();
   auto next_shape = now;
   auto next_status = now;
+  auto next_checkpoint = checkpoint_writer_ ? now : SteadyClock::time_point::max();
   last_status_time_ = now;
   while (true) {
-    ServerInbox::Taken taken = inbox_.Wait(std::min(next_shape, next_status));
+    ServerInbox::Taken taken = inbox_.Wait(std::min({next_shape, next_status, next_checkpoint}));
     if (taken.stop) break;
     bool changed_session = false;
     for (const command_t& command : taken.commands) {
@@ -294,6 +301,11 @@ void Server::SolveLoop() {
       PublishStatus();
       next_status += status_period;
       if (next_status <= now) next_status = now + status_period;
+    }
+    if (now >= next_checkpoint || (checkpoint_writer_ && changed_session)) {
+      OfferCheckpoint();
+      next_checkpoint += checkpoint_period;
+      if (next_checkpoint <= now) next_checkpoint = now + checkpoint_period;
     }
   }
 }
@@ -452,6 +464,14 @@ ServerStats Server::Stats() const {
   s.scene = scene_name_;
   s.method = method_name_;
   s.last_command_message = last_command_message_;
+  if (checkpoint_writer_) {
+    s.checkpoints = true;
+    s.resumed = resumed_.load();
+    s.checkpoint = checkpoint_writer_->Stats();
+    const transport::PercentileSummary offer = checkpoint_offer_us_.Compute();
+    s.checkpoint_offer_us_p50 = offer.p50;
+    s.checkpoint_offer_us_p99 = offer.p99;
+  }
   return s;
 }
 
@@ -467,7 +487,7 @@ struct Figure {
 
 std::vector<Figure> Figures(const ServerStats& s) {
   auto n = [](int64_t v) { return static_cast<double>(v); };
-  return {{"updates", n(s.updates), true, true},
+  std::vector<Figure> figures = {{"updates", n(s.updates), true, true},
           {"update_rate_hz", s.update_rate_hz, false, true},
           {"solve_us_p50", s.solve_us_p50, false, true},
           {"solve_us_p99", s.solve_us_p99, false, true},
@@ -481,6 +501,18 @@ std::vector<Figure> Figures(const ServerStats& s) {
           {"shapes_published", n(s.shapes_published), true, false},
           {"statuses_published", n(s.statuses_published), true, false},
           {"publish_failures", n(s.publish_failures), true, false}};
+  if (s.checkpoints) {  // --state-dir only: the summary without it is unchanged
+    figures.insert(figures.end(),
+                   {{"resumed", n(s.resumed ? 1 : 0), true, false},
+                    {"checkpoints_written", n(s.checkpoint.written), true, false},
+                    {"checkpoint_failures", n(s.checkpoint.failed), true, false},
+                    {"checkpoint_write_us_p50", s.checkpoint.write_us_p50, false, false},
+                    {"checkpoint_write_us_p99", s.checkpoint.write_us_p99, false, false},
+                    {"checkpoint_write_us_max", s.checkpoint.write_us_max, false, false},
+                    {"checkpoint_offer_us_p50", s.checkpoint_offer_us_p50, false, false},
+                    {"checkpoint_offer_us_p99", s.checkpoint_offer_us_p99, false, false}});
+  }
+  return figures;
 }
 
 std::string FigureText(const Figure& f, int decimals) {

@@ -33,6 +33,7 @@
 #include "auth/session_key.h"
 
 #include "background_job.h"
+#include "checkpoint_writer.h"
 #include "server_inbox.h"
 #include "server_params.h"
 #include "scene/scene.h"
@@ -68,6 +69,12 @@ struct ServerStats {
   std::string scene;              // name of the scene in use
   std::string method;             // solver method in use
   std::string last_command_message;  // what the last command did or why it was refused
+  // Checkpoints (--state-dir; server_checkpoint.cc). All zero / false without it.
+  bool checkpoints = false;          // --state-dir given
+  bool resumed = false;              // this start resumed a checkpoint
+  CheckpointWriterStats checkpoint;  // files written, failures, write time
+  double checkpoint_offer_us_p50 = 0.0;  // the solve thread's cost of one snapshot
+  double checkpoint_offer_us_p99 = 0.0;
 };
 
 // Test seams. Called on the solve thread.
@@ -79,6 +86,8 @@ struct ServerTestHooks {
   // Just after each tracker update, with the controls and the tracker (its state and
   // last result): a test compares the server's path with a sweep of the same scene.
   std::function<void(const Vec& u, const EquilibriumTracker& tracker)> after_update;
+  // On the checkpoint writer thread, before each write (a test blocks it: a slow disk).
+  std::function<void()> before_checkpoint_write;
 };
 
 class Server {
@@ -151,6 +160,13 @@ class Server {
   void PublishShape();
   void PublishStatus();
   std::unique_ptr<Session> MakeSession(const Scene& scene) const;
+  // Checkpoints (server_checkpoint.cc). At construction: prepares --state-dir
+  // (CheckpointIoError), resumes a valid checkpoint of this session (a refused one is
+  // logged with its reason and the server starts fresh) and starts the writer.
+  void SetUpCheckpoints();
+  bool ResumeFromCheckpoint();
+  // Solve thread: hands the writer a snapshot when the state changed since the last one.
+  void OfferCheckpoint();
   void SetInfo(const std::string& scene, const std::string& method, const std::string* command);
 
   // Devices whose freshness the server tracks; poses of further device_ids are refused
@@ -205,6 +221,14 @@ class Server {
   std::string scene_name_, method_name_, last_command_message_;
   transport::SampleWindow run_window_{kSolveWindow};
   int64_t first_update_us_ = 0, last_update_us_ = 0;  // steady clock
+
+  // Checkpoints: the writer (null without --state-dir), and on the solve thread what the
+  // last snapshot saw (updates and applied commands), its count and its cost.
+  std::unique_ptr<CheckpointWriter> checkpoint_writer_;
+  std::atomic<bool> resumed_{false};
+  int64_t checkpoint_seq_ = 0;
+  int64_t checkpoint_updates_ = -1, checkpoint_commands_ = -1;
+  transport::SampleWindow checkpoint_offer_us_{4096};  // guarded by info_mutex_
 };
 
 }  // namespace snapthread::server

@@ -99,6 +99,10 @@ int main(int argc, char** argv) {
   app.add_option("--key", params.key_path,
                  "Session key file (default: $SNAPTHREAD_KEY_FILE, else "
                  "$XDG_CONFIG_HOME/snapthread/session.key); created (mode 0600) when missing");
+  app.add_option("--state-dir", params.state_dir,
+                 "Checkpoint the scene, method, grasp and state here (>= 5 Hz, atomically); "
+                 "restarted with the same directory and --session the server resumes on the "
+                 "same branch. Made (mode 0700) when missing. Default: no checkpoints");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -138,6 +142,8 @@ int main(int argc, char** argv) {
     server = std::make_unique<snapthread::server::Server>(params);
   } catch (const snapthread::auth::KeyFileError& e) {
     return Usage(std::string("--key: ") + e.what());
+  } catch (const snapthread::server::CheckpointIoError& e) {
+    return Usage(e.what());
   } catch (const snapthread::server::LcmInitError& e) {
     std::fprintf(stderr, "snapthread-server: %s\n", e.what());
     return kExitLcm;

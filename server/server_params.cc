@@ -63,6 +63,10 @@ bool ServerParams::IsValid(std::string* error) const {
     return Fail(error, "--load-timeout: must be in (0, 3600] seconds, got " +
                            std::to_string(load_timeout_s));
   }
+  if (!std::isfinite(checkpoint_rate_hz) || checkpoint_rate_hz < 5.0 || checkpoint_rate_hz > 1000.0) {
+    return Fail(error, "checkpoint rate: must be in [5, 1000] Hz, got " +
+                           std::to_string(checkpoint_rate_hz));
+  }
   if (!IsKnownLogLevel(log_level)) {
     return Fail(error, "--log-level: unknown level '" + log_level +
                            "' (expected trace, debug, info, warn, error, critical or off)");

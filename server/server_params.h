@@ -50,6 +50,12 @@ struct ServerParams {
   // The session key file (--key): "" = $SNAPTHREAD_KEY_FILE, else the XDG default
   // (auth/key_file.h). The server creates it when it does not exist.
   std::string key_path;
+  // Where the server checkpoints the scene, method, grasp and state (--state-dir; "" =
+  // no checkpoints). Restarted with the same directory and session it resumes on the
+  // same branch (server/checkpoint.h). Made (mode 0700) when missing.
+  std::string state_dir;
+  // Checkpoints per second while the state changes (>= 5, issue 12); not a flag.
+  double checkpoint_rate_hz = 20.0;
 
   // False with a message naming the offending field (as a command-line flag) when
   // invalid. Does not touch the file system (the scene is checked when loaded).

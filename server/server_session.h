@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -16,6 +17,8 @@ struct Server::Session {
   std::unique_ptr<EquilibriumTracker> tracker;
   // The grip direction of a device at rest (pose_mapping.h).
   Eigen::Vector3d rest_direction = Eigen::Vector3d::UnitX();
+  // The scene's YAML as loaded, for checkpoints (empty without --state-dir).
+  std::string scene_text;
 };
 
 }  // namespace snapthread::server

@@ -3,12 +3,10 @@
 // codes and a malloc-counting guard (after Drake's LimitMalloc) for the
 // "no allocation after the first Factorize()" promise of the interface.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <memory>
-#include <new>
 #include <random>
 #include <string>
 #include <utility>
@@ -17,88 +15,17 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include "allocation_counter.h"
 #include "linalg/linear_solver.h"
 #include "models/models.h"
 #include "solvers/solver.h"
 #include "tracking/tracker.h"
 
-// ---------------------------------------------------------------------------------
-// Allocation counting. glibc lets a program replace malloc; the replacements forward
-// to __libc_* and count while the calling thread has counting switched on. This sees
-// every heap allocation: operator new (the replacement below calls malloc), Eigen's aligned_malloc
-// (std::malloc, which operator new alone would miss) and CHOLMOD's SuiteSparse_malloc.
-// operator new/delete are replaced as well, with their own counter, so the test can
-// also say "no C++ allocation" independently of the malloc interposition.
-namespace {
-std::atomic<long> g_mallocs{0};
-std::atomic<long> g_news{0};
-thread_local bool t_counting = false;
-}  // namespace
-// Under AddressSanitizer the sanitizer owns malloc: no interposition there, and the
-// allocation-counting tests run in the Release build only (deploy/test.sh).
-#if !defined(__SANITIZE_ADDRESS__)
-extern "C" void* __libc_malloc(size_t size);
-extern "C" void* __libc_calloc(size_t count, size_t size);
-extern "C" void* __libc_realloc(void* ptr, size_t size);
-extern "C" void __libc_free(void* ptr);
-
-
-extern "C" void* malloc(size_t size) {
-  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
-extern "C" void* calloc(size_t count, size_t size) {
-  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(count, size);
-}
-extern "C" void* realloc(void* ptr, size_t size) {
-  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(ptr, size);
-}
-extern "C" void free(void* ptr) { __libc_free(ptr); }
-
-void* operator new(size_t size) {
-  if (t_counting) g_news.fetch_add(1, std::memory_order_relaxed);
-  void* p = malloc(size == 0 ? 1 : size);  // counted by malloc too
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-void* operator new[](size_t size) { return operator new(size); }
-void* operator new(size_t size, const std::nothrow_t&) noexcept {
-  if (t_counting) g_news.fetch_add(1, std::memory_order_relaxed);
-  return malloc(size == 0 ? 1 : size);
-}
-void* operator new[](size_t size, const std::nothrow_t& tag) noexcept {
-  return operator new(size, tag);
-}
-void operator delete(void* p) noexcept { __libc_free(p); }
-void operator delete[](void* p) noexcept { __libc_free(p); }
-void operator delete(void* p, size_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, size_t) noexcept { __libc_free(p); }
-#endif  // !__SANITIZE_ADDRESS__
-
 namespace snapthread {
 namespace {
 
-// Counts heap allocations of this thread between construction and Stop().
-class AllocationCounter {
- public:
-  AllocationCounter() : mallocs0_(g_mallocs.load()), news0_(g_news.load()) {
-    t_counting = true;
-  }
-  ~AllocationCounter() { t_counting = false; }
-  void Stop() {
-    t_counting = false;
-    mallocs_ = g_mallocs.load() - mallocs0_;
-    news_ = g_news.load() - news0_;
-  }
-  long mallocs() const { return mallocs_; }
-  long news() const { return news_; }
-
- private:
-  long mallocs0_, news0_;
-  long mallocs_ = -1, news_ = -1;
-};
+// Allocation counting: tests/support/allocation_counter.h.
+using test_support::AllocationCounter;
 
 // ---------------------------------------------------------------------------------
 // Matrices.

@@ -7,7 +7,6 @@
 // relative-norm tolerance 1e-6 passes with margin while any wrong term (a missing
 // factor, sign, transpose or chain-rule piece) is off by O(1).
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdlib>
@@ -22,51 +21,8 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "allocation_counter.h"
 #include "models/models.h"
-
-// ---------------------------------------------------------------------------------
-// Allocation counting (Drake's LimitMalloc idea): this test binary interposes glibc's
-// malloc family and counts calls while a guard is active. Eigen's dynamic objects and
-// operator new all end in these functions.
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
-#define SNAPTHREAD_COUNT_MALLOC 1
-namespace {
-std::atomic<bool> g_count_allocations{false};
-std::atomic<long> g_allocations{0};
-void NoteAllocation() {
-  if (g_count_allocations.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-}
-}  // namespace
-extern "C" {
-void* __libc_malloc(std::size_t size);
-void* __libc_calloc(std::size_t count, std::size_t size);
-void* __libc_realloc(void* ptr, std::size_t size);
-void* __libc_memalign(std::size_t alignment, std::size_t size);
-void* malloc(std::size_t size) {
-  NoteAllocation();
-  return __libc_malloc(size);
-}
-void* calloc(std::size_t count, std::size_t size) {
-  NoteAllocation();
-  return __libc_calloc(count, size);
-}
-void* realloc(void* ptr, std::size_t size) {
-  NoteAllocation();
-  return __libc_realloc(ptr, size);
-}
-void* aligned_alloc(std::size_t alignment, std::size_t size) {
-  NoteAllocation();
-  return __libc_memalign(alignment, size);
-}
-int posix_memalign(void** out, std::size_t alignment, std::size_t size) {
-  NoteAllocation();
-  *out = __libc_memalign(alignment, size);
-  return *out == nullptr ? 12 /* ENOMEM */ : 0;
-}
-}
-#endif
 
 namespace snapthread {
 namespace {
@@ -317,16 +273,14 @@ TEST_P(ModelDerivativeTest, PresizedOutputsAreReusedWithoutAllocation) {
   const double* g_data = g.data();
   const double* exu_data = exu.data();
 
-#ifdef SNAPTHREAD_COUNT_MALLOC
-  // Sanity check of the counter itself, so a broken interposition cannot pass silently.
-  g_allocations = 0;
-  g_count_allocations = true;
-  { Vec scratch(1000); scratch.setZero(); }
-  g_count_allocations = false;
-  ASSERT_GE(g_allocations.load(), 1) << "malloc counter is not counting";
-  g_allocations = 0;
-  g_count_allocations = true;
-#endif
+  if (test_support::kCountsAllocations) {
+    // Sanity check of the counter itself, so a broken interposition cannot pass silently.
+    test_support::AllocationCounter sanity;
+    { Vec scratch(1000); scratch.setZero(); }
+    sanity.Stop();
+    ASSERT_GE(sanity.mallocs(), 1) << "malloc counter is not counting";
+  }
+  test_support::AllocationCounter counter;
   double e = 0.0;
   for (int rep = 0; rep < 3; ++rep) {
     e += m.Energy(pt.x, pt.u);
@@ -336,10 +290,8 @@ TEST_P(ModelDerivativeTest, PresizedOutputsAreReusedWithoutAllocation) {
     m.MixedHessian(pt.x, pt.u, &exu);
     m.ControlHessian(pt.x, pt.u, &euu);
   }
-#ifdef SNAPTHREAD_COUNT_MALLOC
-  g_count_allocations = false;
-  EXPECT_EQ(g_allocations.load(), 0) << "evaluation allocated on presized outputs";
-#endif
+  counter.Stop();
+  EXPECT_EQ(counter.mallocs(), 0) << "evaluation allocated on presized outputs";
   EXPECT_TRUE(std::isfinite(e));
   EXPECT_EQ(h.valuePtr(), values);
   EXPECT_EQ(h.innerIndexPtr(), inner);

@@ -4,10 +4,6 @@
 // EquilibriumTracker.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -18,48 +14,11 @@
 #include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
+#include "allocation_counter.h"
 #include "models/rod_energy.h"
 #include "models/rod_model.h"
 #include "solvers/registry.h"
 #include "tracking/tracker.h"
-
-// Allocation counting (as in linear_solver_test.cc): malloc is replaced and counts
-// while the calling thread has counting switched on; operator new goes through malloc.
-namespace {
-std::atomic<long> g_mallocs{0};
-thread_local bool t_counting = false;
-}  // namespace
-// Under AddressSanitizer the sanitizer owns malloc: no interposition there, and the
-// allocation-counting tests run in the Release build only (deploy/test.sh).
-#if !defined(__SANITIZE_ADDRESS__)
-extern "C" void* __libc_malloc(size_t size);
-extern "C" void* __libc_calloc(size_t count, size_t size);
-extern "C" void* __libc_realloc(void* ptr, size_t size);
-extern "C" void __libc_free(void* ptr);
-extern "C" void* malloc(size_t size) {
-  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
-extern "C" void* calloc(size_t count, size_t size) {
-  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(count, size);
-}
-extern "C" void* realloc(void* ptr, size_t size) {
-  if (t_counting) g_mallocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(ptr, size);
-}
-extern "C" void free(void* ptr) { __libc_free(ptr); }
-void* operator new(size_t size) {
-  void* p = malloc(size == 0 ? 1 : size);
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-void* operator new[](size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { __libc_free(p); }
-void operator delete[](void* p) noexcept { __libc_free(p); }
-void operator delete(void* p, size_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, size_t) noexcept { __libc_free(p); }
-#endif  // !__SANITIZE_ADDRESS__
 
 namespace snapthread {
 namespace {
@@ -292,16 +251,15 @@ TEST(RodModel, HessianRefillDoesNotAllocate) {
   Mat exu(model.NumStates(), 6), euu(6, 6);
   model.Hessian(s.x, s.u, &h);
   const Mat first(h);
-  const long before = g_mallocs.load();
-  t_counting = true;
+  test_support::AllocationCounter counter;
   model.Hessian(s.x, s.u, &h);
   model.Gradient(s.x, s.u, &g);
   model.ControlGradient(s.x, s.u, &eu);
   model.MixedHessian(s.x, s.u, &exu);
   model.ControlHessian(s.x, s.u, &euu);
   const double e = model.Energy(s.x, s.u);
-  t_counting = false;
-  EXPECT_EQ(g_mallocs.load() - before, 0);
+  counter.Stop();
+  EXPECT_EQ(counter.mallocs(), 0);
   EXPECT_TRUE(std::isfinite(e));
   EXPECT_EQ((Mat(h) - first).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(model.HessianBandwidth(), 10);  // a vertex spans nodes i-1 .. i+1

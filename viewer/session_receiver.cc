@@ -1,5 +1,6 @@
 #include "session_receiver.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -16,12 +17,13 @@ SessionReceiver::SessionReceiver(lcm::LCM* lcm, const std::string& session,
       key_(key),
       shape_channel_(transport::Channels(session).shape),
       status_channel_(transport::Channels(session).solver_status) {
-  subscriptions_.push_back(lcm_->subscribe(shape_channel_, &SessionReceiver::OnShape, this));
-  subscriptions_.push_back(lcm_->subscribe(status_channel_, &SessionReceiver::OnStatus, this));
-  for (auto* s : subscriptions_) {
-    // Latest wins: a viewer never needs a backlog of stale shapes.
-    if (s != nullptr) s->setQueueCapacity(4);
-  }
+  lcm::Subscription* shapes = lcm_->subscribe(shape_channel_, &SessionReceiver::OnShape, this);
+  lcm::Subscription* statuses = lcm_->subscribe(status_channel_, &SessionReceiver::OnStatus, this);
+  // LCM's reader thread drops what arrives while a subscription's queue is full (its
+  // default is 30 messages). Statuses (10 Hz) only update the overlay; every shape counts.
+  if (shapes != nullptr) shapes->setQueueCapacity(kShapeQueue);
+  if (statuses != nullptr) statuses->setQueueCapacity(4);
+  subscriptions_ = {shapes, statuses};
 }
 
 SessionReceiver::~SessionReceiver() {
@@ -96,6 +98,9 @@ void SessionReceiver::OnShape(const lcm::ReceiveBuffer* rbuf, const std::string&
   latest_.shape = std::move(shape);
   latest_.has_shape = true;
   latest_.shapes_received = ++shapes_received_;
+  if (sequence_.first < 0) sequence_.first = latest_.shape.seq;
+  sequence_.highest = std::max(sequence_.highest, latest_.shape.seq);
+  sequence_.received++;
   shape_times_s_.push_back(now);
   while (!shape_times_s_.empty() && shape_times_s_.front() < now - 1.0) shape_times_s_.pop_front();
   history_.push_back({now, f});
@@ -133,6 +138,11 @@ SessionSnapshot SessionReceiver::Snapshot(bool with_history) const {
   s.shape_rate_hz = recent;
   if (with_history) s.force_history.assign(history_.begin(), history_.end());
   return s;
+}
+
+ShapeSequence SessionReceiver::shape_sequence() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return sequence_;
 }
 
 std::string SessionReceiver::last_error() const {

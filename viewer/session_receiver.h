@@ -1,7 +1,11 @@
 // The viewer's LCM side: subscribes to <SESSION>_SHAPE and <SESSION>_SOLVER_STATUS, vets
 // every message (bad ones are dropped and counted; handlers never throw) and keeps the latest
 // of each for the render loop. LCM is handled on its own thread, so rendering never blocks
-// on the network.
+// on the network: liblcm's reader thread drains the socket into the subscription queue,
+// the receiver's thread (Loop) vets each message into the latest-value slot, and the render
+// loop copies the slot (Snapshot). The shape queue holds seconds of shapes, so a receiver
+// thread the scheduler leaves off the CPU under load catches up instead of LCM dropping
+// what arrives meanwhile; the renderer still only ever sees the latest shape.
 #pragma once
 
 #include <atomic>
@@ -27,6 +31,15 @@ struct ForceSample {
   double force_n;  // |force_newtons|
 };
 
+// The server's shape sequence numbers (thread_shape_t::seq) against what arrived.
+struct ShapeSequence {
+  int64_t first = -1;    // first seq received (-1: none yet)
+  int64_t highest = -1;  // highest seq received
+  int64_t received = 0;  // valid shapes received
+  // Published between first and highest but not received (lost or refused).
+  int64_t Missed() const { return first < 0 ? 0 : highest - first + 1 - received; }
+};
+
 struct SessionSnapshot {
   bool has_shape = false;
   thread_shape_t shape;
@@ -44,6 +57,8 @@ struct SessionSnapshot {
 class SessionReceiver {
  public:
   static constexpr double kHistorySeconds = 10.0;
+  // Shapes LCM may queue for the receiver thread: 4 s at the server's 60 Hz.
+  static constexpr int kShapeQueue = 240;
 
   // Subscribes on `lcm` (which must be good()). Call Start() to begin handling.
   // `session` must be a valid session name (transport::Channels throws otherwise).
@@ -62,6 +77,7 @@ class SessionReceiver {
   SessionSnapshot Snapshot(bool with_history = true) const;
   int64_t shapes_received() const { return shapes_received_.load(); }
   int64_t bad_messages() const { return bad_messages_.load(); }
+  ShapeSequence shape_sequence() const;
   // The server epoch learned from an authenticated status (0: none yet).
   int64_t epoch() const { return status_filter_.epoch(); }
   int64_t auth_rejected() const {
@@ -98,6 +114,7 @@ class SessionReceiver {
   SessionSnapshot latest_;
   std::deque<double> shape_times_s_;
   std::deque<ForceSample> history_;
+  ShapeSequence sequence_;
   std::string last_error_;
 };
 

@@ -165,17 +165,21 @@ std::optional<auth::SessionKey> LoadViewerKey(const ViewerOptions& options) {
   }
 }
 
+// Whether the LCM at --lcm-url opened; if not, says so and how to start it.
+bool LcmOpened(const lcm::LCM& lcm, const ViewerOptions& options) {
+  if (lcm.good()) return true;
+  std::fprintf(stderr, "snapthread-viewer: cannot open LCM at %s. %s\n", options.lcm_url.c_str(),
+               transport::LcmStartHint(options.lcm_url).c_str());
+  return false;
+}
+
 }  // namespace
 
 int RunPrintRates(const ViewerOptions& options) {
   const std::optional<auth::SessionKey> key = LoadViewerKey(options);
   if (!key) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
-  if (!lcm.good()) {
-    std::fprintf(stderr, "snapthread-viewer: cannot open LCM at %s. %s\n", options.lcm_url.c_str(),
-                 transport::LcmStartHint(options.lcm_url).c_str());
-    return kExitSetupFailed;
-  }
+  if (!LcmOpened(lcm, options)) return kExitSetupFailed;
   ChannelRateMonitor monitor(&lcm, options.session + "_.*");
   // Checks shapes and statuses on the same LCM (handled by this loop) to count refusals.
   SessionReceiver checked(&lcm, options.session, &*key);
@@ -217,12 +221,11 @@ int RunViewer(const ViewerOptions& options) {
   const std::optional<auth::SessionKey> key = LoadViewerKey(options);
   if (!key) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
-  if (!lcm.good()) {
-    std::fprintf(stderr, "snapthread-viewer: cannot open LCM at %s. %s\n", options.lcm_url.c_str(),
-                 transport::LcmStartHint(options.lcm_url).c_str());
-    return kExitSetupFailed;
-  }
+  if (!LcmOpened(lcm, options)) return kExitSetupFailed;
   SessionReceiver receiver(&lcm, options.session, &*key);
+  // Receiving starts before the window: GL start-up takes seconds on a loaded machine, and
+  // LCM drops what the shape queue cannot hold meanwhile.
+  receiver.Start();
   std::unique_ptr<GraspPublisher> grasp;
   if (scene) {
     grasp = std::make_unique<GraspPublisher>(&lcm, options.session, scene->device, &*key,
@@ -274,7 +277,6 @@ int RunViewer(const ViewerOptions& options) {
     glfwSetScrollCallback(window, &OnScroll);
     glfwSetKeyCallback(window, &OnKey);
 
-    receiver.Start();
     const auto start = Clock::now();
     const bool screenshot = !options.screenshot_path.empty();
     const double frame_period_s = 1.0 / options.max_fps;
@@ -348,6 +350,11 @@ int RunViewer(const ViewerOptions& options) {
       std::printf("snapthread-viewer: %lld shapes, %lld bad messages\n",
                   static_cast<long long>(receiver.shapes_received()),
                   static_cast<long long>(receiver.bad_messages()));
+      // Against the server's numbering: what was published while this viewer listened.
+      const ShapeSequence seq = receiver.shape_sequence();
+      std::printf("snapthread-viewer: shape seq %lld..%lld: %lld received, %lld missed\n",
+                  static_cast<long long>(seq.first), static_cast<long long>(seq.highest),
+                  static_cast<long long>(seq.received), static_cast<long long>(seq.Missed()));
     }
     receiver.Stop();
   }

@@ -47,7 +47,8 @@ int main(int argc, char** argv) {
   app.add_option("--scene", o.scene_path, "scene YAML (its device mapping; needed by --grasp-mode)")
       ->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
-  o.lcm_url = snapthread::transport::ResolveLcmUrl(o.lcm_url);
+  // A receiver: a kernel buffer that rides out seconds off the CPU (lcm_url.h).
+  o.lcm_url = snapthread::transport::WithReceiveBuffer(snapthread::transport::ResolveLcmUrl(o.lcm_url));
   if (!snapthread::transport::IsValidSessionName(o.session)) {
     std::fprintf(stderr, "snapthread-viewer: bad --session '%s' (expected [A-Za-z0-9_]+)\n",
                  o.session.c_str());

@@ -7,8 +7,9 @@
 namespace snapthread::auth {
 
 // A server session's epoch: 64 random bits (randombytes_buf), never 0 (0 is the field's
-// default and means "no epoch"). New at each server start unless restored from a
-// checkpoint. Throws std::runtime_error only if libsodium cannot start.
+// default and means "no epoch"). New at each server start, also when the server resumes
+// a checkpoint (the saved epoch is never reused: docs/security.md "Checkpoints").
+// Throws std::runtime_error only if libsodium cannot start.
 int64_t NewEpoch();
 
 // A sender's auth_seq source: strictly increasing, starting from CLOCK_REALTIME in

@@ -12,6 +12,20 @@ inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
 // non-empty, else kDefaultLcmUrl.
 std::string ResolveLcmUrl(const std::string& flag_value);
 
+// The kernel receive buffer a long-running receiver (viewer, logger) asks for: 2 s of the
+// whole session's traffic (~2,100 messages/s of up to ~1.5 KB each, counted at the kernel's
+// per-packet overhead), so a receiver the scheduler leaves off the CPU for a while under
+// load catches up instead of the kernel dropping datagrams.
+inline constexpr int kReceiverBufferBytes = 8 * 1024 * 1024;
+
+// `url` with `recv_buf_size=N` added when it is a udpm:// URL without one (other providers
+// and URLs that already set it are returned unchanged). N is `bytes`, but at most
+// `rmem_max` (net.core.rmem_max; LCM's udpm provider sets SO_RCVBUF, which the kernel
+// silently caps there, and LCM warns on every start when it got less than it asked for).
+std::string WithReceiveBuffer(const std::string& url, int bytes, long rmem_max);
+// The same with this machine's /proc/sys/net/core/rmem_max (no cap when unreadable).
+std::string WithReceiveBuffer(const std::string& url, int bytes = kReceiverBufferBytes);
+
 // A one-line hint for a failed LCM start (e.g. the multicast route for udpm).
 std::string LcmStartHint(const std::string& url);
 

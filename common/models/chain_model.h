@@ -6,8 +6,10 @@
 // and nothing allocates) and provides
 //   template <class F> void Local(int t, const Vec& x, const Vec& u, bool want_h, F&& f) const
 // calling f(local gradient, local Hessian (valid if want_h), leading dimension) for term t
-// in the term's assembly variables. Its constructor registers the terms with
-// assembly_.AddTerm and then calls FinishTerms().
+// in the term's assembly variables, and
+//   void AddTerm(bool bend, int first_node)
+// registering one term with assembly_.AddTerm and in terms_ (elements with `bend` and
+// `first_node`). Its constructor calls AddChainTerms(); its Energy can be ChainEnergy.
 #pragma once
 
 #include <algorithm>
@@ -88,14 +90,37 @@ class ChainModel : public Model {
   int HessianBandwidth() const override { return assembly_.Bandwidth(); }
 
  protected:
-  ChainModel(int num_states, int num_controls) : assembly_(num_states, num_controls) {}
+  // params.n is the number of segments (ChainParamSpecs).
+  ChainModel(const ModelParams& params, int num_states, int num_controls)
+      : n_(params.Integer("n")), nx_(num_states), assembly_(num_states, num_controls) {}
 
-  // Builds the pattern once every term is registered, and notes the terms that touch u.
-  void FinishTerms() {
+  // Registers the terms in the chains' order (stretching of segments 1..n, then bending
+  // at joints 1..n-1), then builds the pattern once and notes the terms that touch u.
+  void AddChainTerms() {
+    Derived& self = static_cast<Derived&>(*this);
+    for (int i = 1; i <= n_; ++i) self.AddTerm(false, i - 1);
+    for (int j = 1; j <= n_ - 1; ++j) self.AddTerm(true, j - 1);
     assembly_.Finalize();
     for (int t = 0; t < assembly_.NumTerms(); ++t) {
       if (assembly_.TouchesControls(t)) control_terms_.push_back(t);
     }
+  }
+
+  // shift + the sum, in term order, of the stretching terms stretch (|v| - rest)² and
+  // the bending terms bend (1 - w·w') (hessian_assembly.h), nodes from Derived::Node.
+  template <int D>
+  double ChainEnergy(const Vec& x, const Vec& u, double shift, double bend, double stretch,
+                     double rest) const {
+    const Derived& self = Self();
+    double e = shift;
+    for (const auto& term : self.terms_) {
+      const int a = term.first_node;
+      e += term.bend ? BendTerm<D>(self.Node(a, x, u), self.Node(a + 1, x, u),
+                                   self.Node(a + 2, x, u), bend, nullptr, nullptr)
+                     : StretchTerm<D>(self.Node(a, x, u), self.Node(a + 1, x, u), stretch, rest,
+                                      nullptr, nullptr);
+    }
+    return e;
   }
 
   // Clamped–pinned Euler buckling load 20.19 EI / L² of a chain of n segments of length
@@ -106,6 +131,8 @@ class ChainModel : public Model {
     return 20.19 * c * l / (total * total);
   }
 
+  const int n_;   // segments; nodes p_0 .. p_n
+  const int nx_;  // states
   HessianAssembly assembly_;
 
  private:

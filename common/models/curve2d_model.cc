@@ -19,7 +19,6 @@ namespace {
 
 using internal::BendTerm;
 using internal::ChainModel;
-using internal::ChainParamSpecs;
 using internal::StretchTerm;
 using V2 = Eigen::Vector2d;
 
@@ -28,31 +27,19 @@ constexpr char kName[] = "curve2d";
 class Curve2dModel final : public ChainModel<Curve2dModel> {
  public:
   explicit Curve2dModel(const ModelParams& params)
-      : ChainModel(2 * params.Integer("n") - 3, 2),
-        n_(params.Integer("n")),
+      : ChainModel(params, 2 * params.Integer("n") - 3, 2),
         l_(params.Number("segment_length")),
         beta_(params.Number("bending")),
-        gamma_(params.Number("stretching")),
-        nx_(2 * n_ - 3) {
-    // Term order: stretching of segments 1..n, then bending at joints 1..n-1.
-    for (int i = 1; i <= n_; ++i) AddTerm(false, i - 1);
-    for (int j = 1; j <= n_ - 1; ++j) AddTerm(true, j - 1);
-    FinishTerms();
+        gamma_(params.Number("stretching")) {
+    AddChainTerms();
   }
 
   std::string_view Name() const override { return kName; }
   int SpatialDimension() const override { return 2; }
 
+  // (2.1): Σ γ (|v_i| - l)² + Σ β (1 - t_i · t_{i+1}).
   double Energy(const Vec& x, const Vec& u) const override {
-    double e = 0.0;
-    for (const Term& term : terms_) {
-      const int a = term.first_node;
-      e += term.bend ? BendTerm<2>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u), beta_,
-                                   nullptr, nullptr)
-                     : StretchTerm<2>(Node(a, x, u), Node(a + 1, x, u), gamma_, l_, nullptr,
-                                      nullptr);
-    }
-    return e;
+    return ChainEnergy<2>(x, u, 0.0, beta_, gamma_, l_);
   }
 
   // Nodes evenly spaced on the chord from (0, 0) to u, plus a bump 1e-3 l sin(π i / n)
@@ -137,11 +124,9 @@ class Curve2dModel final : public ChainModel<Curve2dModel> {
     }
   }
 
-  const int n_;
   const double l_;
   const double beta_;
   const double gamma_;
-  const int nx_;
   std::vector<Term> terms_;
 };
 
@@ -150,7 +135,7 @@ class Curve2dModel final : public ChainModel<Curve2dModel> {
 ModelRegistration Curve2dRegistration() {
   return {.name = kName,
           .doc = "planar elastic strip of n segments, clamped at the origin, held at its end (2.1-2.2)",
-          .params = ChainParamSpecs("beta in beta (1 - t_i . t_{i+1}) (2.1)", "gamma in gamma (|v_i| - l)^2 (2.1)"),
+          .params = internal::ChainParamSpecs("beta in beta (1 - t_i . t_{i+1}) (2.1)", "gamma in gamma (|v_i| - l)^2 (2.1)"),
           .factory = [](const ModelParams& p) -> std::unique_ptr<Model> { return std::make_unique<Curve2dModel>(p); },
           .capabilities = {.grasp_layout = PlanarGrasp, .chain = ChainSpec{.per_length = {"bending", "stretching"}}}};
 }

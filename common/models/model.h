@@ -76,6 +76,21 @@ class Model {
   // moves that data to the accepted state here; at x itself E and the equilibrium do not
   // change. Models without history (zeeman, cusp, curve2d, thread3d) have nothing to do.
   virtual void AcceptState(const Vec& /*x*/, const Vec& /*u*/) {}
+
+  // Continuous symmetries: one-parameter groups of rotations x -> S_k(t) x (period 2 pi)
+  // that leave E(., u) unchanged for controls on the rotation's axis and nearly so near
+  // it (a thread3d grasp on the clamp axis lets the thread roll about it at no cost).
+  // Their generators span null directions of E_xx there, along which Newton steps are
+  // singular and straight steps crawl round the circle; the solvers step in the
+  // complement and move along the orbit itself (solvers/symmetry_orbits.h). The
+  // default is none: a model without such a symmetry has nothing to declare.
+  virtual int NumSymmetries() const { return 0; }
+  // The generator d/dt S_k(t) x at t = 0, size NumStates(). k < NumSymmetries().
+  virtual void SymmetryGenerator(int /*k*/, const Vec& x, const Vec& /*u*/, Vec* g) const {
+    g->setZero(x.size());
+  }
+  // y = S_k(t) x (t in radians). k < NumSymmetries().
+  virtual void ApplySymmetry(int /*k*/, double /*t*/, const Vec& x, const Vec& /*u*/, Vec* y) const { *y = x; }
 };
 
 }  // namespace snapthread

@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "models/chain_model.h"
 #include "models/registry.h"
 
@@ -28,7 +30,6 @@ namespace {
 
 using internal::BendTerm;
 using internal::ChainModel;
-using internal::ChainParamSpecs;
 using internal::HessianAssembly;
 using internal::StretchTerm;
 using V3 = Eigen::Vector3d;
@@ -48,33 +49,21 @@ int NumControlsFor(const ModelParams& p) { return p.Bool("grip_direction") ? 6 :
 class Thread3dModel final : public ChainModel<Thread3dModel> {
  public:
   explicit Thread3dModel(const ModelParams& params)
-      : ChainModel(NumStatesFor(params), NumControlsFor(params)),
-        n_(params.Integer("n")),
+      : ChainModel(params, NumStatesFor(params), NumControlsFor(params)),
         rest_(params.Number("segment_length")),
         half_beta_(0.5 * params.Number("bending")),
         half_gamma_(0.5 * params.Number("stretching")),
         energy_shift_(-n_ * params.Number("bending") * params.Number("reference_bend") / 2.0),
-        grip_(params.Bool("grip_direction")),
-        nx_(NumStatesFor(params)),
-        nu_(NumControlsFor(params)) {
-    for (int i = 1; i <= n_; ++i) AddTerm(false, i - 1);
-    for (int j = 1; j <= n_ - 1; ++j) AddTerm(true, j - 1);
-    FinishTerms();
+        grip_(params.Bool("grip_direction")) {
+    AddChainTerms();
   }
 
   std::string_view Name() const override { return kName; }
   int SpatialDimension() const override { return 3; }
 
+  // (3.7), (3.9) as the sums above: Σ γ/2 (l_i - L)² + Σ β/2 (1 - w_j·w_{j+1}) - N β B / 2.
   double Energy(const Vec& x, const Vec& u) const override {
-    double e = energy_shift_;
-    for (const Term& term : terms_) {
-      const int a = term.first_node;
-      e += term.bend ? BendTerm<3>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u),
-                                   half_beta_, nullptr, nullptr)
-                     : StretchTerm<3>(Node(a, x, u), Node(a + 1, x, u), half_gamma_, rest_,
-                                      nullptr, nullptr);
-    }
-    return e;
+    return ChainEnergy<3>(x, u, energy_shift_, half_beta_, half_gamma_, rest_);
   }
 
   // Nodes evenly spaced on the chord from 0 to p_N, plus a bump 1e-3 L sin(π i / N) in a
@@ -112,6 +101,30 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   // Clamped–pinned Euler load with EI = (β/2) L (see chain_model.h).
   double ForceScale() const override { return EulerLoad(n_, rest_, half_beta_); }
 
+  // The roll: rotation of the free nodes p_2 .. p_{N-1} about the clamp–grasp axis (the
+  // line through p_0 = 0 and the grasp), node 1 (x_1 only) and a grip's s unchanged. E
+  // is invariant when the grasp (and a grip direction) lies on the clamp axis, where
+  // the two axes coincide; near it the roll is nearly free. About the clamp axis instead
+  // the grasp would not be on the axis, and rolling half a turn would stretch the last
+  // segment by twice the grasp's offset: an orbit far from the near-symmetric one.
+  int NumSymmetries() const override { return 1; }
+  void SymmetryGenerator(int /*k*/, const Vec& x, const Vec& u, Vec* g) const override {
+    g->setZero(x.size());
+    const V3 axis = RollAxis(u);
+    for (int i = 2; i <= LastFreeNode(); ++i) {
+      const int o = 1 + 3 * (i - 2);
+      g->segment<3>(o) = axis.cross(V3(x.segment<3>(o)));
+    }
+  }
+  void ApplySymmetry(int /*k*/, double t, const Vec& x, const Vec& u, Vec* y) const override {
+    *y = x;
+    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(t, RollAxis(u)).toRotationMatrix();
+    for (int i = 2; i <= LastFreeNode(); ++i) {
+      const int o = 1 + 3 * (i - 2);
+      y->segment<3>(o) = rotation * V3(x.segment<3>(o));
+    }
+  }
+
  private:
   friend class ChainModel<Thread3dModel>;
   struct Term {
@@ -133,6 +146,14 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
     return 1 + 3 * (i - 2) + k;
   }
   bool IsGripNode(int i) const { return grip_ && i == n_ - 1; }
+  // The unit clamp–grasp direction (the clamp axis +x for a grasp at the clamp).
+  V3 RollAxis(const Vec& u) const {
+    const V3 p = u.head<3>();
+    const double length = p.norm();
+    return length > 1e-12 * rest_ ? V3(p / length) : V3::UnitX();
+  }
+  // The last node whose three coordinates are state variables.
+  int LastFreeNode() const { return grip_ ? n_ - 2 : n_ - 1; }
   V3 Node(int i, const Vec& x, const Vec& u) const {
     if (i == 0) return V3::Zero();
     if (i == 1 && !IsGripNode(1)) return V3(x[0], 0.0, 0.0);
@@ -280,14 +301,11 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
     f(gg.data(), hh.data(), kMaxVars);
   }
 
-  const int n_;
   const double rest_;        // L
   const double half_beta_;   // β/2
   const double half_gamma_;  // γ/2
   const double energy_shift_;  // -N β B / 2
   const bool grip_;
-  const int nx_;
-  const int nu_;
   std::vector<Term> terms_;
 };
 
@@ -297,7 +315,7 @@ ModelRegistration Thread3dRegistration() {
   ModelRegistration r;
   r.name = kName;
   r.doc = "3D elastic thread of N segments, clamped at the origin, held at its end (3.1-3.10, 3.15)";
-  r.params = ChainParamSpecs("beta in beta/2 (b_i - B) (3.9)", "gamma in gamma/2 (l_i - L)^2 (3.7)");
+  r.params = internal::ChainParamSpecs("beta in beta/2 (b_i - B) (3.9)", "gamma in gamma/2 (l_i - L)^2 (3.7)");
   r.params.push_back({.name = "reference_bend", .default_value = 0.0, .doc = "B (3.9); shifts the energy only"});
   r.params.push_back({.name = "grip_direction", .kind = ParamKind::kBool, .default_value = 0.0,
                       .doc = "the grip also holds the last segment's direction: u = (X, Y, Z, dx, dy, dz)"});

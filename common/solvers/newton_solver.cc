@@ -31,6 +31,7 @@ SolverBase::SolverBase(const Model& model, const SolverOptions& options)
     if (w.diag_index[j] < 0) throw std::logic_error("Hessian pattern lacks a diagonal entry");
   }
   w.eig.Resize(n_);
+  w.orbits = std::make_unique<SymmetryOrbits>(model_);
   for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch}) v->resize(n_);
 }
 
@@ -263,12 +264,19 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradi
 
 bool SolverBase::MinimizeFully(const Vec& u, Vec* x, SolverSummary* s) {
   constexpr int kMaxIterations = 400;  // the snap minimiser converges in ~10-20
+  // A snap across a symmetry axis goes round the orbit: move there on the circle first.
+  MoveAlongSymmetries(u, x);
   double r = EvalGradient(*x, u, s);
   for (int it = 0; it < kMaxIterations; ++it) {
     if (!std::isfinite(r)) return false;
     if (r < options_.cutoff) {
       // Stationary: a minimum only if E_xx has no negative pivot.
       if (FactorAt(*x, u, s) != LinearSolverStatus::kSuccess || ws_.factor->NegativePivots() == 0) return true;
+      // A saddle along a symmetry orbit: its minimum is on the circle, not on a line.
+      if (MoveAlongSymmetries(u, x)) {
+        r = EvalGradient(*x, u, s);
+        continue;
+      }
       UpdateEigenpair(8);
       const Vec& v = ws_.eig.vector();
       Vec& trial = ws_.trial;
@@ -299,6 +307,10 @@ bool SolverBase::MinimizeFully(const Vec& u, Vec* x, SolverSummary* s) {
     r = EvalGradient(*x, u, s);
   }
   return r < options_.cutoff;
+}
+
+bool SolverBase::MoveAlongSymmetries(const Vec& u, Vec* x) {
+  return !ws_.orbits->empty() && ws_.orbits->MoveDownhill(u, x);
 }
 
 void SolverBase::LeaveSaddle(const Vec& u, Vec* x, SolverSummary* s) {

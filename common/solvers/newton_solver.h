@@ -7,6 +7,7 @@
 
 #include "solvers/eigen_tracking.h"
 #include "solvers/solver.h"
+#include "solvers/symmetry_orbits.h"
 
 namespace snapthread {
 
@@ -95,6 +96,7 @@ class SolverBase : public EquilibriumSolver {
     std::unique_ptr<SymmetricLinearSolver> factor, alt_factor;
     std::vector<int> diag_index;  // position of (i,i) in h.valuePtr()
     SmallestEigenpair eig;
+    std::unique_ptr<SymmetryOrbits> orbits;
     Vec g, dx, trial, last_good, dx_scratch;
   };
 
@@ -106,6 +108,9 @@ class SolverBase : public EquilibriumSolver {
   // differentiation, lowest eigenpair, inertia, residual, energy, timing.
   // gradient_current: the workspace gradient already holds E_x(x).
   void Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradient_current = false);
+  // Moves x downhill along the model's symmetry orbits through it (a snap across a
+  // symmetry axis rolls the state round the circle); true if it moved.
+  bool MoveAlongSymmetries(const Vec& u, Vec* x);
   // After Finish(): a "converged" state with negative pivots is a saddle, not the
   // followed minimum. Leave it and minimise (counted as a snap); then Finish again.
   void LeaveSaddle(const Vec& u, Vec* x, SolverSummary* s);

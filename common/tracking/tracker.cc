@@ -68,6 +68,28 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   return result_;
 }
 
+const TrackResult& EquilibriumTracker::Resume(const Vec& x, const Vec& u) {
+  if (u.size() != model_->NumControls() || x.size() != model_->NumStates())
+    throw std::invalid_argument("EquilibriumTracker::Resume: state or control size mismatch");
+  if (!x.allFinite() || !u.allFinite())
+    throw std::invalid_argument("EquilibriumTracker::Resume: non-finite state or controls");
+  solver_->Reset();
+  x_ = x;
+  u_ = u;
+  // Lagged data (the rod's reference frames) from the model's start to the saved state,
+  // so E(x, u) is the energy the state was accepted under.
+  model_->AcceptState(x_, u_);
+  result_.summary = solver_->Solve(u_, &x_);
+  result_.snapped = false;
+  have_prev_ = false;
+  have_tangent_ = false;
+  x_prev_ = x_;
+  u_prev_ = u_;
+  ComputeForces();
+  model_->AcceptState(x_, u_);
+  return result_;
+}
+
 const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   if (u.size() != model_->NumControls())
     throw std::invalid_argument("EquilibriumTracker::Update: control size mismatch");

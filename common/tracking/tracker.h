@@ -34,6 +34,12 @@ class EquilibriumTracker {
   // Start again from the model's InitialState(u), solved to the cutoff with an
   // unlimited budget (a reset must start on an equilibrium).
   const TrackResult& Reset(const Vec& u);
+  // Start again from a saved equilibrium x at controls u (a server checkpoint): the
+  // model's lagged data is moved to x first (AcceptState), then x is solved again with the
+  // tracking solver, warm-started at x, so the state stays on its branch and the
+  // factorisation, force and K are current. Throws std::invalid_argument for sizes that
+  // do not match the model or a non-finite x or u.
+  const TrackResult& Resume(const Vec& x, const Vec& u);
   // One control update: predictor, solve within the budget, force and stiffness.
   const TrackResult& Update(const Vec& u);
 

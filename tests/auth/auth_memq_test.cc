@@ -61,7 +61,7 @@ class Device {
   }
 
   void SendPose() {
-    device_state_t pose = testing::Sample<device_state_t>();
+    device_state_t pose = test_support::Sample<device_state_t>();
     pose.seq = ++pose_seq_;
     pose.utime = 1000 * pose.seq + 7;
     const int64_t epoch = status_filter_.epoch();
@@ -101,7 +101,7 @@ class Server {
     if (Admit(rbuf->data, rbuf->data_size, pose, channel, *key_, &pose_filter_) != Reason::kAccepted) {
       return;
     }
-    force_model_t m = testing::Sample<force_model_t>();
+    force_model_t m = test_support::Sample<force_model_t>();
     m.device_seq = pose.seq;
     m.device_utime = pose.utime;
     ASSERT_TRUE(Sign(&m, kModel, epoch_, seq_.Next(), *key_));
@@ -110,7 +110,7 @@ class Server {
   }
 
   void SendStatus() {
-    solver_status_t s = testing::Sample<solver_status_t>();
+    solver_status_t s = test_support::Sample<solver_status_t>();
     ASSERT_TRUE(Sign(&s, kStatus, epoch_, seq_.Next(), *key_));
     lcm_->publish(kStatus, &s);
   }
@@ -168,7 +168,7 @@ TEST(AuthOverMemqTest, ForgedReplayedAndRekeyedMessagesAreRefusedAndCounted) {
   // 1. Forged models answering the device's last pose, with the sniffed epoch and a high
   //    sequence number, valid LCM encoding, but no key (tag left zero).
   for (int i = 0; i < 50; ++i) {
-    force_model_t forged = testing::Sample<force_model_t>();
+    force_model_t forged = test_support::Sample<force_model_t>();
     forged.f0[0] = 2.9;
     forged.device_seq = device.pose_seq_;
     forged.device_utime = 1000 * device.pose_seq_ + 7;
@@ -179,7 +179,7 @@ TEST(AuthOverMemqTest, ForgedReplayedAndRekeyedMessagesAreRefusedAndCounted) {
   // 2. The same, signed with a key of the attacker's own.
   const SessionKey rogue = SessionKey::Generate();
   for (int i = 0; i < 10; ++i) {
-    force_model_t forged = testing::Sample<force_model_t>();
+    force_model_t forged = test_support::Sample<force_model_t>();
     forged.device_seq = device.pose_seq_;
     forged.device_utime = 1000 * device.pose_seq_ + 7;
     ASSERT_TRUE(Sign(&forged, kModel, server->epoch_, INT64_MAX - i, rogue));
@@ -192,7 +192,7 @@ TEST(AuthOverMemqTest, ForgedReplayedAndRekeyedMessagesAreRefusedAndCounted) {
   for (const Bytes& b : logged) lcm.publish(kModel, b.data(), static_cast<unsigned>(b.size()));
   // 4. Forged poses to the server (no key): never answered.
   for (int i = 0; i < 30; ++i) {
-    device_state_t pose = testing::Sample<device_state_t>();
+    device_state_t pose = test_support::Sample<device_state_t>();
     pose.epoch = server->epoch_;
     pose.auth_seq = INT64_MAX - i;
     lcm.publish(kPose, &pose);

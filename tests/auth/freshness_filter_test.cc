@@ -185,9 +185,9 @@ TEST(PoseEchoWindowTest, ConcurrentReaderNeverSeesAPoseThatWasNotSent) {
 TEST(MessageGateTest, AdmitCountsBadMacThenFreshness) {
   const SessionKey key = SessionKey::Generate();
   FreshnessFilter f("S_DEVICE_STATE", FreshnessFilter::EpochPolicy::kFixed, kEpoch);
-  device_state_t pose = testing::Sample<device_state_t>();
+  device_state_t pose = test_support::Sample<device_state_t>();
   ASSERT_TRUE(Sign(&pose, "S_DEVICE_STATE", kEpoch, 7, key));
-  const auto bytes = testing::Encode(pose);
+  const auto bytes = test_support::Encode(pose);
   EXPECT_EQ(Admit(bytes.data(), bytes.size(), pose, "S_DEVICE_STATE", key, &f), Reason::kAccepted);
   EXPECT_EQ(Admit(bytes.data(), bytes.size(), pose, "S_DEVICE_STATE", key, &f),
             Reason::kStaleSequence);
@@ -203,17 +203,17 @@ TEST(MessageGateTest, ForceModelMustEchoASentPoseAndARefusalKeepsTheFloor) {
   sent->Record(kEpoch, 41, 123456000);
   FreshnessFilter f("S_FORCE_MODEL", FreshnessFilter::EpochPolicy::kFixed, kEpoch);
 
-  force_model_t unsent = testing::Sample<force_model_t>();
+  force_model_t unsent = test_support::Sample<force_model_t>();
   unsent.device_seq = 40;  // never sent
   ASSERT_TRUE(Sign(&unsent, "S_FORCE_MODEL", kEpoch, 500, key));
-  auto bytes = testing::Encode(unsent);
+  auto bytes = test_support::Encode(unsent);
   EXPECT_EQ(AdmitForceModel(bytes.data(), bytes.size(), unsent, "S_FORCE_MODEL", key, *sent, &f),
             Reason::kUnsentPoseEcho);
   EXPECT_EQ(f.last_accepted_seq(), 0);
 
-  force_model_t genuine = testing::Sample<force_model_t>();  // echoes (41, 123456000)
+  force_model_t genuine = test_support::Sample<force_model_t>();  // echoes (41, 123456000)
   ASSERT_TRUE(Sign(&genuine, "S_FORCE_MODEL", kEpoch, 400, key));
-  bytes = testing::Encode(genuine);
+  bytes = test_support::Encode(genuine);
   EXPECT_EQ(AdmitForceModel(bytes.data(), bytes.size(), genuine, "S_FORCE_MODEL", key, *sent, &f),
             Reason::kAccepted);
   EXPECT_EQ(AdmitForceModel(bytes.data(), bytes.size(), genuine, "S_FORCE_MODEL", key, *sent, &f),

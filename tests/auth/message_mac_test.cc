@@ -14,8 +14,8 @@
 namespace snapthread::auth {
 namespace {
 
-using testing::Encode;
-using testing::Sample;
+using test_support::Encode;
+using test_support::Sample;
 
 constexpr const char* kChannel = "SNAPTHREAD_TEST";
 constexpr int64_t kEpoch = 0x1234567890abcdefLL;
@@ -141,7 +141,7 @@ TEST(MessageMacEdgeTest, StringWithEmbeddedNulIsNotSigned) {
 
 TEST(MessageMacEdgeTest, LargeShapeSignsAndVerifies) {
   const SessionKey key = SessionKey::Generate();
-  thread_shape_t m = testing::Sample(static_cast<const thread_shape_t*>(nullptr), 50000);
+  thread_shape_t m = test_support::SampleShape(50000);
   ASSERT_TRUE(Sign(&m, kChannel, kEpoch, 1, key));
   std::vector<uint8_t> bytes = Encode(m);
   EXPECT_TRUE(VerifyEncoded(bytes.data(), bytes.size(), kChannel, key));

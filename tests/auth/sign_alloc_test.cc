@@ -1,17 +1,15 @@
 // Proves the per-message auth work allocates nothing after warm-up, so the device can
-// sign on its 1 kHz path: global operator new/delete are replaced by counting versions
-// (the guard of tests/service/device_tick_alloc_test.cc), each message type is signed
+// sign on its 1 kHz path: the heap allocations of the thread are counted
+// (tests/support/allocation_counter.h), each message type is signed
 // once to warm the per-thread buffer up, then 10,000 rounds of Sign, VerifyEncoded,
 // the freshness filter, the pose-echo window and the sequence counter must allocate
 // nothing.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
 #include <memory>
-#include <new>
 #include <vector>
 
+#include "allocation_counter.h"
 #include "auth/freshness_filter.h"
 #include "auth/message_gate.h"
 #include "auth/message_mac.h"
@@ -19,70 +17,24 @@
 #include "auth/session_epoch.h"
 #include "sample_messages.h"
 
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-
-void* CountedAlloc(std::size_t n) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  void* p = std::malloc(n == 0 ? 1 : n);
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-void* CountedAlignedAlloc(std::size_t n, std::align_val_t al) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  const std::size_t a = static_cast<std::size_t>(al);
-  void* p = std::aligned_alloc(a, ((n + a - 1) / a) * a);
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-}  // namespace
-
-void* operator new(std::size_t n) { return CountedAlloc(n); }
-void* operator new[](std::size_t n) { return CountedAlloc(n); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try { return CountedAlloc(n); } catch (...) { return nullptr; }
-}
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-  try { return CountedAlloc(n); } catch (...) { return nullptr; }
-}
-void* operator new(std::size_t n, std::align_val_t al) { return CountedAlignedAlloc(n, al); }
-void* operator new[](std::size_t n, std::align_val_t al) { return CountedAlignedAlloc(n, al); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-
 namespace snapthread::auth {
 namespace {
 
-class AllocationGuard {
- public:
-  AllocationGuard() {
-    g_allocations.store(0);
-    g_counting.store(true);
-  }
-  ~AllocationGuard() { g_counting.store(false); }
-  long count() const { return g_allocations.load(); }
-};
+using test_support::AllocationCounter;
 
 constexpr const char* kPoseChannel = "SNAPTHREAD_DEVICE_STATE";
 constexpr const char* kModelChannel = "SNAPTHREAD_FORCE_MODEL";
 
 TEST(AuthAllocationTest, GuardSeesTheFirstSignOfALargerMessage) {
-  // The guard must be able to fail on this path: the per-thread buffer grows for a
+  // The counter must be able to fail on this path: the per-thread buffer grows for a
   // message larger than any signed before on this thread.
   const SessionKey key = SessionKey::Generate();
-  thread_shape_t big = testing::Sample(static_cast<const thread_shape_t*>(nullptr), 20000);
+  thread_shape_t big = test_support::SampleShape(20000);
   long n = 0;
   {
-    AllocationGuard guard;
+    AllocationCounter counter;
     EXPECT_TRUE(Sign(&big, "SHAPE", 1, 1, key));
-    n = guard.count();
+    n = counter.mallocs();
   }
   EXPECT_GE(n, 1);
 }
@@ -95,11 +47,11 @@ TEST(AuthAllocationTest, SignVerifyAndFreshnessNeverAllocateAfterWarmUp) {
   FreshnessFilter pose_filter(kPoseChannel, FreshnessFilter::EpochPolicy::kFixed, epoch);
   FreshnessFilter model_filter(kModelChannel, FreshnessFilter::EpochPolicy::kFixed, epoch);
 
-  device_state_t pose = testing::Sample<device_state_t>();
-  force_model_t model = testing::Sample<force_model_t>();
-  device_status_t status = testing::Sample<device_status_t>();
-  thread_shape_t shape = testing::Sample<thread_shape_t>();
-  // Encoded buffers the receivers check, made outside the guard (LCM's receive buffer).
+  device_state_t pose = test_support::Sample<device_state_t>();
+  force_model_t model = test_support::Sample<force_model_t>();
+  device_status_t status = test_support::Sample<device_status_t>();
+  thread_shape_t shape = test_support::Sample<thread_shape_t>();
+  // Encoded buffers the receivers check, made outside the counter (LCM's receive buffer).
   std::vector<uint8_t> pose_bytes(4096), model_bytes(4096);
 
   // Warm-up: one of each (the per-thread buffer reaches its size).
@@ -118,15 +70,15 @@ TEST(AuthAllocationTest, SignVerifyAndFreshnessNeverAllocateAfterWarmUp) {
     pose.utime = 1000 * (i + 1);
     pose.position[0] = 1e-5 * i;
     {
-      AllocationGuard guard;
+      AllocationCounter counter;
       EXPECT_TRUE(Sign(&pose, kPoseChannel, epoch, device_seq.Next(), key));
       sent->Record(epoch, pose.seq, pose.utime);
-      allocations += guard.count();
+      allocations += counter.mallocs();
     }
     pose.encode(pose_bytes.data(), 0, pose_size);
     // Server: admits the pose, answers with a signed model.
     {
-      AllocationGuard guard;
+      AllocationCounter counter;
       if (Admit(pose_bytes.data(), static_cast<size_t>(pose_size), pose, kPoseChannel, key,
                 &pose_filter) == Reason::kAccepted) {
         ++accepted_poses;
@@ -135,13 +87,13 @@ TEST(AuthAllocationTest, SignVerifyAndFreshnessNeverAllocateAfterWarmUp) {
       model.device_utime = pose.utime;
       model.f0[0] = 0.001 * i;
       EXPECT_TRUE(Sign(&model, kModelChannel, epoch, server_seq.Next(), key));
-      allocations += guard.count();
+      allocations += counter.mallocs();
     }
     model.encode(model_bytes.data(), 0, model_size);
     if (i % 7 == 3) model_bytes[50] ^= 1;  // now and then a damaged one (bad MAC path)
     // Device: admits the model.
     {
-      AllocationGuard guard;
+      AllocationCounter counter;
       if (AdmitForceModel(model_bytes.data(), static_cast<size_t>(model_size), model,
                           kModelChannel, key, *sent, &model_filter) == Reason::kAccepted) {
         ++accepted_models;
@@ -150,7 +102,7 @@ TEST(AuthAllocationTest, SignVerifyAndFreshnessNeverAllocateAfterWarmUp) {
         status.ticks = i;
         EXPECT_TRUE(Sign(&status, "STATUS", epoch, device_seq.Next(), key));
       }
-      allocations += guard.count();
+      allocations += counter.mallocs();
     }
   }
   EXPECT_EQ(allocations, 0);

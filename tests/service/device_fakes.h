@@ -1,17 +1,33 @@
 // In-memory stand-ins for the network and the server, so a whole DeviceClient runs in
 // one thread without LCM: InMemoryTransport keeps what the client publishes and hands it
 // encoded force models; SpringServer answers each new pose with the force model of a
-// known linear spring, echoing the pose's sequence number and time.
+// known linear spring, echoing the pose's sequence number and time (optionally with one
+// snap, and signed with a session key as the real server does).
 #pragma once
 
 #include <cstdint>
 #include <cstring>
+#include <limits>
+#include <string>
 #include <vector>
 
+#include "auth/message_mac.h"
+#include "auth/session_epoch.h"
+#include "auth/session_key.h"
+#include "messages/channels.h"
 #include "snapthread/force_model_t.hpp"
+#include "snapthread/solver_status_t.hpp"
 #include "transport.h"
 
 namespace snapthread::device::testing {
+
+// An LCM message as it comes off the wire.
+template <class Msg>
+std::vector<uint8_t> Encoded(const Msg& msg) {
+  std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
 
 class InMemoryTransport final : public DeviceTransport {
  public:
@@ -41,11 +57,7 @@ class InMemoryTransport final : public DeviceTransport {
 
   // The server side: queue bytes (a force model as it would come off the wire).
   void Deliver(std::vector<uint8_t> bytes) { inbox_.push_back(std::move(bytes)); }
-  void Deliver(const force_model_t& msg) {
-    std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
-    msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-    Deliver(std::move(bytes));
-  }
+  void Deliver(const force_model_t& msg) { Deliver(Encoded(msg)); }
 
   std::vector<device_state_t> states;
   std::vector<device_status_t> statuses;
@@ -63,18 +75,45 @@ class SpringServer {
 
   void set_stiffness(double k_n_per_m) { k_ = k_n_per_m; }
 
+  // Signs every model AnswerAll sends, and DeliverStatus, for `session` (key must
+  // outlive the server): the device then learns `epoch` and checks as in production.
+  void SignWith(const auth::SessionKey* key, int64_t epoch, const std::string& session) {
+    key_ = key;
+    epoch_ = epoch;
+    channels_ = transport::Channels(session);
+  }
+
   force_model_t ModelFor(const device_state_t& s) {
     force_model_t m{};
     m.seq = seq_++;
     m.device_seq = s.seq;
     m.device_utime = s.utime;
-    m.status = force_model_t::STATUS_REGULAR;
+    // The snaps, with hysteresis as a fold pair has: a pose at or past snap_at_x_m moves
+    // the thread to its other branch, one at or below snap_back_at_x_m moves it back.
+    const bool snaps_now = snapped_ ? s.position[0] <= snap_back_at_x_m
+                                    : s.position[0] >= snap_at_x_m;
+    if (snaps_now) {
+      snapped_ = !snapped_;
+      ++snaps_;
+    }
+    m.status = snaps_now ? force_model_t::STATUS_SNAPPED : force_model_t::STATUS_REGULAR;
     for (int i = 0; i < 3; ++i) {
       m.u0[i] = s.position[i];
-      m.f0[i] = -k_ * (s.position[i] - anchor_m[i]);
+      m.f0[i] = -k_ * (s.position[i] - anchor_m[i]) + (snapped_ ? snap_jump_n[i] : 0.0);
       m.K[i][i] = -k_;
     }
     return m;
+  }
+
+  // A signed solver status announcing the epoch (SignWith first).
+  void DeliverStatus() {
+    solver_status_t st{};
+    st.scene = "spring";
+    st.method = "spring";
+    if (key_ != nullptr &&
+        auth::Sign(&st, channels_.solver_status, epoch_, auth_seq_.Next(), *key_)) {
+      t_->DeliverStatus(Encoded(st));
+    }
   }
 
   // The poses published since the last call, not yet answered.
@@ -87,14 +126,26 @@ class SpringServer {
   // Answers every new pose (latest last); returns how many.
   int AnswerAll() {
     int n = 0;
-    for (const auto& s : TakeNewPoses()) {
-      t_->Deliver(ModelFor(s));
-      ++n;
-    }
+    for (const auto& s : TakeNewPoses()) n += Send(ModelFor(s)) ? 1 : 0;
     return n;
   }
 
+  // Sends a model (signed with this server's epoch after SignWith); false when it
+  // cannot be signed.
+  bool Send(force_model_t m) {
+    if (key_ != nullptr && !auth::Sign(&m, channels_.force_model, epoch_, auth_seq_.Next(), *key_)) {
+      return false;
+    }
+    t_->Deliver(m);
+    return true;
+  }
+
   double anchor_m[3] = {0.0, 0.0, 0.0};
+  // No snap by default; snap_jump_n is added to the force on the other branch.
+  double snap_at_x_m = std::numeric_limits<double>::infinity();
+  double snap_back_at_x_m = -std::numeric_limits<double>::infinity();
+  double snap_jump_n[3] = {0.0, 0.0, 0.0};
+  int snaps() const { return snaps_; }
   double k() const { return k_; }
 
  private:
@@ -102,6 +153,12 @@ class SpringServer {
   double k_;
   int64_t seq_ = 1;
   size_t taken_ = 0;
+  bool snapped_ = false;
+  int snaps_ = 0;
+  const auth::SessionKey* key_ = nullptr;
+  int64_t epoch_ = 0;
+  auth::AuthSequence auth_seq_{0};
+  transport::Channels channels_{transport::kDefaultSession};
 };
 
 }  // namespace snapthread::device::testing

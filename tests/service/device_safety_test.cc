@@ -32,16 +32,12 @@ force_model_t Model(double f0x, double stiffness_n_per_m) {
   return m;
 }
 
+// The limits the tests below are written for, spelled out so that a change of the
+// defaults does not change the tests.
 SafetyLimits TestLimits() {
-  SafetyLimits l;
-  l.max_force_n = 3.0;
-  l.max_stiffness_n_per_m = 800.0;
-  l.max_force_rate_n_per_s = 1000.0;
-  l.model_timeout_s = 0.050;
-  l.fade_time_s = 0.100;
-  l.workspace_radius_m = 0.08;
-  l.tick_period_s = 0.001;
-  return l;
+  return {.max_force_n = 3.0, .max_stiffness_n_per_m = 800.0, .max_force_rate_n_per_s = 1000.0,
+          .model_timeout_s = 0.050, .fade_time_s = 0.100, .workspace_radius_m = 0.08,
+          .tick_period_s = 0.001};
 }
 
 LocalModel Prepared(const force_model_t& msg, int64_t receive_us,
@@ -54,15 +50,33 @@ LocalModel Prepared(const force_model_t& msg, int64_t receive_us,
 
 double Norm(const double f[3]) { return std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]); }
 
-// Runs ticks at 1 ms from *now_us until the fade-in is complete.
-void Settle(ForceSafety* s, LocalModel m, const double pos[3], int64_t* now_us,
-            SafetyOutput* out, int ticks = 200) {
-  for (int i = 0; i < ticks; ++i) {
-    m.receive_us = *now_us;  // fresh every tick
-    s->Step(pos, true, &m, *now_us, out);
-    *now_us += kTickUs;
+
+// The force safety layer with TestLimits() and the device at the origin, from t = 0.
+class DeviceForceSafetyTest : public ::testing::Test {
+ protected:
+  // Runs ticks at 1 ms with *m kept fresh (received at every tick); 200 ticks complete
+  // the fade-in.
+  void Settle(LocalModel* m, int ticks = 200) {
+    for (int i = 0; i < ticks; ++i) {
+      m->receive_us = now_;
+      safety_.Step(kOrigin, true, m, now_, &out_);
+      now_ += kTickUs;
+    }
   }
-}
+  // A ramp over the fade time, not a step: done within fade_time (+ 2 ticks), and not
+  // before 90 % of it.
+  void ExpectRampOverFadeTime(int ticks) const {
+    ASSERT_GT(ticks, 0);
+    EXPECT_LE(ticks, 1e3 * limits_.fade_time_s + 2);
+    EXPECT_GE(ticks, 0.9e3 * limits_.fade_time_s);
+  }
+
+  static constexpr double kOrigin[3] = {0.0, 0.0, 0.0};
+  const SafetyLimits limits_ = TestLimits();
+  ForceSafety safety_{limits_, false};
+  int64_t now_ = 0;
+  SafetyOutput out_;
+};
 
 // ---- PrepareModel -----------------------------------------------------------------------
 
@@ -178,7 +192,7 @@ TEST(DeviceLimitsTest, SmallerOfDeviceAndScene) {
 
 // ---- ForceSafety ----------------------------------------------------------------------
 
-TEST(DeviceForceSafetyTest, EvaluatesTheLocalModel) {
+TEST_F(DeviceForceSafetyTest, EvaluatesTheLocalModel) {
   ForceSafety s(TestLimits(), false);
   force_model_t msg = Model(0.2, 100.0);
   msg.u0[0] = 0.01;
@@ -198,7 +212,7 @@ TEST(DeviceForceSafetyTest, EvaluatesTheLocalModel) {
   EXPECT_FALSE(out.fading);
 }
 
-TEST(DeviceForceSafetyTest, ForceMagnitudeIsClamped) {
+TEST_F(DeviceForceSafetyTest, ForceMagnitudeIsClamped) {
   ForceSafety s(TestLimits(), false);
   force_model_t msg = Model(0.0, 0.0);
   msg.f0[0] = 30.0;
@@ -218,129 +232,93 @@ TEST(DeviceForceSafetyTest, ForceMagnitudeIsClamped) {
   EXPECT_GT(s.counters().force_clamps.load(), 0u);
 }
 
-TEST(DeviceForceSafetyTest, SlewLimitBoundsEveryTickAndStillReachesTheTarget) {
-  const SafetyLimits limits = TestLimits();
-  ForceSafety s(limits, false);
-  const double pos[3] = {0, 0, 0};
-  int64_t now = 0;
-  SafetyOutput out;
-  const LocalModel small = Prepared(Model(0.1, 0.0), now);
-  Settle(&s, small, pos, &now, &out);
-  ASSERT_NEAR(out.force_n[0], 0.1, 1e-12);
-  const uint64_t before = s.counters().slew_limits.load();
+TEST_F(DeviceForceSafetyTest, SlewLimitBoundsEveryTickAndStillReachesTheTarget) {
+  LocalModel small = Prepared(Model(0.1, 0.0), now_);
+  Settle(&small);
+  ASSERT_NEAR(out_.force_n[0], 0.1, 1e-12);
+  const uint64_t before = safety_.counters().slew_limits.load();
   // A snap: 0.1 N -> 2.9 N in one model update.
-  const double max_step = limits.max_force_rate_n_per_s * limits.tick_period_s;
-  double prev = out.force_n[0];
+  const double max_step = limits_.max_force_rate_n_per_s * limits_.tick_period_s;
+  double prev = out_.force_n[0];
   int ticks_to_target = -1;
   for (int i = 0; i < 20; ++i) {
-    const LocalModel big = Prepared(Model(2.9, 0.0), now);
-    s.Step(pos, true, &big, now, &out);
-    now += kTickUs;
-    EXPECT_LE(std::abs(out.force_n[0] - prev), max_step + 1e-12);
-    prev = out.force_n[0];
-    if (ticks_to_target < 0 && std::abs(out.force_n[0] - 2.9) < 1e-12) ticks_to_target = i + 1;
+    const LocalModel big = Prepared(Model(2.9, 0.0), now_);
+    safety_.Step(kOrigin, true, &big, now_, &out_);
+    now_ += kTickUs;
+    EXPECT_LE(std::abs(out_.force_n[0] - prev), max_step + 1e-12);
+    prev = out_.force_n[0];
+    if (ticks_to_target < 0 && std::abs(out_.force_n[0] - 2.9) < 1e-12) ticks_to_target = i + 1;
   }
   EXPECT_EQ(ticks_to_target, 3);  // ceil(2.8 N / 1 N per tick): felt within 3 ms
-  EXPECT_EQ(s.counters().slew_limits.load() - before, 2u);
+  EXPECT_EQ(safety_.counters().slew_limits.load() - before, 2u);
 }
 
-TEST(DeviceForceSafetyTest, StaleModelFadesToZeroAndFreshModelRecovers) {
-  const SafetyLimits limits = TestLimits();
-  ForceSafety s(limits, false);
-  const double pos[3] = {0, 0, 0};
-  int64_t now = 0;
-  SafetyOutput out;
-  // Fade-in from zero at start: gain ramps over fade_time.
-  LocalModel m = Prepared(Model(1.0, 0.0), now);
-  s.Step(pos, true, &m, now, &out);
-  EXPECT_LT(out.force_n[0], 0.05);
-  const int64_t received = 0;
-  for (int i = 0; i < 40; ++i) {  // keep it fresh: receive time moves with the ticks
-    now += kTickUs;
-    m.receive_us = now;
-    s.Step(pos, true, &m, now, &out);
-  }
-  (void)received;
-  now += kTickUs;
-  m.receive_us = now;
-  for (int i = 0; i < 200; ++i) {
-    m.receive_us = now;
-    s.Step(pos, true, &m, now, &out);
-    now += kTickUs;
-  }
-  ASSERT_NEAR(out.force_n[0], 1.0, 1e-12);
+TEST_F(DeviceForceSafetyTest, StaleModelFadesToZeroAndFreshModelRecovers) {
+  LocalModel m = Prepared(Model(1.0, 0.0), now_);
+  Settle(&m, 1);
+  EXPECT_LT(out_.force_n[0], 0.05);  // fade-in from zero at start: gain ramps over fade_time
+  Settle(&m, 240);
+  ASSERT_NEAR(out_.force_n[0], 1.0, 1e-12);
   // The server goes silent: the model ages.
   const int64_t last_rx = m.receive_us;
-  double prev = out.force_n[0];
+  double prev = out_.force_n[0];
   int64_t zero_at_ms = -1;
   bool monotone = true;
   for (int i = 0; i < 400; ++i) {
-    s.Step(pos, true, &m, now, &out);
-    const double age_ms = 1e-3 * static_cast<double>(now - last_rx);
-    if (age_ms <= 1e3 * limits.model_timeout_s) {
-      EXPECT_NEAR(out.force_n[0], 1.0, 1e-12) << age_ms;  // within the timeout: untouched
-      EXPECT_FALSE(out.fading);
+    safety_.Step(kOrigin, true, &m, now_, &out_);
+    const double age_ms = 1e-3 * static_cast<double>(now_ - last_rx);
+    if (age_ms <= 1e3 * limits_.model_timeout_s) {
+      EXPECT_NEAR(out_.force_n[0], 1.0, 1e-12) << age_ms;  // within the timeout: untouched
+      EXPECT_FALSE(out_.fading);
     } else {
-      EXPECT_TRUE(out.fading);
+      EXPECT_TRUE(out_.fading);
     }
-    if (out.force_n[0] > prev + 1e-12) monotone = false;
-    prev = out.force_n[0];
-    if (zero_at_ms < 0 && out.force_n[0] == 0.0) zero_at_ms = static_cast<int64_t>(age_ms);
-    now += kTickUs;
+    if (out_.force_n[0] > prev + 1e-12) monotone = false;
+    prev = out_.force_n[0];
+    if (zero_at_ms < 0 && out_.force_n[0] == 0.0) zero_at_ms = static_cast<int64_t>(age_ms);
+    now_ += kTickUs;
   }
   EXPECT_TRUE(monotone);
   ASSERT_GE(zero_at_ms, 0);
   // Zero no earlier than timeout + most of the fade (linear) and no later than timeout +
   // fade + one tick.
-  EXPECT_GE(zero_at_ms, 1e3 * (limits.model_timeout_s + 0.9 * limits.fade_time_s));
-  EXPECT_LE(zero_at_ms, 1e3 * (limits.model_timeout_s + limits.fade_time_s) + 2);
-  EXPECT_EQ(out.force_n[0], 0.0);
-  EXPECT_GT(s.counters().fade_ticks.load(), 300u);
+  EXPECT_GE(zero_at_ms, 1e3 * (limits_.model_timeout_s + 0.9 * limits_.fade_time_s));
+  EXPECT_LE(zero_at_ms, 1e3 * (limits_.model_timeout_s + limits_.fade_time_s) + 2);
+  EXPECT_EQ(out_.force_n[0], 0.0);
+  EXPECT_GT(safety_.counters().fade_ticks.load(), 300u);
   // A fresh model: the force fades back in within the fade time.
   int recovered_after = -1;
   for (int i = 0; i < 300; ++i) {
-    m.receive_us = now;
-    s.Step(pos, true, &m, now, &out);
-    now += kTickUs;
-    EXPECT_FALSE(out.fading);
-    if (recovered_after < 0 && std::abs(out.force_n[0] - 1.0) < 1e-12) recovered_after = i + 1;
+    Settle(&m, 1);
+    EXPECT_FALSE(out_.fading);
+    if (recovered_after < 0 && std::abs(out_.force_n[0] - 1.0) < 1e-12) recovered_after = i + 1;
   }
-  ASSERT_GT(recovered_after, 0);
-  EXPECT_LE(recovered_after, 1e3 * limits.fade_time_s + 2);
-  EXPECT_GE(recovered_after, 0.9e3 * limits.fade_time_s);  // faded in, not stepped
+  ExpectRampOverFadeTime(recovered_after);
 }
 
 // A stop (SIGINT/SIGTERM in snapthread-device) fades a fresh model's force to zero
 // within the fade time, monotonically and within the slew limit, and it stays there.
-TEST(DeviceForceSafetyTest, FadeOutOnStopReachesZeroWithinTheRamp) {
-  const SafetyLimits limits = TestLimits();
-  ForceSafety s(limits, false);
-  const double pos[3] = {0, 0, 0};
-  int64_t now = 0;
-  SafetyOutput out;
-  LocalModel m = Prepared(Model(2.5, 0.0), now);
-  Settle(&s, m, pos, &now, &out, 300);
-  ASSERT_NEAR(out.force_n[0], 2.5, 1e-12);
-  s.RequestFadeOut();
-  double prev = out.force_n[0];
+TEST_F(DeviceForceSafetyTest, FadeOutOnStopReachesZeroWithinTheRamp) {
+  LocalModel m = Prepared(Model(2.5, 0.0), now_);
+  Settle(&m, 300);
+  ASSERT_NEAR(out_.force_n[0], 2.5, 1e-12);
+  safety_.RequestFadeOut();
+  double prev = out_.force_n[0];
   int zero_after = -1;
   for (int i = 0; i < 300; ++i) {
-    m.receive_us = now;  // the model stays fresh: the stop alone fades the force
-    s.Step(pos, true, &m, now, &out);
-    now += kTickUs;
-    EXPECT_TRUE(out.fading);
-    EXPECT_LE(out.force_n[0], prev + 1e-12) << i;
-    EXPECT_LE(prev - out.force_n[0], limits.max_force_rate_n_per_s * limits.tick_period_s + 1e-9) << i;
-    prev = out.force_n[0];
-    if (zero_after < 0 && out.force_n[0] == 0.0) zero_after = i + 1;
+    Settle(&m, 1);  // the model stays fresh: the stop alone fades the force
+    EXPECT_TRUE(out_.fading);
+    EXPECT_LE(out_.force_n[0], prev + 1e-12) << i;
+    EXPECT_LE(prev - out_.force_n[0], limits_.max_force_rate_n_per_s * limits_.tick_period_s + 1e-9)
+        << i;
+    prev = out_.force_n[0];
+    if (zero_after < 0 && out_.force_n[0] == 0.0) zero_after = i + 1;
   }
-  ASSERT_GT(zero_after, 0);
-  EXPECT_LE(zero_after, 1e3 * limits.fade_time_s + 2);
-  EXPECT_GE(zero_after, 0.9e3 * limits.fade_time_s);  // faded, not stepped
-  EXPECT_EQ(out.force_n[0], 0.0);
+  ExpectRampOverFadeTime(zero_after);
+  EXPECT_EQ(out_.force_n[0], 0.0);
 }
 
-TEST(DeviceForceSafetyTest, BadPosesGetZeroForceAtOnce) {
+TEST_F(DeviceForceSafetyTest, BadPosesGetZeroForceAtOnce) {
   ForceSafety s(TestLimits(), false);
   const double good[3] = {0.01, 0, 0};
   int64_t now = 0;
@@ -376,7 +354,7 @@ TEST(DeviceForceSafetyTest, BadPosesGetZeroForceAtOnce) {
   EXPECT_NEAR(out.force_n[0], 1.0, 1e-12);
 }
 
-TEST(DeviceForceSafetyTest, FuzzOutputAlwaysFiniteAndBounded) {
+TEST_F(DeviceForceSafetyTest, FuzzOutputAlwaysFiniteAndBounded) {
   const SafetyLimits limits = TestLimits();
   ForceSafety s(limits, true);
   std::mt19937_64 rng(12345);

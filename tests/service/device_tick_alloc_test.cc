@@ -1,17 +1,16 @@
 // Proves the servo tick (read device -> latest model -> safety -> command -> rings)
-// never allocates: global operator new/delete are replaced by counting versions (after
-// Drake's iiwa_command_sender_test.cc malloc guard), one warm-up tick runs, then 10,000
-// ticks must allocate nothing, through fresh models, stale-model fades, out-of-workspace
-// poses, full rings and both simulated backends; and the same through DeviceClient::Tick
-// (the production path) with its receive and io steps run between the ticks.
+// never allocates: the heap allocations of the servo thread are counted
+// (tests/support/allocation_counter.h, after Drake's iiwa_command_sender_test.cc malloc
+// guard), one warm-up tick runs, then 10,000 ticks must allocate nothing, through fresh
+// models, stale-model fades, out-of-workspace poses, full rings and both simulated
+// backends; and the same through DeviceClient::Tick (the production path) with its
+// receive and io steps run between the ticks.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
 #include <memory>
-#include <new>
 #include <vector>
 
+#include "allocation_counter.h"
 #include "device_client.h"
 #include "device_fakes.h"
 #include "safety.h"
@@ -20,67 +19,21 @@
 #include "sim_path_device.h"
 #include "virtual_hand_device.h"
 
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-
-void* CountedAlloc(std::size_t n) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  void* p = std::malloc(n == 0 ? 1 : n);
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-void* CountedAlignedAlloc(std::size_t n, std::align_val_t al) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  const std::size_t a = static_cast<std::size_t>(al);
-  void* p = std::aligned_alloc(a, ((n + a - 1) / a) * a);
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-}  // namespace
-
-void* operator new(std::size_t n) { return CountedAlloc(n); }
-void* operator new[](std::size_t n) { return CountedAlloc(n); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try { return CountedAlloc(n); } catch (...) { return nullptr; }
-}
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-  try { return CountedAlloc(n); } catch (...) { return nullptr; }
-}
-void* operator new(std::size_t n, std::align_val_t al) { return CountedAlignedAlloc(n, al); }
-void* operator new[](std::size_t n, std::align_val_t al) { return CountedAlignedAlloc(n, al); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-
 namespace snapthread::device {
 namespace {
 
 int64_t g_now_us = 0;
 int64_t TestClock() { return g_now_us; }
 
-class AllocationGuard {
- public:
-  AllocationGuard() {
-    g_allocations.store(0);
-    g_counting.store(true);
-  }
-  ~AllocationGuard() { g_counting.store(false); }
-  long count() const { return g_allocations.load(); }
-};
+using test_support::AllocationCounter;
 
 TEST(DeviceMallocGuardTest, GuardCountsAllocations) {
-  // The guard must be able to fail: an allocation inside it is seen.
+  // The counter must be able to fail: an allocation inside it is seen.
   long n = 0;
   {
-    AllocationGuard guard;
+    AllocationCounter counter;
     auto v = std::make_unique<std::vector<double>>(100);
-    n = guard.count();
+    n = counter.mallocs();
   }
   EXPECT_GE(n, 2);
 }
@@ -136,9 +89,9 @@ uint64_t RunTicks(HapticDevice* device, int ticks) {
       while (lateness->TryPop(&l)) {}
     }
     g_now_us += 1000;
-    AllocationGuard guard;
+    AllocationCounter counter;
     tick.Tick(g_now_us, i % 37);
-    allocations += guard.count();
+    allocations += counter.mallocs();
   }
   EXPECT_EQ(allocations, 0);
   EXPECT_EQ(tick.counters().ticks.load(), static_cast<uint64_t>(ticks) + 1);
@@ -189,9 +142,9 @@ TEST(DeviceServoTickAllocationTest, DeviceClientTickNeverAllocates) {
     }
     client.Receive(0);
     g_now_us += 1000;
-    AllocationGuard guard;
+    AllocationCounter counter;
     client.Tick(g_now_us, i % 37);
-    allocations += guard.count();
+    allocations += counter.mallocs();
   }
   EXPECT_EQ(allocations, 0);
   EXPECT_GT(client.receiver().received(), 5000u);
@@ -205,10 +158,10 @@ TEST(DeviceMallocGuardTest, SampleWindowPushAndComputeNeverAllocate) {
   window.Compute();  // warm-up
   long allocations = 0;
   {
-    AllocationGuard guard;
+    AllocationCounter counter;
     for (int i = 0; i < 10000; ++i) window.Push(static_cast<double>(i % 977));
     const auto s = window.Compute();
-    allocations = guard.count();
+    allocations = counter.mallocs();
     EXPECT_EQ(s.count, 1000u);
     EXPECT_EQ(s.max, 976.0);
   }

@@ -30,86 +30,10 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// ---- sample messages ---------------------------------------------------------------
+// ---- sample messages (tests/support/sample_messages.h) ------------------------------
 
-// The pose and the force model of the auth tests (tests/auth/sample_messages.h).
-device_state_t SampleDeviceState() { return auth::testing::Sample<device_state_t>(); }
-
-force_model_t SampleForceModel() { return auth::testing::Sample<force_model_t>(); }
-
-thread_shape_t SampleShape(int n) {
-  thread_shape_t m{};
-  m.utime = 5;
-  m.seq = 6;
-  m.scene = "curve2d_snap";
-  m.model = "curve2d";
-  m.num_nodes = n;
-  m.positions.assign(n, std::vector<double>(3, 0.0));
-  for (int i = 0; i < n; ++i) {
-    m.positions[i][0] = i;
-    m.positions[i][1] = 0.5 * i;
-  }
-  m.grasp[0] = n;
-  m.grip_direction[0] = 1.0;
-  m.force[1] = 2.0;
-  m.force_newtons[1] = 0.2;
-  m.status = force_model_t::STATUS_SNAPPED;
-  m.snaps = 3;
-  return m;
-}
-
-solver_status_t SampleSolverStatus() {
-  solver_status_t m{};
-  m.utime = 9;
-  m.seq = 10;
-  m.scene = "zeeman";
-  m.method = "higher-order";
-  m.iterations = 2;
-  m.residual = 1e-11;
-  m.lambda_min = -0.25;
-  m.negative_pivots = 1;
-  m.status = force_model_t::STATUS_REGULAR;
-  m.update_rate_hz = 950.0;
-  m.solve_us_p50 = 40.0;
-  m.solve_us_p99 = 120.0;
-  m.updates = 1000;
-  m.snaps = 2;
-  m.dropped_poses = 5;
-  m.rejected_messages = 1;
-  return m;
-}
-
-device_status_t SampleDeviceStatus() {
-  device_status_t m{};
-  m.utime = 11;
-  m.seq = 12;
-  m.device_id = "sim-path";
-  m.tick_rate_hz = 1000.0;
-  m.lateness_us_p50 = 50;
-  m.lateness_us_p99 = 120;
-  m.lateness_us_max = 900;
-  m.model_age_ms = 1.5;
-  m.round_trip_us_p50 = 400;
-  m.round_trip_us_p99 = 1200;
-  m.force_norm_n = 0.7;
-  m.ticks = 10000;
-  m.models_received = 9000;
-  m.models_rejected = 1;
-  m.force_clamps = 2;
-  m.stiffness_clamps = 3;
-  m.slew_limits = 4;
-  m.fades = 5;
-  m.snaps_felt = 6;
-  return m;
-}
-
-command_t SampleCommand() {
-  command_t m{};
-  m.utime = 13;
-  m.command = command_t::LOAD_SCENE;
-  m.argument = "scenes/zeeman.yaml";
-  return m;
-}
+using test_support::Sample;
+using test_support::SampleShape;
 
 // Equality through the encoding: two messages are equal when their bytes are.
 template <class T>
@@ -167,6 +91,19 @@ TEST(TransportLcmUrlTest, FlagThenEnvironmentThenDefault) {
   }
 }
 
+TEST(TransportLcmUrlTest, ReceiversAskForABufferTheKernelGrants) {
+  const std::string udpm = "udpm://239.255.76.67:7667";
+  EXPECT_EQ(WithReceiveBuffer(udpm + "?ttl=0", 8388608, 4194304), udpm + "?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(WithReceiveBuffer(udpm, 1048576, 4194304), udpm + "?recv_buf_size=1048576");
+  EXPECT_EQ(WithReceiveBuffer(udpm + "?ttl=1", 1048576, 0), udpm + "?ttl=1&recv_buf_size=1048576");
+  // The user's own size stays; other providers have no such option.
+  EXPECT_EQ(WithReceiveBuffer(udpm + "?recv_buf_size=65536", 1048576, 4194304),
+            udpm + "?recv_buf_size=65536");
+  EXPECT_EQ(WithReceiveBuffer("memq://", 1048576, 4194304), "memq://");
+  EXPECT_EQ(WithReceiveBuffer("file:///tmp/x.lcmlog?mode=r", 1048576, 4194304),
+            "file:///tmp/x.lcmlog?mode=r");
+}
+
 TEST(TransportClockTest, MonotonicAdvancesAndRealtimeIsRecent) {
   const int64_t a = MonotonicMicros();
   std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -209,22 +146,22 @@ void RoundTrip(const T& sent) {
   EXPECT_EQ(Encode(catcher.got.front()), Encode(sent));
 }
 
-TEST(TransportRoundTripTest, DeviceState) { RoundTrip(SampleDeviceState()); }
+TEST(TransportRoundTripTest, DeviceState) { RoundTrip(Sample<device_state_t>()); }
 TEST(TransportRoundTripTest, ForceModel) {
-  RoundTrip(SampleForceModel());
+  RoundTrip(Sample<force_model_t>());
 }
 TEST(TransportRoundTripTest, ThreadShape) {
   RoundTrip(SampleShape(0));
   RoundTrip(SampleShape(1));
   RoundTrip(SampleShape(200));
 }
-TEST(TransportRoundTripTest, SolverStatus) { RoundTrip(SampleSolverStatus()); }
-TEST(TransportRoundTripTest, DeviceStatus) { RoundTrip(SampleDeviceStatus()); }
-TEST(TransportRoundTripTest, Command) { RoundTrip(SampleCommand()); }
+TEST(TransportRoundTripTest, SolverStatus) { RoundTrip(Sample<solver_status_t>()); }
+TEST(TransportRoundTripTest, DeviceStatus) { RoundTrip(Sample<device_status_t>()); }
+TEST(TransportRoundTripTest, Command) { RoundTrip(Sample<command_t>()); }
 
 TEST(TransportRoundTripTest, ForceModelFieldsSurvive) {
   // One explicit field-by-field check so that an encoding comparison bug cannot hide one.
-  const force_model_t sent = SampleForceModel();
+  const force_model_t sent = Sample<force_model_t>();
   const auto bytes = Encode(sent);
   force_model_t got;
   std::string why;
@@ -244,25 +181,25 @@ TEST(TransportRoundTripTest, ForceModelFieldsSurvive) {
 
 TEST(TransportValidateTest, AcceptsSamples) {
   std::string why;
-  EXPECT_TRUE(Validate(SampleDeviceState(), &why)) << why;
-  EXPECT_TRUE(Validate(SampleForceModel(), &why)) << why;
+  EXPECT_TRUE(Validate(Sample<device_state_t>(), &why)) << why;
+  EXPECT_TRUE(Validate(Sample<force_model_t>(), &why)) << why;
   EXPECT_TRUE(Validate(SampleShape(5), &why)) << why;
-  EXPECT_TRUE(Validate(SampleSolverStatus(), &why)) << why;
-  EXPECT_TRUE(Validate(SampleDeviceStatus(), &why)) << why;
-  EXPECT_TRUE(Validate(SampleCommand(), &why)) << why;
+  EXPECT_TRUE(Validate(Sample<solver_status_t>(), &why)) << why;
+  EXPECT_TRUE(Validate(Sample<device_status_t>(), &why)) << why;
+  EXPECT_TRUE(Validate(Sample<command_t>(), &why)) << why;
 }
 
 TEST(TransportValidateTest, RejectsNonFiniteDeviceState) {
   for (double bad : {kNaN, kInf, -kInf}) {
     for (int i = 0; i < 3; ++i) {
-      auto m = SampleDeviceState();
+      auto m = Sample<device_state_t>();
       m.position[i] = bad;
       std::string why;
       EXPECT_FALSE(Validate(m, &why));
       EXPECT_NE(why.find("position"), std::string::npos) << why;
     }
     for (int i = 0; i < 4; ++i) {
-      auto m = SampleDeviceState();
+      auto m = Sample<device_state_t>();
       m.orientation[i] = bad;
       EXPECT_FALSE(Validate(m, nullptr));
     }
@@ -270,7 +207,7 @@ TEST(TransportValidateTest, RejectsNonFiniteDeviceState) {
 }
 
 TEST(TransportValidateTest, QuaternionNormRange) {
-  auto m = SampleDeviceState();
+  auto m = Sample<device_state_t>();
   m.orientation[0] = 0.0;  // zero quaternion
   EXPECT_FALSE(Validate(m, nullptr));
   m.orientation[0] = 3.0;
@@ -284,24 +221,24 @@ TEST(TransportValidateTest, QuaternionNormRange) {
 TEST(TransportValidateTest, RejectsNonFiniteForceModel) {
   for (double bad : {kNaN, kInf, -kInf}) {
     for (int i = 0; i < 3; ++i) {
-      auto a = SampleForceModel(); a.u0[i] = bad; EXPECT_FALSE(Validate(a, nullptr));
-      auto b = SampleForceModel(); b.f0[i] = bad; EXPECT_FALSE(Validate(b, nullptr));
-      auto c = SampleForceModel(); c.torque0[i] = bad; EXPECT_FALSE(Validate(c, nullptr));
+      auto a = Sample<force_model_t>(); a.u0[i] = bad; EXPECT_FALSE(Validate(a, nullptr));
+      auto b = Sample<force_model_t>(); b.f0[i] = bad; EXPECT_FALSE(Validate(b, nullptr));
+      auto c = Sample<force_model_t>(); c.torque0[i] = bad; EXPECT_FALSE(Validate(c, nullptr));
       for (int j = 0; j < 3; ++j) {
-        auto d = SampleForceModel(); d.K[i][j] = bad;
+        auto d = Sample<force_model_t>(); d.K[i][j] = bad;
         std::string why;
         EXPECT_FALSE(Validate(d, &why));
         EXPECT_NE(why.find("K"), std::string::npos);
       }
     }
-    auto e = SampleForceModel(); e.residual = bad; EXPECT_FALSE(Validate(e, nullptr));
+    auto e = Sample<force_model_t>(); e.residual = bad; EXPECT_FALSE(Validate(e, nullptr));
   }
-  auto s = SampleForceModel();
+  auto s = Sample<force_model_t>();
   s.status = 4;
   EXPECT_FALSE(Validate(s, nullptr));
   s.status = -1;
   EXPECT_FALSE(Validate(s, nullptr));
-  auto t = SampleForceModel();
+  auto t = Sample<force_model_t>();
   t.has_torque = 2;
   EXPECT_FALSE(Validate(t, nullptr));
 }
@@ -330,13 +267,13 @@ TEST(TransportValidateTest, ShapeCountsMustAgree) {
 }
 
 TEST(TransportValidateTest, StatusesAndCommands) {
-  auto s = SampleSolverStatus();
+  auto s = Sample<solver_status_t>();
   s.residual = kNaN;
   EXPECT_FALSE(Validate(s, nullptr));
-  auto d = SampleDeviceStatus();
+  auto d = Sample<device_status_t>();
   d.lateness_us_p99 = kInf;
   EXPECT_FALSE(Validate(d, nullptr));
-  auto c = SampleCommand();
+  auto c = Sample<command_t>();
   c.command = 0;
   EXPECT_FALSE(Validate(c, nullptr));
   c.command = command_t::SET_METHOD;
@@ -362,19 +299,19 @@ void ExpectTruncationsRejected(const T& sample) {
   EXPECT_FALSE(DecodeAndValidate(longer.data(), static_cast<int>(longer.size()), &out, &why));
   EXPECT_NE(why.find("trailing"), std::string::npos) << why;
   // Wrong type (hash mismatch).
-  const auto other = Encode(SampleCommand());
+  const auto other = Encode(Sample<command_t>());
   if constexpr (!std::is_same_v<T, command_t>) {
     EXPECT_FALSE(DecodeAndValidate(other.data(), static_cast<int>(other.size()), &out, &why));
   }
 }
 
 TEST(TransportDecodeTest, TruncatedOversizedAndWrongTypeRejected) {
-  ExpectTruncationsRejected(SampleDeviceState());
-  ExpectTruncationsRejected(SampleForceModel());
+  ExpectTruncationsRejected(Sample<device_state_t>());
+  ExpectTruncationsRejected(Sample<force_model_t>());
   ExpectTruncationsRejected(SampleShape(7));
-  ExpectTruncationsRejected(SampleSolverStatus());
-  ExpectTruncationsRejected(SampleDeviceStatus());
-  ExpectTruncationsRejected(SampleCommand());
+  ExpectTruncationsRejected(Sample<solver_status_t>());
+  ExpectTruncationsRejected(Sample<device_status_t>());
+  ExpectTruncationsRejected(Sample<command_t>());
 }
 
 TEST(TransportDecodeTest, HugeShapeCountIsRefusedBeforeAllocation) {
@@ -394,7 +331,7 @@ TEST(TransportDecodeTest, HugeShapeCountIsRefusedBeforeAllocation) {
 }
 
 TEST(TransportDecodeTest, CorruptStringLengthDoesNotThrow) {
-  auto m = SampleDeviceState();
+  auto m = Sample<device_state_t>();
   auto bytes = Encode(m);
   // device_id's length field follows hash, utime and seq.
   for (uint32_t bad : {0u, 0xffffffffu, 0x80000000u, 0x7fffffffu}) {
@@ -412,7 +349,7 @@ TEST(TransportDecodeTest, CorruptStringLengthDoesNotThrow) {
 
 TEST(TransportDecodeTest, StringWithoutItsNulIsRefused) {
   // lcm-gen's decoder skips a string's last byte without looking at it.
-  auto m = SampleDeviceState();
+  auto m = Sample<device_state_t>();
   auto bytes = Encode(m);
   const size_t nul = 24 + 4 + m.device_id.size();
   ASSERT_EQ(bytes[nul], 0);
@@ -457,12 +394,12 @@ void Fuzz(const T& sample, uint32_t seed, int* accepted) {
 
 TEST(TransportDecodeTest, FuzzEveryType) {
   int accepted = 0;
-  Fuzz(SampleDeviceState(), 1, &accepted);
-  Fuzz(SampleForceModel(), 2, &accepted);
+  Fuzz(Sample<device_state_t>(), 1, &accepted);
+  Fuzz(Sample<force_model_t>(), 2, &accepted);
   Fuzz(SampleShape(10), 3, &accepted);
-  Fuzz(SampleSolverStatus(), 4, &accepted);
-  Fuzz(SampleDeviceStatus(), 5, &accepted);
-  Fuzz(SampleCommand(), 6, &accepted);
+  Fuzz(Sample<solver_status_t>(), 4, &accepted);
+  Fuzz(Sample<device_status_t>(), 5, &accepted);
+  Fuzz(Sample<command_t>(), 6, &accepted);
   // Flipping bytes of doubles often still gives a valid message: the fuzz reaches Validate.
   EXPECT_GT(accepted, 0);
 }
@@ -479,10 +416,10 @@ TEST(TransportDecodeTest, GarbageOverMemqIsCountedNotFatal) {
     for (auto& b : buf) b = static_cast<uint8_t>(byte(rng));
     lcm.publish("FUZZ", buf.data(), static_cast<unsigned>(buf.size()));
   }
-  auto bad = SampleForceModel();
+  auto bad = Sample<force_model_t>();
   bad.K[1][1] = kNaN;
   lcm.publish("FUZZ", &bad);
-  const auto good = SampleForceModel();
+  const auto good = Sample<force_model_t>();
   lcm.publish("FUZZ", &good);
   while (lcm.handleTimeout(10) > 0) {
   }

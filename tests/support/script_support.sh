@@ -12,6 +12,20 @@ stop_logger() {
 fail() { echo "FAIL: $*"; echo "--- outputs in $work"; for f in "$work"/*.txt; do echo "== $f"; tail -n 15 "$f"; done; exit 1; }
 # json FILE "['key']": a field of a JSON file.
 json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))$2)" "$1"; }
+# start_xvfb NAME [SCREEN]: a virtual X display for windows of this test; sets $display
+# (":N") and appends Xvfb's pid to pids. Xvfb picks a free display itself and writes its
+# number to -displayfd once it accepts connections, so there is no display-number race
+# with other tests and no sleep (xvfb-run's -a guesses a number from lock files and waits
+# for a SIGUSR1 that can arrive before it waits).
+start_xvfb() {
+  local f="$work/$1.display"
+  : > "$f"
+  Xvfb -displayfd 3 -screen 0 "${2:-640x480x24}" -nolisten tcp 3> "$f" > "$work/$1.txt" 2>&1 &
+  pids+=("$!")
+  for _ in $(seq 300); do grep -q '^[0-9][0-9]*$' "$f" && break; sleep 0.1; done
+  grep -q '^[0-9][0-9]*$' "$f" || fail "Xvfb did not start within 30 s"
+  display=":$(cat "$f")"
+}
 # make_key: a session key for this run in $work/session.key (sets $key; every binary
 # gets --key "$key").
 make_key() {
@@ -31,4 +45,13 @@ run_session() {
   $2 "$bin/snapthread-device" --key "$key" --backend virtual-hand --scene "$scene" --session "$session" --lcm-url "$url" \
       --duration "$duration" --no-rt --summary "$work/device.json" > "$work/device.txt" 2>&1
   device_rc=$?
+}
+# end_session LOGGER_PID: after run_session (and after waiting for the other processes,
+# such as viewers), waits for the server (sets server_rc), stops the logger and fails
+# unless the device and the server exited 0.
+end_session() {
+  wait "$server_pid"; server_rc=$?
+  stop_logger "$1"
+  [ $device_rc -eq 0 ] || fail "device exited $device_rc"
+  [ $server_rc -eq 0 ] || fail "server exited $server_rc"
 }

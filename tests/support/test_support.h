@@ -1,8 +1,9 @@
 // The shared test fixtures (tests/support): child processes, temporary directories,
-// the tree's paths, unique LCM sessions, waiting for a condition.
+// the tree's paths, unique LCM sessions, waiting for a condition, a virtual X display.
 #pragma once
 
 #include "child_process.h"
 #include "environment.h"
 #include "session_key_file.h"
 #include "temp_dir.h"
+#include "virtual_display.h"

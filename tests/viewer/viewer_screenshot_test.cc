@@ -1,4 +1,4 @@
-// End-to-end: snapthread-viewer runs as a real process under xvfb-run, receives shapes over
+// End-to-end: snapthread-viewer runs as a real process on its own Xvfb, receives shapes over
 // udpm loopback, and its screenshot must show the thread where the camera projects it.
 #include <atomic>
 #include <cstdio>
@@ -176,16 +176,16 @@ ViewerRun RunViewerScreenshot(const std::string& session, const std::string& dir
                               int after_shapes, double timeout_s) {
   ViewerRun run;
   run.png = dir + "/shot.png";
-  std::random_device rd;
-  const std::string server_num = std::to_string(100 + rd() % 800);
-  const std::vector<std::string> argv = {
-      "xvfb-run", "-a", "-n", server_num, "-s", "-screen 0 1280x720x24",
+  const VirtualDisplay display(dir);
+  EXPECT_TRUE(display.ready()) << "Xvfb did not start: " << display.error();
+  if (!display.ready()) return run;
+  const std::vector<std::string> argv = display.On({
       BinDir() + "/snapthread-viewer", "--session", session, "--lcm-url", kLoopbackUrl,
       "--screenshot", run.png, "--after-shapes", std::to_string(after_shapes), "--timeout-s",
       std::to_string(timeout_s), "--width", std::to_string(kWidth), "--height",
-      std::to_string(kHeight)};
+      std::to_string(kHeight)});
   ChildProcess viewer(argv, OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
-  EXPECT_TRUE(viewer.started()) << "cannot start xvfb-run";
+  EXPECT_TRUE(viewer.started()) << "cannot start snapthread-viewer";
   if (viewer.started()) run.result = viewer.Finish(timeout_s + 40.0);
   return run;
 }
@@ -387,16 +387,20 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
       ASSERT_EQ(log.writeEvent(&e), 0);
     }
   }
-  // The viewer first (it must be listening), then the player.
-  std::random_device rd;
-  const std::vector<std::string> viewer_argv = {
-      "xvfb-run", "-a", "-n", std::to_string(100 + rd() % 800), "-s", "-screen 0 1280x720x24",
+  // The viewer first (it must be listening: it says so once subscribed and its window is
+  // up), then the player.
+  const VirtualDisplay display(dir);
+  ASSERT_TRUE(display.ready()) << "Xvfb did not start: " << display.error();
+  const std::vector<std::string> viewer_argv = display.On({
       BinDir() + "/snapthread-viewer", "--session", session, "--lcm-url", kLoopbackUrl,
       "--screenshot", dir + "/shot.png", "--after-shapes", "10", "--timeout-s", "30",
-      "--width", std::to_string(kWidth), "--height", std::to_string(kHeight)};
+      "--width", std::to_string(kWidth), "--height", std::to_string(kHeight)});
   ChildProcess viewer(viewer_argv, OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
   ASSERT_TRUE(viewer.started());
-  std::this_thread::sleep_for(std::chrono::seconds(2));  // Xvfb + GL start-up
+  const bool listening = WaitUntil(
+      [&] { return viewer.Err().find("listening on") != std::string::npos || !viewer.running(); }, 30.0);
+  ASSERT_TRUE(listening && viewer.running()) << "viewer did not start listening:\n"
+                                             << viewer.Out() << viewer.Err();
   ChildProcess player({"lcm-logplayer", std::string("--lcm-url=") + kLoopbackUrl, log_path},
                       OutputFiles(dir + "/player_out.txt", dir + "/player_err.txt", true));
   ASSERT_TRUE(player.started()) << "cannot start lcm-logplayer (liblcm-bin)";
@@ -475,10 +479,9 @@ TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
                 viewer.c_str(), scene_path.c_str(), session.c_str(), kLoopbackUrl, kWidth, kHeight,
                 title.c_str(), int(std::lround(grasp_px.x())), int(std::lround(grasp_px.y())),
                 int(target_px.x() - 20), int(target_px.y()), int(target_px.x()), int(target_px.y()));
-  std::random_device rd;
-  ChildProcess run({"xvfb-run", "-a", "-n", std::to_string(100 + rd() % 800), "-s",
-                    "-screen 0 1280x720x24", "bash", "-c", script},
-                   OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
+  const VirtualDisplay display(dir);
+  ASSERT_TRUE(display.ready()) << "Xvfb did not start: " << display.error();
+  ChildProcess run(display.On({"bash", "-c", script}), OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
   ASSERT_TRUE(run.started());
   const ProcessResult r = run.Finish(40.0);
   publisher.Stop();

@@ -1,0 +1,55 @@
+// No shipped scene followed along its grasp.path (200 steps per leg: there the axis
+// crossing failed without the roll of solvers/symmetry_orbits.h), and no case of the
+// stability suite (every standard sweep, registered method and budget of
+// snapthread-stability), ends an update with a failed linear solver (issue 13).
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "solvers/registry.h"
+#include "stability.h"
+#include "test_util.h"
+
+namespace snapthread {
+namespace {
+
+int FailedRows(const Scene& scene, const std::vector<Vec>& controls) {
+  const auto rows = RunSweep(MakeTracker(scene).get(), controls);
+  int failed = 0;
+  for (const SweepRow& r : rows) failed += r.termination == Termination::kLinearSolverFailed ? 1 : 0;
+  return failed;
+}
+
+TEST(SolverFailure, NoShippedSceneAlongItsPath) {
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(testing::SourceDir() + "/scenes")) {
+    if (entry.path().extension() != ".yaml") continue;
+    const Scene scene = LoadScene(entry.path().string());
+    if (scene.path.size() < 2) continue;
+    ++scenes;
+    for (const std::string& method : SolverRegistry::Global().Names()) {
+      Scene sc = scene;
+      sc.solver.method = method;
+      EXPECT_EQ(FailedRows(sc, PathControls(sc, 200)), 0) << entry.path().filename() << ", " << method;
+    }
+  }
+  EXPECT_GE(scenes, 5);
+}
+
+TEST(SolverFailure, NoStabilityCase) {
+  // The budgets of snapthread-stability's default --budgets (0 = unlimited).
+  for (const StandardSweep& sw : StandardSweeps(testing::SourceDir() + "/scenes")) {
+    const Scene scene = LoadScene(sw.scene_file);
+    for (const std::string& method : SolverRegistry::Global().Names()) {
+      for (int budget : {1, 2, 3, 5, 10, 0}) {
+        Scene sc = scene;
+        sc.solver.method = method;
+        sc.solver.max_iterations = budget;
+        EXPECT_EQ(FailedRows(sc, sw.controls), 0) << sw.name << ", " << method << ", budget " << budget;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace snapthread
