@@ -120,11 +120,9 @@ void SolveBand(const double* data, int n, int b, double* v, int m, std::ptrdiff_
   }
   if constexpr (B > 0) {
     for (int i = n - 1; i >= head; --i) {
-      const double* __restrict ri = data + static_cast<std::ptrdiff_t>(i) * (B + 1);
+      const double* ri = data + static_cast<std::ptrdiff_t>(i) * (B + 1);
       for (int c = 0; c < m; ++c) {
-        // Independent updates of B entries (no reduction): restrict lets them vectorise
-        // without changing any result.
-        double* __restrict xc = v + c * stride + (i - B);
+        double* xc = v + c * stride + (i - B);
         const double xi = xc[B];
 #pragma GCC unroll 32
         for (int k = 0; k < B; ++k) xc[k] -= ri[k] * xi;
