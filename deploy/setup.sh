@@ -12,6 +12,7 @@ packages=(
   libyaml-cpp-dev libcli11-dev libsodium-dev
   libglfw3-dev libepoxy-dev xvfb xauth libstb-dev libpng-dev libgl1-mesa-dri xdotool
   gnuplot-nox graphviz python3 ccache
+  clang libclang-rt-14-dev
   libceres-dev liblapack-dev
   iproute2 procps
 )
