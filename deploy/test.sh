@@ -28,12 +28,10 @@ if [ "${1:-}" != "--quick" ]; then
   #  - the tests that dispatch LCM subscriptions (labels service, viewer, GraspMapping):
   #    under UBSan, liblcm 1.3.1 (uninstrumented) calls the C++ subscription callback with a
   #    user_data that is not the subscription object (lcm-cpp-impl.hpp:88/108, misaligned
-  #    or wrong dynamic type) in 32 of 97 such tests. OPEN. The likely cause, not yet
-  #    verified: lcm_dispatch_handlers in liblcm 1.3.1 walks the channel's handler list by
-  #    index with the lock released, so an unsubscribe on another thread (or in a handler)
-  #    during dispatch makes it call past the shortened list (lcm-proj/lcm#619, fixed
-  #    upstream by #621 in 2026, not in Debian's 1.3.1). The fix on our side is to never
-  #    unsubscribe while another thread dispatches the same lcm_t.
+  #    or wrong dynamic type) in 32 of 97 such tests. OPEN, cause not found: it happens
+  #    in ScenePath, where every subscription is made before the handling thread starts
+  #    and none is removed while it runs, so it is not only the upstream dispatch-vs-
+  #    unsubscribe race of liblcm 1.3.1 (lcm-proj/lcm#619, fixed upstream by #621).
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --output-on-failure -j2 --timeout 900 -L 'unit|report' -LE 'process|soak|netns' \
       -E 'Allocat|NotAllocate|WithoutAllocation|NeverAllocate|architecture_test|TimeBudget|GraspMapping'
