@@ -56,8 +56,12 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
     x_ += (0.1 * snap_threshold_ / std::max(v.lpNorm<Eigen::Infinity>(), 1e-300)) * v;
     result_.summary = start_solver->Solve(u, &x_);
   }
-  // Re-solve with the tracking solver so its factorisation and eigenpair are current.
-  result_.summary = solver_->Solve(u, &x_);
+  return SolveAndStartHere();
+}
+
+const TrackResult& EquilibriumTracker::SolveAndStartHere() {
+  // Solve with the tracking solver so its factorisation and eigenpair are current.
+  result_.summary = solver_->Solve(u_, &x_);
   result_.snapped = false;
   have_prev_ = false;
   have_tangent_ = false;
@@ -76,20 +80,13 @@ const TrackResult& EquilibriumTracker::Resume(const Vec& x, const Vec& u) {
   if (!x.allFinite() || !u.allFinite())
     throw std::invalid_argument("EquilibriumTracker::Resume: non-finite state or controls");
   solver_->Reset();
+  model_->ResetHistory();
   x_ = x;
   u_ = u;
   // Lagged data (the rod's reference frames) from the model's start to the saved state,
   // so E(x, u) is the energy the state was accepted under.
   model_->AcceptState(x_, u_);
-  result_.summary = solver_->Solve(u_, &x_);
-  result_.snapped = false;
-  have_prev_ = false;
-  have_tangent_ = false;
-  x_prev_ = x_;
-  u_prev_ = u_;
-  ComputeForces();
-  model_->AcceptState(x_, u_);
-  return result_;
+  return SolveAndStartHere();
 }
 
 const TrackResult& EquilibriumTracker::Update(const Vec& u) {

@@ -56,6 +56,9 @@ class EquilibriumTracker {
   void SetSnapThreshold(double t) { snap_threshold_ = t; }
 
  private:
+  // The end of Reset and Resume: solve at (x_, u_) with the tracking solver and make that
+  // state the start of the path (no predictor history, force and K, lagged model data).
+  const TrackResult& SolveAndStartHere();
   void ComputeForces();
 
   std::unique_ptr<Model> model_;
