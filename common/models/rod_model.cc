@@ -42,15 +42,6 @@ bool RodParams::IsValid(std::string* error) const {
   return true;
 }
 
-// u -> x_{n-1}, x_n, θ_{n-1}: values, Jacobian (7 x 6 over (p, φ)) and, for each of the
-// seven coordinates, the Hessian in φ (the map is linear in p).
-struct RodModel::GraspMap {
-  V3 xn1, xn;
-  double theta = 0.0;
-  Eigen::Matrix<double, 7, 6> jac;
-  std::array<M3, 7> hess_phi;
-};
-
 RodModel::RodModel(const RodParams& params) : p_(params) {
   std::string error;
   if (!p_.IsValid(&error)) throw std::invalid_argument(error);
@@ -138,8 +129,9 @@ void RodModel::BuildTerms() {
     term.code[10] = theta_code(i);
     add(term);
   }
+  RegisterContact();
   assembly_.Finalize();
-  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     if (assembly_.TouchesControls(t)) control_terms_.push_back(t);
   }
 }
@@ -302,6 +294,7 @@ double RodModel::Energy(const Vec& x, const Vec& u) const {
                              nullptr);
     }
   }
+  if (contact_.enabled()) e += contact_.Energy(ContactNodes(x, gm));
   return e;
 }
 
@@ -309,10 +302,11 @@ void RodModel::Gradient(const Vec& x, const Vec& u, Vec* g) const {
   if (g->size() != nx_) g->resize(nx_);
   g->setZero();
   const GraspMap gm = Grasp(u, true);
-  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, x, gm, false,
           [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
   }
+  if (contact_.enabled()) contact_.AddGradient(ContactNodes(x, gm), g->data());
 }
 
 void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
@@ -324,11 +318,12 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
   double* values = h->valuePtr();
   std::fill(values, values + pattern.nonZeros(), 0.0);
   const GraspMap gm = Grasp(u, true);
-  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
       assembly_.AddHessian(t, lh, ld, values);
     });
   }
+  if (contact_.enabled()) contact_.AddHessian(ContactNodes(x, gm), values);
 }
 
 void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
@@ -340,6 +335,7 @@ void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
       assembly_.AddControlGradient(t, lg, eu->data());
     });
   }
+  if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, gm), ContactControls(gm), eu->data());
 }
 
 bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const {
@@ -353,6 +349,7 @@ bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) 
       assembly_.AddControlGradient(t, lg, e.data());
     });
   }
+  if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, gm), ContactControls(gm), e.data());
   *torque = -e.tail<3>();
   return true;
 }
@@ -366,6 +363,7 @@ void RodModel::MixedHessian(const Vec& x, const Vec& u, Mat* exu) const {
       assembly_.AddMixedHessian(t, lh, ld, exu);
     });
   }
+  if (contact_.enabled()) contact_.AddMixedHessian(ContactNodes(x, gm), ContactControls(gm), exu);
 }
 
 void RodModel::ControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
@@ -377,6 +375,7 @@ void RodModel::ControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
       assembly_.AddControlHessian(t, lh, ld, euu);
     });
   }
+  if (contact_.enabled()) contact_.AddControlHessian(ContactNodes(x, gm), ContactControls(gm), euu);
 }
 
 Vec RodModel::InitialState(const Vec& u) const {
@@ -494,8 +493,9 @@ ModelRegistration RodRegistration() {
       {.name = "natural_curvature_2", .default_value = 0.0, .units = "1/m",
        .doc = "natural material curvature kappa2-bar (bending towards m2)"},
       {.name = "radius", .default_value = 0.01, .min = 0.0, .units = "m",
-       .doc = "tube radius (drawing only; contact is not modelled)"},
+       .doc = "tube radius (drawing; the capsule radius of self-contact)"},
   };
+  for (ParamSpec& spec : internal::ContactParamSpecs()) r.params.push_back(std::move(spec));
   r.factory = [](const ModelParams& mp) -> std::unique_ptr<Model> {
     RodParams p;
     p.n = mp.Integer("n");
@@ -508,6 +508,7 @@ ModelRegistration RodRegistration() {
     p.natural_curvature = mp.Number("natural_curvature");
     p.natural_curvature_2 = mp.Number("natural_curvature_2");
     p.radius = mp.Number("radius");
+    p.contact = internal::ReadContactParams(mp);
     return std::make_unique<RodModel>(p);
   };
   r.capabilities.grasp_layout = [](const ModelParams&) {
