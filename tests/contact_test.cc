@@ -3,6 +3,8 @@
 // barrier against central differences, the additive CCD (two capsules pushed together
 // never cross, whatever the step), and the broad phase against all pairs.
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <array>
 #include <cmath>
 #include <random>
@@ -271,6 +273,48 @@ TEST(SelfContact, ChainStepBoundKeepsEveryPairApart) {
     }
   }
   EXPECT_GT(tested, 20);
+}
+
+// Contact cost against n (issue 15 item 8): energy, gradient and Hessian of every active
+// pair on a close helix (each segment near the turns above and below it, so the active
+// pairs grow like n). The work the broad phase leaves to the narrow phase must grow like
+// n too: 16 x the segments give 16 x the candidate pairs, where all pairs would give
+// 256 x. The times (best of 5) are printed, not asserted (a loaded machine).
+TEST(SelfContact, CostGrowsLinearlyWithTheSegments) {
+  const ContactParams p{.enabled = true, .radius = 0.02, .dhat = 0.02, .stiffness = 1.0};
+  const int sizes[2] = {200, 3200};
+  int pairs[2] = {0, 0}, candidates[2] = {0, 0};
+  double per_call_us[2] = {0.0, 0.0};
+  for (int s = 0; s < 2; ++s) {
+    const int m = sizes[s];
+    const SelfContact sc(p, m, 0.1);
+    Eigen::Matrix3Xd nodes(3, m + 1);
+    for (int k = 0; k <= m; ++k) {
+      const double a = 0.5 * k;  // turns 0.05 apart: gap 0.01 < d-hat
+      nodes.col(k) = V3(0.2 * std::cos(a), 0.2 * std::sin(a), 0.05 * a / (2 * M_PI));
+    }
+    double best = 1e300;
+    for (int rep = 0; rep < 5; ++rep) {
+      const auto t0 = std::chrono::steady_clock::now();
+      double sum = sc.Energy(nodes);
+      int count = 0;
+      sc.ForEachActive(nodes, true, [&](int, int, const Vec12& g, const Mat12& h) {
+        sum += g[0] + h(0, 0);
+        ++count;
+      });
+      best = std::min(best, std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+      pairs[s] = count;
+      candidates[s] = sc.CandidatePairs();
+      ASSERT_TRUE(std::isfinite(sum));
+    }
+    per_call_us[s] = best;
+  }
+  std::printf("self-contact E + E_x + E_xx: n = %d: %.0f us (%d active of %d candidate pairs); "
+              "n = %d: %.0f us (%d of %d)\n",
+              sizes[0], per_call_us[0], pairs[0], candidates[0], sizes[1], per_call_us[1], pairs[1], candidates[1]);
+  EXPECT_GT(pairs[0], sizes[0] / 2);
+  EXPECT_LE(candidates[1], 20 * candidates[0]);
+  EXPECT_LE(pairs[1], 20 * pairs[0]);
 }
 
 }  // namespace

@@ -7,9 +7,16 @@ namespace snapthread::contact {
 namespace {
 
 std::uint64_t Hash(const std::int64_t c[3]) {
-  // Large odd multipliers (Teschner et al. 2003, "Optimized spatial hashing").
-  return static_cast<std::uint64_t>(c[0]) * 73856093ULL ^ static_cast<std::uint64_t>(c[1]) * 19349663ULL ^
-         static_cast<std::uint64_t>(c[2]) * 83492791ULL;
+  // Odd 64-bit multipliers, then a splitmix64 finaliser: the table takes the low bits,
+  // which a plain product of small cell coordinates leaves clustered.
+  std::uint64_t h = static_cast<std::uint64_t>(c[0]) * 0x9E3779B97F4A7C15ULL ^
+                    static_cast<std::uint64_t>(c[1]) * 0xC2B2AE3D27D4EB4FULL ^
+                    static_cast<std::uint64_t>(c[2]) * 0x165667B19E3779F9ULL;
+  h ^= h >> 30;
+  h *= 0xBF58476D1CE4E5B9ULL;
+  h ^= h >> 27;
+  h *= 0x94D049BB133111EBULL;
+  return h ^ (h >> 31);
 }
 
 }  // namespace
