@@ -13,6 +13,10 @@ import path from 'node:path';
 const [modules, mode, url, out, arg] = process.argv.slice(2);
 const require = createRequire(path.join(path.resolve(modules), 'index.js'));
 const MEASURE_S = 5;
+// After the first shapes: Chromium compiles the shaders and JIT-compiles the page in the
+// first seconds (longer on a loaded machine), and a page then works off the messages
+// queued meanwhile; the rates are of the steady state after it.
+const WARM_UP_S = 8;
 
 const CHROMIUM_ARGS = [
   '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
@@ -34,20 +38,24 @@ const counters = (page) => page.evaluate(() => ({
   frames: Number(document.body.dataset.framesDrawn || 0),
   seq: Number(document.body.dataset.lastShapeSeq ?? -1),
   status: Number(document.body.dataset.lastShapeStatus ?? -1),
+  utime: Number(document.body.dataset.lastShapeUtime ?? 0),
   t: performance.now(),
 }));
 
 async function live(browser, pages) {
-  const context = await browser.newContext({ viewport: { width: 800, height: 500 } });
   const opened = [];
   for (let i = 0; i < pages; ++i) {
+    // A context (a window) per page: two tabs of one window would leave one in the
+    // background, where Chromium throttles its animation frames.
+    const context = await browser.newContext({ viewport: { width: 800, height: 500 } });
     const page = await context.newPage();
-    const response = await page.goto(url);
+    const response = await page.goto(url, { timeout: 120000 });
     opened.push({ page, http: response.status() });
   }
   for (const { page } of opened) {
-    await page.waitForFunction(() => Number(document.body.dataset.shapesReceived || 0) > 10, null, { timeout: 30000 });
+    await page.waitForFunction(() => Number(document.body.dataset.shapesReceived || 0) > 10, null, { timeout: 120000 });
   }
+  await new Promise((r) => setTimeout(r, WARM_UP_S * 1000));
   const before = await Promise.all(opened.map(({ page }) => counters(page)));
   await new Promise((r) => setTimeout(r, MEASURE_S * 1000));
   const after = await Promise.all(opened.map(({ page }) => counters(page)));
@@ -65,6 +73,9 @@ async function live(browser, pages) {
     result.push({
       http: opened[i].http, seconds: s, webgl,
       shapes_per_s: (after[i].shapes - before[i].shapes) / s,
+      // Over the server's time stamps of the shapes: the rate the bridge sent them at,
+      // whatever bursts the page's own event loop added.
+      shapes_per_server_s: (after[i].shapes - before[i].shapes) / ((after[i].utime - before[i].utime) / 1e6),
       frames_per_s: (after[i].frames - before[i].frames) / s,
       shapes: after[i].shapes, frames: after[i].frames, status, screenshot: shot,
     });
@@ -74,8 +85,8 @@ async function live(browser, pages) {
 
 async function replay(browser) {
   const page = await browser.newPage({ viewport: { width: 800, height: 500 } });
-  await page.goto(url);
-  await page.waitForFunction(() => document.body.dataset.replayShapes !== undefined, null, { timeout: 30000 });
+  await page.goto(url, { timeout: 120000 });
+  await page.waitForFunction(() => document.body.dataset.replayShapes !== undefined, null, { timeout: 120000 });
   await page.selectOption('#replay-speed', '16');
   const start = Date.now();
   await page.waitForFunction(() => document.body.dataset.replayAtEnd === 'true', null, { timeout: 120000 });

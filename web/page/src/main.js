@@ -1,7 +1,7 @@
 // snapthread-web's page: connects to the bridge, draws every shape it gets, charts the
 // force models and shows the statuses. Test hooks (cumulative counters, read by the
 // browser tests): document.body.dataset.shapesReceived and .framesDrawn; also .lastShapeSeq,
-// .connection, and in replay .replayShape / .replayShapes / .replayAtEnd.
+// .lastShapeStatus, .lastShapeUtime (the server's stamp), .connection, and in replay .replayShape / .replayShapes / .replayAtEnd.
 import { SceneView } from './scene_view.js';
 import { Charts } from './charts.js';
 import { StatusPanel } from './status_panel.js';
@@ -32,6 +32,7 @@ function onMessage(m) {
       data.shapesReceived = shapes;
       data.lastShapeSeq = m.seq;
       data.lastShapeStatus = m.status;
+      data.lastShapeUtime = m.utime;
       break;
     case 'force': charts.addForceModel(m); break;
     case 'solver': panel.solver = m; break;

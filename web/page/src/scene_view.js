@@ -55,9 +55,18 @@ function placeArrow(arrow, from, to, radius) {
   arrow.quaternion.setFromUnitVectors(UP, d.divideScalar(length));
 }
 
+// A software rasteriser (SwiftShader, llvmpipe): multisampling would cost most of its
+// frame rate, so the page draws without it there, as the native viewer does headless.
+function softwareRenderer() {
+  const gl = document.createElement('canvas').getContext('webgl2');
+  const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+  const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
+  return /swiftshader|llvmpipe|software/i.test(name);
+}
+
 export class SceneView {
   constructor(canvas) {
-    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true });
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !softwareRenderer() });
     this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
     this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
     this.renderer.setClearColor(new THREE.Color(...C.BACKGROUND), 1);
@@ -66,6 +75,8 @@ export class SceneView {
     this.camera.position.set(0, 0, 3);
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.enableDamping = false;
+    this.dirty = true;  // something to draw: a new shape, a camera move, a resize
+    this.controls.addEventListener('change', () => { this.dirty = true; });
     this.tube = null;
     this.tubeMaterials = new Map();  // by status
     this.sphere = new THREE.SphereGeometry(1, 20, 12);
@@ -81,11 +92,23 @@ export class SceneView {
     this.forceScale = 0;  // the largest |F| seen (renderer.cc force_scale_n_)
     this.fitted = false;
     this.pending = null;  // the newest shape not drawn yet
-    window.addEventListener('keydown', (e) => { if (e.key === 'f' || e.key === 'F') this.fitted = false; });
+    this.last = null;     // the shape drawn
+    window.addEventListener('keydown', (e) => {
+      if (e.key === 'f' || e.key === 'F') this.refit();
+    });
+  }
+
+  refit() {
+    this.fitted = false;
+    if (!this.pending) this.pending = this.last;
+    this.dirty = true;
   }
 
   // Keeps the newest shape; it is built into geometry at the next frame only.
-  setShape(shape) { this.pending = shape; }
+  setShape(shape) {
+    this.pending = shape;
+    this.dirty = true;
+  }
 
   material(status) {
     if (!this.tubeMaterials.has(status)) this.tubeMaterials.set(status, headlightMaterial(C.statusColour(status)));
@@ -93,6 +116,7 @@ export class SceneView {
   }
 
   build(shape) {
+    this.last = shape;
     const p = shape.positions;
     const nodes = [];
     for (let i = 0; i + 2 < p.length; i += 3) nodes.push(new THREE.Vector3(p[i], p[i + 1], p[i + 2]));
@@ -187,6 +211,7 @@ export class SceneView {
     this.camera.updateProjectionMatrix();
     this.controls.update();
     this.fitted = true;
+    this.dirty = true;
   }
 
   resize() {
@@ -197,16 +222,20 @@ export class SceneView {
       this.renderer.setSize(w, h, false);
       this.camera.aspect = w / Math.max(h, 1);
       this.camera.updateProjectionMatrix();
+      this.dirty = true;
     }
   }
 
-  // One frame: builds the newest shape if one came, then renders. True when drawn.
+  // One frame: builds the newest shape if one came and renders, when anything changed
+  // (a still session costs no drawing). True when drawn.
   draw() {
+    this.resize();
+    if (!this.dirty) return false;
+    this.dirty = false;
     if (this.pending) {
       this.build(this.pending);
       this.pending = null;
     }
-    this.resize();
     this.controls.update();
     this.renderer.render(this.scene, this.camera);
     return true;
