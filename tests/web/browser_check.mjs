@@ -4,6 +4,8 @@
 //   live URL OUT_DIR PAGES: opens PAGES pages, waits for shapes, counts shapes and frames
 //        over MEASURE_S seconds per page, screenshots each page's canvas.
 //   replay URL OUT_DIR: one page, sets the speed to 16x, waits for the log's end.
+//   page URL OUT_DIR SECONDS: one 1280x900 page, a screenshot of all of it after SECONDS
+//        (the README's picture).
 //   auth URL_WITHOUT_TOKEN OUT_DIR TOKEN: HTTP status of the page and of a WebSocket
 //        upgrade without, with a wrong and with the right token.
 import { createRequire } from 'node:module';
@@ -101,6 +103,15 @@ async function replay(browser) {
            status: Number(d.lastShapeStatus ?? -1), screenshot: shot };
 }
 
+async function wholePage(browser, seconds) {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+  await page.goto(url, { timeout: 120000 });
+  await page.waitForTimeout(seconds * 1000);
+  const shot = path.join(out, 'page.png');
+  await page.screenshot({ path: shot });
+  return { screenshot: shot, ...(await page.evaluate(() => ({ ...document.body.dataset }))) };
+}
+
 function status(target, headers = {}) {
   return new Promise((resolve, reject) => {
     const req = http.get(target, { headers }, (res) => { res.resume(); resolve(res.statusCode); });
@@ -131,7 +142,9 @@ try {
     result = await auth(arg);
   } else {
     browser = await launch();
-    result = mode === 'live' ? await live(browser, Number(arg || 2)) : await replay(browser);
+    if (mode === 'live') result = await live(browser, Number(arg || 2));
+    else if (mode === 'page') result = await wholePage(browser, Number(arg || 15));
+    else result = await replay(browser);
   }
   console.log(JSON.stringify(result));
 } catch (e) {

@@ -5,11 +5,20 @@ import uPlot from 'uplot';
 
 const WINDOW_S = 20;
 
+// Axis labels: plain numbers where they read well, powers of ten for the residual.
+function tick(v, log) {
+  if (v === null || v === undefined) return '';
+  if (log || (v !== 0 && (Math.abs(v) < 1e-2 || Math.abs(v) >= 1e5))) return v.toExponential(0);
+  return String(Number(v.toPrecision(3)));
+}
+
 function chart(parent, title, label, colour, log) {
   const opts = {
-    title, width: 340, height: 120,
+    title, width: 340, height: 110,
     scales: { x: { time: false }, y: log ? { distr: 3 } : {} },
-    axes: [{ stroke: '#aaa', grid: { stroke: '#333' } }, { stroke: '#aaa', grid: { stroke: '#333' }, size: 60 }],
+    axes: [{ stroke: '#aaa', grid: { stroke: '#333' } },
+           { stroke: '#aaa', grid: { stroke: '#333' }, size: 60,
+             values: (u, splits) => splits.map((v) => tick(v, log)) }],
     series: [{ label: 't (s)' }, { label, stroke: colour, width: 1.5, points: { show: false } }],
     legend: { show: false },
   };

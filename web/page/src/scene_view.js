@@ -205,7 +205,8 @@ export class SceneView {
   fit(box, extent) {
     const centre = box.getCenter(new THREE.Vector3());
     this.controls.target.copy(centre);
-    this.camera.position.set(centre.x, centre.y, centre.z + 1.6 * extent);
+    // Far enough back for the force arrow (up to 0.3 extent past the grasp) to stay in view.
+    this.camera.position.set(centre.x, centre.y, centre.z + 2.0 * extent);
     this.camera.near = extent * 1e-3;
     this.camera.far = extent * 100;
     this.camera.updateProjectionMatrix();
