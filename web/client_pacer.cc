@@ -28,6 +28,9 @@ ClientPacer::Next ClientPacer::Take(Clock::time_point now) {
   for (const FeedKind kind : kOrder) {
     Slot& slot = slots_[Index(kind)];
     if (!slot.pending) continue;
+    const bool paced = slot.min_interval > Clock::duration::zero();
+    // A full window: the page's Ack() makes the session ask again.
+    if (paced && in_flight_ >= kWindow) continue;
     const Clock::time_point allowed = slot.last_sent + slot.min_interval;
     if (now >= allowed || slot.last_sent == Clock::time_point{}) {
       next.text = std::move(slot.pending);
@@ -36,6 +39,7 @@ ClientPacer::Next ClientPacer::Take(Clock::time_point now) {
       next.wait = false;
       slot.last_sent = now;
       sent_[Index(kind)]++;
+      if (paced) in_flight_++;
       return next;
     }
     if (!next.wait || allowed < next.at) {

@@ -33,6 +33,10 @@ void Hub::Leave(WsClient* client) {
 }
 
 void Hub::OnClientMessage(WsClient* client, const std::string& text) {
+  if (text == "ack") {
+    client->Acked();
+    return;
+  }
   if (text.rfind("ping ", 0) == 0) {
     char* end = nullptr;
     const double t = std::strtod(text.c_str() + 5, &end);

@@ -39,7 +39,8 @@ class Hub : public std::enable_shared_from_this<Hub> {
   // io thread:
   void Join(WsClient* client);
   void Leave(WsClient* client);
-  // A text message from a page: "ping T" is answered to that page alone ("pong"), the
+  // A text message from a page: "ack" acknowledges a paced message (ClientPacer), "ping T"
+  // is answered to that page alone ("pong"), the
   // rest goes to the command handler. Unknown commands are counted and ignored.
   void OnClientMessage(WsClient* client, const std::string& text);
   size_t clients() const { return clients_.size(); }

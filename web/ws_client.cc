@@ -58,6 +58,11 @@ void WsClient::Offer(FeedKind kind, Text text) {
   Pump();
 }
 
+void WsClient::Acked() {
+  pacer_.Ack();
+  Pump();
+}
+
 void WsClient::Pump() {
   if (!open_ || writing_) return;
   ClientPacer::Next next = pacer_.Take(Clock::now());

@@ -29,6 +29,7 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   // Completes the upgrade of `request` (already checked for the token), then joins the hub.
   void Accept(boost::beast::http::request<boost::beast::http::string_body> request);
   void Offer(FeedKind kind, Text text);
+  void Acked();  // the page handled a shape or force model
   const ClientPacer& pacer() const { return pacer_; }
 
  private:

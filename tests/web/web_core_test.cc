@@ -66,12 +66,14 @@ TEST(ClientPacer, AOneKilohertzStreamReachesAPageAtMostSixtyTimesASecondLatestFi
   const Clock::time_point t0 = Clock::now();
   int sent = 0;
   std::string last;
-  // One second of shapes at 1 kHz; the page reads whenever the pacer allows.
+  // One second of shapes at 1 kHz; the page reads whenever the pacer allows, and
+  // acknowledges each shape at once.
   for (int i = 0; i < 1000; ++i) {
     const Clock::time_point now = t0 + std::chrono::milliseconds(i);
     pacer.Offer(FeedKind::kShape, T(std::to_string(i)));
     const ClientPacer::Next next = pacer.Take(now);
     if (next.text) {
+      pacer.Ack();
       sent++;
       last = *next.text;
       EXPECT_EQ(last, std::to_string(i)) << "the newest shape goes, not an old one";
@@ -105,6 +107,27 @@ TEST(ClientPacer, AStalledPageHoldsOneMessagePerKindAndStatusesGoFirst) {
   EXPECT_FALSE(third.text);
   EXPECT_FALSE(third.wait) << "nothing is left once the latest went";
   EXPECT_EQ(pacer.dropped(FeedKind::kShape), 9999);
+}
+
+TEST(ClientPacer, APageThatDoesNotAcknowledgeGetsNoMoreThanTheWindow) {
+  ClientPacer pacer(60.0);
+  Clock::time_point now = Clock::now();
+  int sent = 0;
+  for (int i = 0; i < 100; ++i, now += 20ms) {  // 50 Hz: each shape may go at once
+    pacer.Offer(FeedKind::kShape, T(std::to_string(i)));
+    sent += pacer.Take(now).text != nullptr;
+  }
+  EXPECT_EQ(sent, ClientPacer::kWindow) << "no acknowledgement, no more shapes";
+  EXPECT_EQ(pacer.in_flight(), ClientPacer::kWindow);
+  pacer.Offer(FeedKind::kDeviceStatus, T("status"));
+  const ClientPacer::Next status = pacer.Take(now);
+  ASSERT_TRUE(status.text) << "unpaced kinds are not held by the window";
+  EXPECT_EQ(*status.text, "status");
+  EXPECT_FALSE(pacer.Take(now).text);
+  pacer.Ack();
+  const ClientPacer::Next latest = pacer.Take(now);
+  ASSERT_TRUE(latest.text);
+  EXPECT_EQ(*latest.text, "99") << "after the acknowledgement the latest shape goes";
 }
 
 TEST(ObserverToken, ComesFromTheQueryAndComparesExactly) {

@@ -22,6 +22,9 @@ const connection = new Connection(onMessage, (state) => { data.connection = stat
 const replay = new ReplayControls(document.getElementById('replay'), (c) => connection.send(c));
 
 function onMessage(m) {
+  // The bridge keeps at most a few shapes and force models unacknowledged per page, so a
+  // page that falls behind gets the latest ones, not a backlog (web/client_pacer.h).
+  if (m.type === 'shape' || m.type === 'force') connection.send('ack');
   switch (m.type) {
     case 'shape':
       view.setShape(m);
