@@ -17,12 +17,13 @@ SelfContact::SelfContact(const ContactParams& params, int segments, double rest_
   hi_.resize(3, segments_);
 }
 
-void SelfContact::FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to,
-                            double reach) const {
+void SelfContact::FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to, double reach,
+                            BroadPhase* broad, Eigen::Matrix3Xd* lo, Eigen::Matrix3Xd* hi,
+                            std::vector<std::pair<int, int>>* pairs) const {
   const double half = 0.5 * reach;
-  if (lo_.cols() != segments_) {
-    lo_.resize(3, segments_);
-    hi_.resize(3, segments_);
+  if (lo->cols() != segments_) {
+    lo->resize(3, segments_);
+    hi->resize(3, segments_);
   }
   for (int i = 0; i < segments_; ++i) {
     Eigen::Vector3d l = nodes.col(i).cwiseMin(nodes.col(i + 1));
@@ -31,13 +32,13 @@ void SelfContact::FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3X
       l = l.cwiseMin(to->col(i)).cwiseMin(to->col(i + 1));
       h = h.cwiseMax(to->col(i)).cwiseMax(to->col(i + 1));
     }
-    lo_.col(i) = l.array() - half;
-    hi_.col(i) = h.array() + half;
+    lo->col(i) = l.array() - half;
+    hi->col(i) = h.array() + half;
   }
-  broad_.Overlaps(lo_, hi_, &pairs_);
-  pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+  broad->Overlaps(*lo, *hi, pairs);
+  pairs->erase(std::remove_if(pairs->begin(), pairs->end(),
                               [&](const std::pair<int, int>& p) { return !Included(p.first, p.second); }),
-               pairs_.end());
+               pairs->end());
 }
 
 double SelfContact::Energy(const Eigen::Matrix3Xd& nodes) const {
@@ -68,8 +69,11 @@ double SelfContact::MaxStepFraction(const Eigen::Matrix3Xd& from, const Eigen::M
 
 std::vector<ContactPoint> SelfContact::ActivePairs(const Eigen::Matrix3Xd& nodes) const {
   std::vector<ContactPoint> out;
-  FindPairs(nodes, nullptr, params_.ActivationDistance());
-  for (const auto& [i, j] : pairs_) {
+  BroadPhase broad;
+  Eigen::Matrix3Xd lo, hi;
+  std::vector<std::pair<int, int>> pairs;
+  FindPairs(nodes, nullptr, params_.ActivationDistance(), &broad, &lo, &hi, &pairs);
+  for (const auto& [i, j] : pairs) {
     const SegmentClosest c = ClosestPoints(nodes.col(i), nodes.col(i + 1), nodes.col(j), nodes.col(j + 1));
     if (c.distance_sq >= barrier_.ActivationSq()) continue;
     ContactPoint p;

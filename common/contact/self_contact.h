@@ -85,7 +85,8 @@ class SelfContact {
   // work that must stay O(n + contacts)).
   int CandidatePairs() const { return static_cast<int>(pairs_.size()); }
 
-  // The active pairs with their closest points (allocates: for status and drawing).
+  // The active pairs with their closest points (allocates: for status and drawing). Uses
+  // scratch of its own, so another thread may call it while the solver's thread runs.
   std::vector<ContactPoint> ActivePairs(const Eigen::Matrix3Xd& nodes) const;
   // The smallest centreline distance over the included pairs (brute force, for tests and
   // reports), and which pair.
@@ -94,7 +95,11 @@ class SelfContact {
  private:
   // pairs_ = included pairs whose boxes (segment boxes, or swept boxes over `to` when
   // given) inflated by half of `reach` overlap.
-  void FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to, double reach) const;
+  void FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to, double reach) const {
+    FindPairs(nodes, to, reach, &broad_, &lo_, &hi_, &pairs_);
+  }
+  void FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to, double reach, BroadPhase* broad,
+                 Eigen::Matrix3Xd* lo, Eigen::Matrix3Xd* hi, std::vector<std::pair<int, int>>* pairs) const;
 
   ContactParams params_{};
   Barrier barrier_{ContactParams{}};
