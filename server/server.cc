@@ -425,6 +425,7 @@ void Server::PublishStatus() {
   in.snaps = snaps_.load();
   in.dropped_poses = dropped_poses_.load();
   in.rejected_messages = rejected_messages_.load();
+  in.contacts = static_cast<int32_t>(session_->tracker->ActiveContacts().size());
   in.seq = status_seq_++;
   in.utime = transport::RealtimeMicros();
   solver_status_t msg = BuildSolverStatus(in);

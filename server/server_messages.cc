@@ -153,6 +153,18 @@ thread_shape_t BuildShape(const ShapeInputs& in) {
   for (int i = 0; i < dim && i < in.force_model_units.size(); ++i) {
     msg.force[i] = Finite(in.force_model_units[i]) ? in.force_model_units[i] : 0.0;
   }
+  // Self-contact: the closest points of each active pair (none without contact).
+  if (nodes.cols() > 0) {
+    for (const contact::ContactPoint& c : model.ActiveContacts(in.x, in.u)) {
+      std::vector<double> row(6, 0.0);
+      for (int i = 0; i < 3; ++i) {
+        row[i] = Finite(c.point_a[i]) ? c.point_a[i] : 0.0;
+        row[3 + i] = Finite(c.point_b[i]) ? c.point_b[i] : 0.0;
+      }
+      msg.contacts.push_back(row);
+    }
+    msg.num_contacts = static_cast<int32_t>(msg.contacts.size());
+  }
   return msg;
 }
 
@@ -180,6 +192,7 @@ solver_status_t BuildSolverStatus(const StatusInputs& in) {
   msg.snaps = in.snaps;
   msg.dropped_poses = in.dropped_poses;
   msg.rejected_messages = in.rejected_messages;
+  msg.contacts = in.contacts;
   return msg;
 }
 

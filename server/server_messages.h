@@ -75,6 +75,7 @@ struct StatusInputs {
   int64_t snaps = 0;
   int64_t dropped_poses = 0;
   int64_t rejected_messages = 0;
+  int32_t contacts = 0;  // active self-contact pairs at the last update
   int64_t seq = 0;
   int64_t utime = 0;
 };
