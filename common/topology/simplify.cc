@@ -123,15 +123,22 @@ void SimplifyClosedPolygon(std::vector<Eigen::Vector3d>& polygon) {
   int count = n, query = 0;
   for (bool removed = true; removed && count > 3;) {
     removed = false;
-    double total = 0.0;
+    // Cells of about two typical edges: the median, since the closure's few long edges
+    // would inflate a mean (they go to the grid's scan-always list instead).
+    std::vector<double> lengths;
+    lengths.reserve(count);
     for (int s = 0; s < n; ++s)
-      if (alive[s]) total += (polygon[next[s]] - polygon[s]).norm();
-    const double cell = std::max({2.0 * total / count, scale / 128.0, 1e-300});
+      if (alive[s]) lengths.push_back((polygon[next[s]] - polygon[s]).norm());
+    std::nth_element(lengths.begin(), lengths.begin() + count / 2, lengths.end());
+    const double cell = std::max(2.0 * lengths[count / 2], 1e-9 * scale);
     EdgeGrid grid(bounds, cell);
     for (int s = 0; s < n; ++s)
       if (alive[s]) grid.Insert(s, BoxOf(polygon[s], polygon[next[s]]));
+    // A vertex whose neighbour went this pass waits for the next one: chains of removals
+    // would grow one triangle across the whole curve, and every query with it.
+    std::vector<char> touched(n, 0);
     for (int v = 0; v < n && count > 3; ++v) {
-      if (!alive[v]) continue;
+      if (!alive[v] || touched[v]) continue;
       const int a = prev[v], c = next[v];
       const Eigen::Vector3d &pa = polygon[a], &pv = polygon[v], &pc = polygon[c];
       Box tri = BoxOf(pa, pv);
@@ -141,6 +148,9 @@ void SimplifyClosedPolygon(std::vector<Eigen::Vector3d>& polygon) {
       auto test = [&](int s) {
         if (blocked || !alive[s] || stamp[s] == query) return;
         stamp[s] = query;
+        const Box e = BoxOf(polygon[s], polygon[next[s]]);
+        if ((e.lo.array() > tri.hi.array()).any() || (e.hi.array() < tri.lo.array()).any())
+          return;
         // Edges sharing a vertex with the triangle meet it only there.
         if (s == prev[a] || s == a || s == v || s == c) return;
         blocked = SegmentMeetsTriangle(polygon[s], polygon[next[s]], pa, pv, pc, scale);
@@ -150,6 +160,7 @@ void SimplifyClosedPolygon(std::vector<Eigen::Vector3d>& polygon) {
       }
       if (blocked) continue;
       alive[v] = 0;
+      touched[a] = touched[c] = 1;
       next[a] = c;
       prev[c] = a;
       --count;
