@@ -35,6 +35,8 @@ FORBIDDEN = [
     ("messages", {"solvers", "linalg", "tracking", "CHOLMOD"}),
     ("snapthread-device", {"solvers", "linalg", "tracking", "CHOLMOD"}),
     ("device_client", {"solvers", "linalg", "tracking", "CHOLMOD"}),
+    # Knot identification is geometry only: no physics, no messages.
+    ("topology", {"models", "solvers", "linalg", "tracking", "scene", "messages", "LCM"}),
 ]
 
 
