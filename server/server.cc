@@ -1,5 +1,7 @@
 #include "server.h"
 
+#include "grasp_poses.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -291,7 +293,7 @@ void Server::SolveLoop() {
       changed_session = true;
     }
     if (PollSceneLoad()) changed_session = true;
-    if (taken.pose) SolveAndPublish(*taken.pose);
+    if (!taken.poses.empty()) SolveAndPublish(taken.poses);
     now = SteadyClock::now();
     if (now >= next_shape || changed_session) {
       PublishShape();
@@ -311,16 +313,21 @@ void Server::SolveLoop() {
   }
 }
 
-void Server::SolveAndPublish(const PoseSample& pose) {
+void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
   EquilibriumTracker& tracker = *session_->tracker;
-  const Model& model = tracker.model();
   const Scene& scene = session_->scene;
-  const Eigen::Vector3d position(pose.state.position[0], pose.state.position[1],
-                                 pose.state.position[2]);
-  const Eigen::Vector4d quaternion(pose.state.orientation[0], pose.state.orientation[1],
-                                   pose.state.orientation[2], pose.state.orientation[3]);
-  const Vec u = messages::PoseToControls(scene.device, scene.grasp_layout, position, quaternion,
-                                         session_->rest_direction);
+  // Each pose moves its own grasp (grasp_poses.h); the others keep their controls.
+  Vec u = tracker.control();
+  const std::vector<int> grasp_of = ApplyGraspPoses(scene, session_->rest_direction, poses, &u);
+  bool any = false;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    if (grasp_of[k] >= 0) {
+      any = true;
+    } else {
+      Reject(channels_.device_state, "no grasp '" + poses[k].state.grasp + "' in scene " + scene.name);
+    }
+  }
+  if (!any) return;
 
   if (hooks_.before_update) hooks_.before_update();
   const TrackResult* result = nullptr;
@@ -335,12 +342,44 @@ void Server::SolveAndPublish(const PoseSample& pose) {
   const double solve_us = std::chrono::duration<double, std::micro>(SteadyClock::now() - t0).count();
   if (hooks_.after_update && result != nullptr) hooks_.after_update(u, tracker);
 
+  updates_.fetch_add(1);
+  if (ClassifyStatus(result) == force_model_t::STATUS_SNAPPED) {
+    snaps_.fetch_add(1);
+    ++snaps_since_reset_;
+    if (spdlog::should_log(spdlog::level::debug)) spdlog::debug("server: snap at u = ({})", Format(u));
+  }
+  status_window_.Push(solve_us);
+  {
+    const int64_t now_us = SteadyMicros();
+    std::lock_guard<std::mutex> lock(info_mutex_);
+    run_window_.Push(solve_us);
+    if (first_update_us_ == 0) first_update_us_ = now_us;
+    last_update_us_ = now_us;
+  }
+  // One force model per pose that named a grasp: that grasp's block of F and K.
+  bool first = true;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    if (grasp_of[k] < 0) continue;
+    PublishGraspModel(poses[k], grasp_of[k], u, result, solve_us, first);
+    first = false;
+  }
+}
+
+void Server::PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, const TrackResult* result,
+                               double solve_us, bool first) {
+  const Model& model = session_->tracker->model();
+  const Scene& scene = session_->scene;
+  const DeviceMapping mapping = GraspDeviceMapping(scene, grasp);
   ForceModelInputs in;
-  in.mapping = &scene.device;
+  in.mapping = &mapping;
   in.model = &model;
   in.u = u;
-  in.position_m = position;
+  in.position_m = Eigen::Vector3d(pose.state.position[0], pose.state.position[1], pose.state.position[2]);
   in.result = result;
+  if (!scene.grasps.empty()) {
+    in.grasp_offset = scene.grasps[grasp].offset;
+    in.grasp_controls = scene.grasp_layout.NumControls();
+  }
   in.device_seq = pose.state.seq;
   in.device_utime = pose.state.utime;
   in.server_receive_utime = pose.receive_utime;
@@ -354,27 +393,16 @@ void Server::SolveAndPublish(const PoseSample& pose) {
     spdlog::error("server: refusing to publish an invalid force model: {}", why);
     msg = BuildForceModel(ForceModelInputs{in.mapping, in.model, in.u, Eigen::Vector3d::Zero(),
                                            nullptr, in.device_seq, in.device_utime,
-                                           in.server_receive_utime, 0.0, in.seq, in.utime});
+                                           in.server_receive_utime, 0.0, in.seq, in.utime,
+                                           in.grasp_offset, in.grasp_controls});
   }
-  // Statistics before the message leaves: whoever receives the model sees them counted.
-  last_status_ = msg.status;
-  for (int i = 0; i < 3; ++i) last_force_n_[i] = msg.f0[i];
-  updates_.fetch_add(1);
-  if (msg.status == force_model_t::STATUS_INVALID) invalid_models_.fetch_add(1);
-  if (msg.status == force_model_t::STATUS_SNAPPED) {
-    snaps_.fetch_add(1);
-    ++snaps_since_reset_;
-    if (spdlog::should_log(spdlog::level::debug)) {
-      spdlog::debug("server: snap at u = ({})", Format(u));
-    }
-  }
-  status_window_.Push(solve_us);
-  {
-    const int64_t now_us = SteadyMicros();
-    std::lock_guard<std::mutex> lock(info_mutex_);
-    run_window_.Push(solve_us);
-    if (first_update_us_ == 0) first_update_us_ = now_us;
-    last_update_us_ = now_us;
+  msg.grasp = scene.grasps.empty() ? std::string() : scene.grasps[grasp].name;
+  // Statistics of the update (counted by SolveAndPublish before any model leaves, so
+  // whoever receives one sees them); the first grasp's model is the one reported.
+  if (first) {
+    last_status_ = msg.status;
+    for (int i = 0; i < 3; ++i) last_force_n_[i] = msg.f0[i];
+    if (msg.status == force_model_t::STATUS_INVALID) invalid_models_.fetch_add(1);
   }
   if (!SignForChannel(&msg, channels_.force_model)) return;
   if (lcm_->publish(channels_.force_model, &msg) != 0) publish_failures_.fetch_add(1);

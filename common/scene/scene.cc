@@ -253,7 +253,7 @@ void ReadGrasps(const YAML::Node& list, const ModelRegistration& model, const Re
     const std::string key = "grasps[" + std::to_string(i) + "]";
     const YAML::Node g = list[i];
     if (!g.IsMap()) rd.Fail(key, "expected a mapping with name, edge or node, start, path");
-    GraspRead r = ReadGrasp(g, key, sc->grasp_layout, rd, {"name", "edge", "node"});
+    GraspRead r = ReadGrasp(g, key, sc->grasp_layout, rd, {"name", "edge", "node", "model_origin"});
     SceneGrasp sg;
     if (!g["name"]) rd.Fail(key + ".name", "missing (expected a name, e.g. left)");
     sg.name = rd.Get<std::string>(g["name"], key + ".name", "a name");
@@ -270,6 +270,11 @@ void ReadGrasps(const YAML::Node& list, const ModelRegistration& model, const Re
     if (sg.holds != expected)
       rd.Fail(key + "." + kind, "expected the " + expected + " (the model's grasps in order), got " + sg.holds);
     sg.offset = static_cast<int>(i) * m;
+    if (g["model_origin"]) {
+      const Vec o = rd.Vector(g["model_origin"], key + ".model_origin", 3);
+      sg.has_model_origin = true;
+      sg.model_origin = {o[0], o[1], o[2]};
+    }
     if (!r.path.empty()) {
       if (path_points != 0 && r.path.size() != path_points)
         rd.Fail(key + ".path", "expected " + std::to_string(path_points) + " points as the other grasps' paths");
@@ -443,6 +448,13 @@ int FindGrasp(const Scene& scene, const std::string& name) {
   for (size_t i = 0; i < scene.grasps.size(); ++i)
     if (scene.grasps[i].name == name) return static_cast<int>(i);
   return -1;
+}
+
+DeviceMapping GraspDeviceMapping(const Scene& scene, int grasp) {
+  DeviceMapping m = scene.device;
+  if (grasp >= 0 && grasp < static_cast<int>(scene.grasps.size()) && scene.grasps[grasp].has_model_origin)
+    m.model_origin = scene.grasps[grasp].model_origin;
+  return m;
 }
 
 Scene LoadScene(const std::string& path, const std::vector<SceneOverride>& overrides) {

@@ -33,6 +33,10 @@ struct SceneGrasp {
   std::string name;
   std::string holds;  // "edge 0", "edge 59"; "" for the single grasp
   int offset = 0;     // its first control in u
+  // The model point this grasp's device origin maps to (`model_origin:` of the grasp):
+  // each hand works about its own end. Unset: the scene's device.model_origin.
+  bool has_model_origin = false;
+  std::array<double, 3> model_origin = {0.0, 0.0, 0.0};
 };
 
 struct Scene {
@@ -57,6 +61,9 @@ struct Scene {
 // The index in scene.grasps of the grasp called `name`, -1 when there is none ("" names
 // the first grasp of any scene, so a client without --grasp binds as before).
 int FindGrasp(const Scene& scene, const std::string& name);
+// The device mapping of grasp `grasp` (an index into scene.grasps; the scene's mapping
+// for a scene without grasps): the scene's, about the grasp's own model origin.
+DeviceMapping GraspDeviceMapping(const Scene& scene, int grasp);
 
 class SceneError : public std::runtime_error {
  public:
