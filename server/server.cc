@@ -118,9 +118,12 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
   session->scene.solver = options;
   // The one scene -> tracker path (SceneError for invalid parameters or options).
   session->tracker = MakeTracker(session->scene);
-  if (scene.grasp_layout.NumControls() != session->tracker->model().NumControls()) {
+  // Every grasp takes the layout's controls (issue 15: several grasps concatenate theirs).
+  const int grasp_controls =
+      scene.grasp_layout.NumControls() * std::max<int>(1, static_cast<int>(scene.grasps.size()));
+  if (grasp_controls != session->tracker->model().NumControls()) {
     throw SceneError(scene.file + ": the scene's grasp layout has " +
-                     std::to_string(scene.grasp_layout.NumControls()) + " controls, model " +
+                     std::to_string(grasp_controls) + " controls, model " +
                      std::string(session->tracker->model().Name()) + " has " +
                      std::to_string(session->tracker->model().NumControls()));
   }
