@@ -57,8 +57,12 @@ bool CountedRowsAgree(const thread_shape_t& msg, std::string* why) {
                            : Rows == &thread_shape_t::frames  ? "frames"
                            : Rows == &thread_shape_t::grasps  ? "grasps"
                                                               : "contacts";
+  const std::string count = Count == &thread_shape_t::num_nodes    ? "num_nodes"
+                            : Count == &thread_shape_t::num_frames ? "num_frames"
+                            : Count == &thread_shape_t::num_grasps ? "num_grasps"
+                                                                   : "num_contacts";
   if (rows.size() != static_cast<size_t>(msg.*Count)) {
-    return Fail(why, name + " has " + std::to_string(rows.size()) + " rows, its count says " +
+    return Fail(why, name + " has " + std::to_string(rows.size()) + " rows, " + count + " says " +
                          std::to_string(msg.*Count));
   }
   for (size_t i = 0; i < rows.size(); ++i) {
