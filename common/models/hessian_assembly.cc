@@ -54,6 +54,7 @@ void HessianAssembly::Finalize() {
   runs_.clear();
   const int* outer = pattern_.outerIndexPtr();
   const int* inner = pattern_.innerIndexPtr();
+  std::vector<char> reached(pattern_.nonZeros(), 0);
   for (int t = 0; t < terms; ++t) {
     run_begin_[t] = static_cast<int>(runs_.size());
     const int* v = TermVars(t);
@@ -67,14 +68,17 @@ void HessianAssembly::Finalize() {
         const int* it = std::lower_bound(first, last, v[i]);
         assert(it != last && *it == v[i]);
         const int index = static_cast<int>(it - inner);
+        const bool is_first = reached[index] == 0;
+        reached[index] = 1;
         if (!runs_.empty() && static_cast<int>(runs_.size()) > run_begin_[t]) {
           Run& run = runs_.back();
-          if (run.local_col == j && run.local_row + run.len == i && run.value + run.len == index) {
+          if (run.local_col == j && run.local_row + run.len == i && run.value + run.len == index &&
+              run.first == is_first) {
             ++run.len;
             continue;
           }
         }
-        runs_.push_back({i, j, 1, index});
+        runs_.push_back({i, j, 1, index, is_first});
       }
     }
   }
@@ -104,6 +108,27 @@ void HessianAssembly::AddHessian(int term, const double* local_h, int ld, double
     const double* src = local_h + run->local_row + run->local_col * ld;
     double* dst = values + run->value;
     for (int r = 0; r < run->len; ++r) dst[r] += src[r];
+  }
+}
+
+void HessianAssembly::StoreHessian(int term, const double* local_h, int ld, double* values) const {
+  const Run* run = runs_.data() + run_begin_[term];
+  const Run* end = runs_.data() + run_begin_[term + 1];
+  for (; run != end; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    // A node's three coordinates make most runs 3 long: that case unrolled.
+    if (run->len == 3) {
+      if (run->first) {
+        dst[0] = src[0], dst[1] = src[1], dst[2] = src[2];
+      } else {
+        dst[0] += src[0], dst[1] += src[1], dst[2] += src[2];
+      }
+    } else if (run->first) {
+      for (int r = 0; r < run->len; ++r) dst[r] = src[r];
+    } else {
+      for (int r = 0; r < run->len; ++r) dst[r] += src[r];
+    }
   }
 }
 

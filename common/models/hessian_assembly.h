@@ -57,6 +57,11 @@ class HessianAssembly {
   void AddControlGradient(int term, const double* local_g, double* eu) const;
   // `values` is valuePtr() of a matrix with exactly Pattern()'s structure.
   void AddHessian(int term, const double* local_h, int ld, double* values) const;
+  // The same sum without clearing `values` first: the first term (in term order) to
+  // reach a slot stores into it, later ones add. Call it for every term, in order
+  // 0 .. NumTerms() - 1. 0 + h == h exactly, so the result is AddHessian's on a zeroed
+  // matrix to the last bit, without a pass that clears the whole matrix.
+  void StoreHessian(int term, const double* local_h, int ld, double* values) const;
   // exu: num_states x num_controls, euu: num_controls x num_controls (presized).
   void AddMixedHessian(int term, const double* local_h, int ld, Mat* exu) const;
   void AddControlHessian(int term, const double* local_h, int ld, Mat* euu) const;
@@ -75,6 +80,7 @@ class HessianAssembly {
     int local_col;
     int len;
     int value;
+    bool first;  // the first term to reach these slots (StoreHessian stores, not adds)
   };
   std::vector<int> run_begin_;        // term t's runs are runs_[run_begin_[t], run_begin_[t+1])
   std::vector<Run> runs_;

@@ -322,11 +322,11 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
     *h = pattern;
   }
   double* values = h->valuePtr();
-  std::fill(values, values + pattern.nonZeros(), 0.0);
+  // StoreHessian: every slot is reached by some term, so no clearing pass.
   const GraspMap gm = Grasp(u, true);
   for (int t = 0; t < assembly_.NumTerms(); ++t) {
     Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
-      assembly_.AddHessian(t, lh, ld, values);
+      assembly_.StoreHessian(t, lh, ld, values);
     });
   }
 }

@@ -184,8 +184,11 @@ void EquilibriumTracker::ComputeForces() {
   Mat& k = result_.stiffness;
   if (ok) {
     // -(E_uu - E_ux sol), written without temporaries (no allocation per update).
-    k.noalias() = exu_.transpose() * sol_;
-    k -= euu_;
+    // (A column dot per entry: a general matrix product packs its operands first, a
+    // tenth of an update at n = 1000.)
+    for (int j = 0; j < k.cols(); ++j) {
+      for (int i = 0; i < k.rows(); ++i) k(i, j) = exu_.col(i).dot(sol_.col(j)) - euu_(i, j);
+    }
   }
   if (!ok || !k.allFinite()) {
     // No usable factorisation: the stiffness with the state held (no response), finite.
