@@ -53,6 +53,12 @@ class Model {
   // E_xx with the fixed pattern of HessianPattern().
   virtual const SparseMatrix& HessianPattern() const = 0;
   virtual void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const = 0;
+  // E_x and E_xx at one state, the same values as Gradient() and Hessian(); a model may
+  // fuse the two passes over its terms (the solvers call this where both are needed).
+  virtual void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
+    Gradient(x, u, g);
+    Hessian(x, u, h);
+  }
   // E_u, size NumControls(). The force on the grasp is F = -E_u (envelope theorem, §2.3.4).
   virtual void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const = 0;
   // E_xu, NumStates() x NumControls() (dense: only a few rows are non-zero).
