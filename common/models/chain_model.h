@@ -97,6 +97,24 @@ class ChainModel : public Model {
     }
   }
 
+  // One pass over the control terms for all three (the same operations, the same bits).
+  void ControlDerivatives(const Vec& x, const Vec& u, Vec* eu, Mat* exu, Mat* euu) const override {
+    const int nx = NumStates(), nu = NumControls();
+    if (eu->size() != nu) eu->resize(nu);
+    if (exu->rows() != nx || exu->cols() != nu) exu->resize(nx, nu);
+    if (euu->rows() != nu || euu->cols() != nu) euu->resize(nu, nu);
+    eu->setZero();
+    exu->setZero();
+    euu->setZero();
+    for (int t : control_terms_) {
+      Self().Local(t, x, u, true, [&](const double* lg, const double* lh, int ld) {
+        assembly_.AddControlGradient(t, lg, eu->data());
+        assembly_.AddMixedHessian(t, lh, ld, exu);
+        assembly_.AddControlHessian(t, lh, ld, euu);
+      });
+    }
+  }
+
   int HessianBandwidth() const override { return assembly_.Bandwidth(); }
 
  protected:

@@ -83,6 +83,20 @@ void HessianAssembly::Finalize() {
     }
   }
   run_begin_[terms] = static_cast<int>(runs_.size());
+
+  store_begin_.assign(4 * terms + 1, 0);
+  store_runs_.clear();
+  for (int t = 0; t < terms; ++t) {
+    for (int k = 0; k < 4; ++k) {
+      store_begin_[4 * t + k] = static_cast<int>(store_runs_.size());
+      for (int r = run_begin_[t]; r < run_begin_[t + 1]; ++r) {
+        const Run& run = runs_[r];
+        const int kind = (run.len == 3 ? 0 : 2) + (run.first ? 0 : 1);
+        if (kind == k) store_runs_.push_back(run);
+      }
+    }
+  }
+  store_begin_[4 * terms] = static_cast<int>(store_runs_.size());
 }
 
 void HessianAssembly::AddGradient(int term, const double* local_g, double* g) const {
@@ -112,23 +126,28 @@ void HessianAssembly::AddHessian(int term, const double* local_h, int ld, double
 }
 
 void HessianAssembly::StoreHessian(int term, const double* local_h, int ld, double* values) const {
-  const Run* run = runs_.data() + run_begin_[term];
-  const Run* end = runs_.data() + run_begin_[term + 1];
-  for (; run != end; ++run) {
+  const Run* runs = store_runs_.data();
+  const int* begin = store_begin_.data() + 4 * term;
+  // A node's three coordinates make most runs 3 long: those unrolled.
+  for (const Run* run = runs + begin[0]; run != runs + begin[1]; ++run) {
     const double* src = local_h + run->local_row + run->local_col * ld;
     double* dst = values + run->value;
-    // A node's three coordinates make most runs 3 long: that case unrolled.
-    if (run->len == 3) {
-      if (run->first) {
-        dst[0] = src[0], dst[1] = src[1], dst[2] = src[2];
-      } else {
-        dst[0] += src[0], dst[1] += src[1], dst[2] += src[2];
-      }
-    } else if (run->first) {
-      for (int r = 0; r < run->len; ++r) dst[r] = src[r];
-    } else {
-      for (int r = 0; r < run->len; ++r) dst[r] += src[r];
-    }
+    dst[0] = src[0], dst[1] = src[1], dst[2] = src[2];
+  }
+  for (const Run* run = runs + begin[1]; run != runs + begin[2]; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    dst[0] += src[0], dst[1] += src[1], dst[2] += src[2];
+  }
+  for (const Run* run = runs + begin[2]; run != runs + begin[3]; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    for (int r = 0; r < run->len; ++r) dst[r] = src[r];
+  }
+  for (const Run* run = runs + begin[3]; run != runs + begin[4]; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    for (int r = 0; r < run->len; ++r) dst[r] += src[r];
   }
 }
 

@@ -84,6 +84,12 @@ class HessianAssembly {
   };
   std::vector<int> run_begin_;        // term t's runs are runs_[run_begin_[t], run_begin_[t+1])
   std::vector<Run> runs_;
+  // The same runs for StoreHessian, grouped per term into four loops without branches:
+  // first-reached runs of 3, other runs of 3, first-reached others, other others
+  // (store_begin_[4 t + k] .. store_begin_[4 t + k + 1]). A slot appears once per term,
+  // so the order of the runs within a term does not change any sum.
+  std::vector<int> store_begin_;
+  std::vector<Run> store_runs_;
   std::vector<char> touches_controls_;
   SparseMatrix pattern_;
   int bandwidth_ = 0;

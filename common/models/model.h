@@ -65,6 +65,13 @@ class Model {
   virtual void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const = 0;
   // E_uu, NumControls() x NumControls().
   virtual void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const = 0;
+  // E_u, E_xu and E_uu at one state, the same values as the three above; a model may
+  // fuse their passes over the terms that touch the controls (the tracker's force and K).
+  virtual void ControlDerivatives(const Vec& x, const Vec& u, Vec* eu, Mat* exu, Mat* euu) const {
+    ControlGradient(x, u, eu);
+    MixedHessian(x, u, exu);
+    ControlHessian(x, u, euu);
+  }
   // A grasp that holds its orientation (GraspLayout::grip_rotation): the torque of the
   // model on the hand about the grasp point, world frame, -dE/dδ for a small world
   // rotation exp([δ]×) of the grasp (the rotation part of -E_u is that torque only while

@@ -331,6 +331,24 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
   }
 }
 
+void RodModel::GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
+  if (g->size() != nx_) g->resize(nx_);
+  g->setZero();
+  const SparseMatrix& pattern = assembly_.Pattern();
+  if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
+      !h->isCompressed()) {
+    *h = pattern;
+  }
+  double* values = h->valuePtr();
+  const GraspMap gm = Grasp(u, true);
+  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+    Local(t, x, gm, true, [&](const double* lg, const double* lh, int ld) {
+      assembly_.AddGradient(t, lg, g->data());
+      assembly_.StoreHessian(t, lh, ld, values);
+    });
+  }
+}
+
 void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
   if (eu->size() != 6) eu->resize(6);
   eu->setZero();

@@ -142,14 +142,12 @@ void EquilibriumTracker::ComputeForces() {
   const Model& m = *model_;
   // F = -E_u at the equilibrium (envelope theorem, §2.3.4); at a degenerate point this
   // is still the finite, continuous force of (2.16-2.17).
-  m.ControlGradient(x_, u_, &eu_);
+  m.ControlDerivatives(x_, u_, &eu_, &exu_, &euu_);
   result_.force = -eu_;
   result_.energy = result_.summary.energy;
   result_.probe = m.Probe(x_, u_);
 
   // K = dF/du = -(E_uu - E_ux E_xx^-1 E_xu) (implicit differentiation, (2.14-2.15)).
-  m.ControlHessian(x_, u_, &euu_);
-  m.MixedHessian(x_, u_, &exu_);
   result_.stiffness_regularized = false;
   if (result_.summary.status == EquilibriumStatus::kSnapping) {
     // Mid-snap (time budget): the state is an accepted, energy-decreasing one but no
