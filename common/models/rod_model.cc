@@ -360,11 +360,29 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
     *h = pattern;
   }
   double* values = h->valuePtr();
-  std::fill(values, values + pattern.nonZeros(), 0.0);
+  // StoreHessian: every slot is reached by some term, so no clearing pass.
   const GraspMaps gm = Grasp(u, true);
   for (int t = 0; t < assembly_.NumTerms(); ++t) {
     Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
-      assembly_.AddHessian(t, lh, ld, values);
+      assembly_.StoreHessian(t, lh, ld, values);
+    });
+  }
+}
+
+void RodModel::GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
+  if (g->size() != nx_) g->resize(nx_);
+  g->setZero();
+  const SparseMatrix& pattern = assembly_.Pattern();
+  if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
+      !h->isCompressed()) {
+    *h = pattern;
+  }
+  double* values = h->valuePtr();
+  const GraspMaps gm = Grasp(u, true);
+  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+    Local(t, x, gm, true, [&](const double* lg, const double* lh, int ld) {
+      assembly_.AddGradient(t, lg, g->data());
+      assembly_.StoreHessian(t, lh, ld, values);
     });
   }
 }

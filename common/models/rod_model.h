@@ -66,6 +66,8 @@ class RodModel final : public Model {
   void Gradient(const Vec& x, const Vec& u, Vec* g) const override;
   const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override;
+  // One pass over the terms for both (the same operations as the two, the same bits).
+  void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override;
   void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override;
   void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override;
   void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override;
