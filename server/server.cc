@@ -293,6 +293,8 @@ void Server::SolveLoop() {
     if (PollSceneLoad()) changed_session = true;
     if (taken.pose) SolveAndPublish(*taken.pose);
     now = SteadyClock::now();
+    if (changed_session) knot_watch_.Reset();
+    knot_watch_.Tick(now, session_->scene, *session_->tracker);
     if (now >= next_shape || changed_session) {
       PublishShape();
       next_shape += shape_period;
