@@ -394,6 +394,7 @@ void Server::PublishShape() {
   in.force_newtons = Eigen::Vector3d(last_force_n_[0], last_force_n_[1], last_force_n_[2]);
   in.status = last_status_;
   in.snaps = snaps_since_reset_;
+  in.knot = knot_watch_.name();
   in.seq = shape_seq_++;
   in.utime = transport::RealtimeMicros();
   thread_shape_t msg = BuildShape(in);
@@ -427,6 +428,8 @@ void Server::PublishStatus() {
   in.snaps = snaps_.load();
   in.dropped_poses = dropped_poses_.load();
   in.rejected_messages = rejected_messages_.load();
+  in.knot = knot_watch_.name();
+  in.knot_determinant = knot_watch_.determinant();
   in.seq = status_seq_++;
   in.utime = transport::RealtimeMicros();
   solver_status_t msg = BuildSolverStatus(in);

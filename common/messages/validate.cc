@@ -29,6 +29,27 @@ bool QuaternionNorm(const device_state_t& msg, std::string* why) {
   return true;
 }
 
+// Stand-in rows for the BRIEF4 fields (main's lcmtypes commit replaces them on merge).
+bool FiniteRows(const std::vector<std::vector<double>>& rows, int32_t num, size_t width,
+                const char* name, std::string* why) {
+  if (rows.size() != static_cast<size_t>(num)) return Fail(why, std::string(name) + " count");
+  for (const auto& row : rows) {
+    if (row.size() != width) return Fail(why, std::string(name) + " row width");
+    for (double v : row)
+      if (!std::isfinite(v)) return Fail(why, std::string(name) + " not finite");
+  }
+  return true;
+}
+bool ShapeFrames(const thread_shape_t& m, std::string* why) {
+  return FiniteRows(m.frames, m.num_frames, 4, "frames", why);
+}
+bool ShapeGrasps(const thread_shape_t& m, std::string* why) {
+  return FiniteRows(m.grasps, m.num_grasps, 6, "grasps", why);
+}
+bool ShapeContacts(const thread_shape_t& m, std::string* why) {
+  return FiniteRows(m.contacts, m.num_contacts, 6, "contacts", why);
+}
+
 bool ShapePositions(const thread_shape_t& msg, std::string* why) {
   if (msg.positions.size() != static_cast<size_t>(msg.num_nodes)) {
     return Fail(why, "positions has " + std::to_string(msg.positions.size()) +
@@ -100,6 +121,14 @@ const Field<S> kThreadShape[] = {
     Member<&S::force_newtons>("force_newtons"),
     Member<&S::status>("status", F::STATUS_REGULAR, F::STATUS_SNAPPING),
     Member<&S::snaps>("snaps"),
+    Count<&S::num_frames>("num_frames", 0, kMaxShapeNodes),
+    CountedRows<S>("frames", 4, &ShapeFrames),
+    Member<&S::grasp_names>("grasp_names"),
+    Count<&S::num_grasps>("num_grasps", 0, 64),
+    CountedRows<S>("grasps", 6, &ShapeGrasps),
+    Count<&S::num_contacts>("num_contacts", 0, kMaxShapeNodes),
+    CountedRows<S>("contacts", 6, &ShapeContacts),
+    Member<&S::knot>("knot"),
     Member<&S::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&S::auth_seq>("auth_seq"),
     Member<&S::mac>("mac"),
@@ -123,6 +152,10 @@ const Field<V> kSolverStatus[] = {
     Member<&V::snaps>("snaps"),
     Member<&V::dropped_poses>("dropped_poses"),
     Member<&V::rejected_messages>("rejected_messages"),
+    Member<&V::knot>("knot"),
+    Member<&V::knot_determinant>("knot_determinant"),
+    Member<&V::contacts>("contacts"),
+    Member<&V::max_update_hz>("max_update_hz"),
     Member<&V::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&V::auth_seq>("auth_seq"),
     Member<&V::mac>("mac"),
