@@ -44,6 +44,10 @@ inline thread_shape_t SampleShape(int nodes) {
           .positions = std::move(positions), .grasp = {1.0 * nodes, 0.0, 0.0},
           .grip_direction = {1.0, 0.0, 0.0}, .force = {0.0, 2.0, 0.0},
           .force_newtons = {0.0, 0.2, 0.0}, .status = force_model_t::STATUS_SNAPPED, .snaps = 3,
+          // Stand-in fields (main's lcmtypes commit brings its own samples).
+          .num_frames = 0, .frames = {}, .grasp_names = "", .num_grasps = 1,
+          .grasps = {{1.0 * nodes, 0.0, 0.0, 0.0, 2.0, 0.0}}, .num_contacts = 1,
+          .contacts = {{0.0, 0.0, 0.1, 1.0, 0.5, -0.1}}, .knot = "trefoil",
           .epoch = 0, .auth_seq = 0, .mac = {}};
 }
 
@@ -54,7 +58,8 @@ inline solver_status_t Sample(const solver_status_t*) {
           .residual = 1e-11, .lambda_min = -0.25, .negative_pivots = 1,
           .status = force_model_t::STATUS_REGULAR, .update_rate_hz = 950.0,
           .solve_us_p50 = 40.0, .solve_us_p99 = 120.0, .updates = 1000, .snaps = 2,
-          .dropped_poses = 5, .rejected_messages = 1, .epoch = 0, .auth_seq = 0, .mac = {}};
+          .dropped_poses = 5, .rejected_messages = 1, .knot = "trefoil", .knot_determinant = 3,
+          .contacts = 1, .max_update_hz = 0.0, .epoch = 0, .auth_seq = 0, .mac = {}};
 }
 
 inline device_status_t Sample(const device_status_t*) {
