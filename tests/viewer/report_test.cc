@@ -274,7 +274,9 @@ TEST(ReportTest, DamagedMiddleIsSkippedAndTheRestStillRead) {
   {
     std::fstream f(log, std::ios::in | std::ios::out | std::ios::binary);
     f.seekp(std::streamoff(size / 2));
-    const std::string junk(300, '\xAB');
+    // Longer than any one event (a force model with its 6x6 wrench block is ~0.8 kB), so
+    // the damage reaches an event header wherever it lands.
+    const std::string junk(2000, '\xAB');
     f.write(junk.data(), std::streamsize(junk.size()));
   }
   std::string summary;
