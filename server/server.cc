@@ -298,6 +298,8 @@ void Server::SolveLoop() {
     if (PollSceneLoad()) changed_session = true;
     if (!taken.poses.empty()) SolveAndPublish(taken.poses);
     now = SteadyClock::now();
+    if (changed_session) knot_watch_.Reset();
+    knot_watch_.Tick(now, session_->scene, *session_->tracker);
     if (now >= next_shape || changed_session) {
       PublishShape();
       next_shape += shape_period;
@@ -423,6 +425,7 @@ void Server::PublishShape() {
   in.force_newtons = Eigen::Vector3d(last_force_n_[0], last_force_n_[1], last_force_n_[2]);
   in.status = last_status_;
   in.snaps = snaps_since_reset_;
+  in.knot = knot_watch_.name();
   in.seq = shape_seq_++;
   in.utime = transport::RealtimeMicros();
   thread_shape_t msg = BuildShape(in);
@@ -456,6 +459,8 @@ void Server::PublishStatus() {
   in.snaps = snaps_.load();
   in.dropped_poses = dropped_poses_.load();
   in.rejected_messages = rejected_messages_.load();
+  in.knot = knot_watch_.name();
+  in.knot_determinant = knot_watch_.determinant();
   in.seq = status_seq_++;
   in.utime = transport::RealtimeMicros();
   solver_status_t msg = BuildSolverStatus(in);

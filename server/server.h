@@ -34,6 +34,7 @@
 
 #include "background_job.h"
 #include "checkpoint_writer.h"
+#include "knot_watch.h"
 #include "server_inbox.h"
 #include "server_params.h"
 #include "scene/scene.h"
@@ -205,6 +206,7 @@ class Server {
   std::unique_ptr<Session> session_;
   std::string method_override_;  // "" = the scene's method
   BackgroundJob<Session> load_;   // the LOAD_SCENE in progress, if any
+  KnotWatch knot_watch_;          // the shape's knot type, a few times a second
   std::string load_name_;         // its argument
   int64_t model_seq_ = 0, shape_seq_ = 0, status_seq_ = 0;
   int64_t snaps_since_reset_ = 0;

@@ -126,6 +126,7 @@ thread_shape_t BuildShape(const ShapeInputs& in) {
   msg.scene = in.scene;
   msg.status = in.status;
   msg.snaps = in.snaps;
+  msg.knot = in.knot;
   for (int i = 0; i < 3; ++i) {
     msg.grasp[i] = 0.0;
     msg.grip_direction[i] = 0.0;
@@ -182,6 +183,8 @@ solver_status_t BuildSolverStatus(const StatusInputs& in) {
   msg.snaps = in.snaps;
   msg.dropped_poses = in.dropped_poses;
   msg.rejected_messages = in.rejected_messages;
+  msg.knot = in.knot;
+  msg.knot_determinant = in.knot_determinant;
   return msg;
 }
 

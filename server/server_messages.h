@@ -63,6 +63,7 @@ struct ShapeInputs {
   Eigen::Vector3d force_newtons = Eigen::Vector3d::Zero();
   int8_t status = force_model_t::STATUS_REGULAR;
   int64_t snaps = 0;
+  std::string knot;      // the shape's knot type (KnotWatch), "" = not computed
   int64_t seq = 0;
   int64_t utime = 0;
 };
@@ -80,6 +81,8 @@ struct StatusInputs {
   int64_t snaps = 0;
   int64_t dropped_poses = 0;
   int64_t rejected_messages = 0;
+  std::string knot;              // KnotWatch: "" = not computed
+  int32_t knot_determinant = 0;  // 0 = not computed
   int64_t seq = 0;
   int64_t utime = 0;
 };

@@ -126,6 +126,11 @@ TEST(TopologyTest, OpenRopesClosedFarAway) {
       [](double t) { return Eigen::Vector3d(std::cos(t), std::sin(t), 0.05 * t); }, 0,
       40 * M_PI, 1000, true);
   EXPECT_EQ(IdentifyKnot(helix).name, "unknot");
+  // A flat spiral (curve2d's case): its inner end's way out crosses it in its own plane.
+  const Curve spiral = Sample(
+      [](double t) { return Eigen::Vector3d((1 + t) * std::cos(t), (1 + t) * std::sin(t), 0); },
+      0, 6 * M_PI, 300, true);
+  EXPECT_EQ(IdentifyKnot(spiral).name, "unknot");
   // Unsimplified, the projections have too many crossings for the polynomial; the
   // determinant is still exact.
   KnotOptions raw;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 namespace snapthread::topology {
@@ -44,8 +45,24 @@ std::vector<Eigen::Vector3d> CloseFarAway(std::span<const Eigen::Vector3d> nodes
   for (const auto& p : nodes) radius = std::max(radius, (p - centroid).norm());
   if (radius <= 0.0) return out;
   const double r = 3.0 * radius;
-  const Eigen::Vector3d d_end = EndDirection(nodes[n - 1], nodes[n - 2], centroid, radius);
-  const Eigen::Vector3d d_start = EndDirection(nodes[0], nodes[1], centroid, radius);
+  Eigen::Vector3d d_end = EndDirection(nodes[n - 1], nodes[n - 2], centroid, radius);
+  Eigen::Vector3d d_start = EndDirection(nodes[0], nodes[1], centroid, radius);
+  // A planar curve (curve2d, or a thread lying flat): the radial way out of an inner end
+  // would cut the curve in its own plane, where no crossing has an over and an under. Both
+  // ends leave at 45 degrees to one side of the plane instead, over everything.
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& p : nodes) scatter += (p - centroid) * (p - centroid).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
+  if (eig.eigenvalues()[0] <= 1e-20 * radius * radius * static_cast<double>(n)) {
+    const Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    auto tilt = [&](const Eigen::Vector3d& d) -> Eigen::Vector3d {
+      const Eigen::Vector3d in_plane = d - d.dot(normal) * normal;
+      if (in_plane.norm() < 1e-9) return normal;
+      return (in_plane.normalized() + normal).normalized();
+    };
+    d_end = tilt(d_end);
+    d_start = tilt(d_start);
+  }
   out.push_back(centroid + r * d_end);
   if (d_end.dot(d_start) < -0.999) {
     // Nearly antipodal: go through a point a quarter turn away from both.

@@ -1,6 +1,7 @@
 #include "topology/simplify.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
@@ -20,6 +21,22 @@ struct Box {
 
 Box BoxOf(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return {a.cwiseMin(b), a.cwiseMax(b)};
+}
+
+// Do coplanar segments pq and rs (plane normal n) meet, within tol?
+bool SegmentsMeetInPlane(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
+                         const Eigen::Vector3d& r, const Eigen::Vector3d& s,
+                         const Eigen::Vector3d& n, double tol) {
+  // Signed areas in the plane: each segment's ends on opposite sides of the other's line.
+  auto side = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& x) {
+    return d.cross(x - o).dot(n);
+  };
+  const Eigen::Vector3d pq = q - p, rs = s - r;
+  const double slack_pq = tol * pq.norm(), slack_rs = tol * rs.norm();
+  const double r_side = side(p, pq, r), s_side = side(p, pq, s);
+  const double p_side = side(r, rs, p), q_side = side(r, rs, q);
+  return !((r_side > slack_pq && s_side > slack_pq) || (r_side < -slack_pq && s_side < -slack_pq) ||
+           (p_side > slack_rs && q_side > slack_rs) || (p_side < -slack_rs && q_side < -slack_rs));
 }
 
 // Does segment pq meet triangle abc (grazing within tol counts)? Möller–Trumbore.
@@ -45,9 +62,12 @@ bool SegmentMeetsTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
     return u >= -slack && w >= -slack && u + w <= 1.0 + slack;
   };
   if (std::abs(dp - dq) <= tol) {
-    // Lying in the plane: conservative, blocked if any sampled point is inside.
-    for (double f : {0.0, 0.25, 0.5, 0.75, 1.0})
-      if (inside(p + f * dir)) return true;
+    // Lying in the plane: blocked if an end is inside or the segment meets an edge.
+    if (inside(p) || inside(q)) return true;
+    const std::array<const Eigen::Vector3d*, 3> v = {&a, &b, &c};
+    for (int k = 0; k < 3; ++k) {
+      if (SegmentsMeetInPlane(p, q, *v[k], *v[(k + 1) % 3], n, tol)) return true;
+    }
     return false;
   }
   const double t = std::clamp(dp / (dp - dq), 0.0, 1.0);

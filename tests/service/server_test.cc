@@ -339,6 +339,13 @@ TEST_F(ServerTest, ThreadGripDirectionFromOrientation) {
     for (int a = 0; a < 3; ++a) EXPECT_NEAR(m.torque0[a], tau[a], 1e-9 * (1.0 + tau.norm()));
   }
   EXPECT_EQ(server_->Stats().snaps, direct_snaps);
+  // The knot type (server/knot_watch.h) reaches the status and the shape: a bent thread
+  // with free ends, closed far away, is the unknot.
+  EXPECT_TRUE(probe_->WaitStatus(0, [](const solver_status_t& st) {
+    return st.knot == "unknot" && st.knot_determinant == 1;
+  }));
+  EXPECT_TRUE(probe_->WaitShape(0, [](const thread_shape_t& sh) { return sh.knot == "unknot"; },
+                                nullptr));
   EXPECT_EQ(probe_->invalid(), 0);
 }
 
