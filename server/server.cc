@@ -21,6 +21,7 @@
 #include "tracking/make_tracker.h"
 #include "realtime/clock.h"
 #include "messages/lcm_url.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "solvers/registry.h"
 
@@ -143,8 +144,8 @@ void Server::SetInfo(const std::string& scene, const std::string& method,
 void Server::Start() {
   if (started_) return;
   started_ = true;
-  state_sub_ = lcm_->subscribe(channels_.device_state, &Server::HandleDeviceState, this);
-  command_sub_ = lcm_->subscribe(channels_.command, &Server::HandleCommand, this);
+  state_sub_ = messages::Subscribe<&Server::HandleDeviceState>(lcm_, channels_.device_state, this);
+  command_sub_ = messages::Subscribe<&Server::HandleCommand>(lcm_, channels_.command, this);
   running_ = true;
   solve_thread_ = std::thread([this] { SolveLoop(); });
   receive_thread_ = std::thread([this] { ReceiveLoop(); });

@@ -26,6 +26,7 @@
 #include "models/models.h"
 #include "scene/scene.h"
 #include "tracking/tracker.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
@@ -47,9 +48,9 @@ using test_support::SourceDir;
 class Probe {
  public:
   Probe(lcm::LCM* lcm, const transport::Channels& ch) : lcm_(lcm) {
-    subs_.push_back(lcm->subscribe(ch.force_model, &Probe::OnModel, this));
-    subs_.push_back(lcm->subscribe(ch.shape, &Probe::OnShape, this));
-    subs_.push_back(lcm->subscribe(ch.solver_status, &Probe::OnStatus, this));
+    subs_.push_back(messages::Subscribe<&Probe::OnModel>(lcm, ch.force_model, this));
+    subs_.push_back(messages::Subscribe<&Probe::OnShape>(lcm, ch.shape, this));
+    subs_.push_back(messages::Subscribe<&Probe::OnStatus>(lcm, ch.solver_status, this));
   }
   ~Probe() {
     for (auto* s : subs_) lcm_->unsubscribe(s);

@@ -24,6 +24,14 @@ std::string SourceDir() { return EnvOr("SNAPTHREAD_SOURCE_DIR", SNAPTHREAD_TEST_
 std::string BinDir() { return EnvOr("SNAPTHREAD_BIN_DIR", SNAPTHREAD_TEST_BIN_DIR); }
 std::string ScenePath(const std::string& file) { return SourceDir() + "/scenes/" + file; }
 
+double SpeedScale() {
+  const char* v = std::getenv("SNAPTHREAD_SPEED_SCALE");
+  if (v == nullptr || *v == '\0') return 1.0;
+  char* end = nullptr;
+  const double scale = std::strtod(v, &end);
+  return (end != v && *end == '\0' && scale >= 1.0 && scale <= 100.0) ? scale : 1.0;
+}
+
 std::string UniqueSession(const std::string& prefix) {
   static std::atomic<int> counter{0};
   std::random_device rd;

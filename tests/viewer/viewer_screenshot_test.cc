@@ -24,6 +24,7 @@
 #include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
 #include "messages/channels.h"
+#include "messages/subscribe.h"
 #include "spline.h"
 #include "png_image.h"
 #include "test_support.h"
@@ -489,7 +490,7 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
 class PoseCollector {
  public:
   explicit PoseCollector(const std::string& session) {
-    lcm_.subscribe(transport::Channels(session).device_state, &PoseCollector::On, this);
+    messages::Subscribe<&PoseCollector::On>(lcm_, transport::Channels(session).device_state, this);
     thread_ = std::thread([this] {
       while (running_) lcm_.handleTimeout(20);
     });
