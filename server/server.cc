@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -116,6 +117,7 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
   session->scene.solver = options;
   // The one scene -> tracker path (SceneError for invalid parameters or options).
   session->tracker = MakeTracker(session->scene);
+  if (params_.snap_ahead) session->fold = std::make_unique<FoldBoundary>(session->scene);
   if (scene.grasp_layout.NumControls() != session->tracker->model().NumControls()) {
     throw SceneError(scene.file + ": the scene's grasp layout has " +
                      std::to_string(scene.grasp_layout.NumControls()) + " controls, model " +
@@ -282,9 +284,26 @@ void Server::SolveLoop() {
   auto next_status = now;
   auto next_checkpoint = checkpoint_writer_ ? now : SteadyClock::time_point::max();
   last_status_time_ = now;
+  // --max-update-hz / solver.max_update_hz: the newest pose waits here for its slot.
+  std::optional<PoseSample> held;
+  auto next_solve = now;
   while (true) {
-    ServerInbox::Taken taken = inbox_.Wait(std::min({next_shape, next_status, next_checkpoint}));
+    const double cap_hz = params_.max_update_hz > 0.0 ? params_.max_update_hz : session_->scene.max_update_hz;
+    const auto wake = std::min({next_shape, next_status, next_checkpoint,
+                                held ? next_solve : SteadyClock::time_point::max()});
+    ServerInbox::Taken taken = inbox_.Wait(wake);
     if (taken.stop) break;
+    if (taken.pose) {
+      if (held) dropped_poses_.fetch_add(1);  // superseded while it waited for its slot
+      held = std::move(taken.pose);
+      taken.pose.reset();
+    }
+    if (held && (cap_hz <= 0.0 || SteadyClock::now() >= next_solve)) {
+      taken.pose = std::move(held);
+      held.reset();
+      const auto t = SteadyClock::now();  // keep the phase unless the slot passed long ago
+      if (cap_hz > 0.0) next_solve = (t - next_solve < Period(cap_hz) ? next_solve : t) + Period(cap_hz);
+    }
     bool changed_session = false;
     for (const command_t& command : taken.commands) {
       ApplyCommand(command);
@@ -326,6 +345,10 @@ void Server::SolveAndPublish(const PoseSample& pose) {
   const TrackResult* result = nullptr;
   const auto t0 = SteadyClock::now();
   try {
+    // The device felt the post-snap model of the current fold: start on the new branch.
+    Vec x_after, u_after;
+    if (session_->fold && session_->fold->TakeSwitch(pose.state.snap_fold_id, &x_after, &u_after))
+      tracker.Resume(x_after, u_after);
     result = &tracker.Update(u);
   } catch (const std::exception& e) {
     if (ShouldLog(&last_solve_error_log_us_)) {
@@ -334,6 +357,7 @@ void Server::SolveAndPublish(const PoseSample& pose) {
   }
   const double solve_us = std::chrono::duration<double, std::micro>(SteadyClock::now() - t0).count();
   if (hooks_.after_update && result != nullptr) hooks_.after_update(u, tracker);
+  if (session_->fold && result != nullptr) session_->fold->AfterUpdate(tracker, u);
 
   ForceModelInputs in;
   in.mapping = &scene.device;
@@ -356,6 +380,7 @@ void Server::SolveAndPublish(const PoseSample& pose) {
                                            nullptr, in.device_seq, in.device_utime,
                                            in.server_receive_utime, 0.0, in.seq, in.utime});
   }
+  if (session_->fold) session_->fold->Fill(&msg);
   // Statistics before the message leaves: whoever receives the model sees them counted.
   last_status_ = msg.status;
   for (int i = 0; i < 3; ++i) last_force_n_[i] = msg.f0[i];
@@ -425,6 +450,7 @@ void Server::PublishStatus() {
   in.snaps = snaps_.load();
   in.dropped_poses = dropped_poses_.load();
   in.rejected_messages = rejected_messages_.load();
+  in.max_update_hz = params_.max_update_hz > 0.0 ? params_.max_update_hz : session_->scene.max_update_hz;
   in.seq = status_seq_++;
   in.utime = transport::RealtimeMicros();
   solver_status_t msg = BuildSolverStatus(in);

@@ -180,6 +180,7 @@ solver_status_t BuildSolverStatus(const StatusInputs& in) {
   msg.snaps = in.snaps;
   msg.dropped_poses = in.dropped_poses;
   msg.rejected_messages = in.rejected_messages;
+  msg.max_update_hz = Finite(in.max_update_hz) ? in.max_update_hz : 0.0;
   return msg;
 }
 

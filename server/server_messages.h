@@ -75,6 +75,7 @@ struct StatusInputs {
   int64_t snaps = 0;
   int64_t dropped_poses = 0;
   int64_t rejected_messages = 0;
+  double max_update_hz = 0.0;  // the update cap in force (0 = none)
   int64_t seq = 0;
   int64_t utime = 0;
 };

@@ -29,6 +29,19 @@ bool QuaternionNorm(const device_state_t& msg, std::string* why) {
   return true;
 }
 
+// Snap-ahead (issue 17): a fold's normal is a unit vector (the device's side test
+// n.(p - point) assumes it), its id positive; a message without a fold carries none.
+bool FoldNormal(const force_model_t& msg, std::string* why) {
+  if (msg.has_fold == 0) return true;
+  if (msg.fold_id <= 0) return Fail(why, "fold_id must be > 0 when has_fold is 1");
+  double n2 = 0.0;
+  for (double v : msg.fold_normal) n2 += v * v;
+  if (std::abs(std::sqrt(n2) - 1.0) > 1e-6) {
+    return Fail(why, "fold_normal norm " + std::to_string(std::sqrt(n2)) + " is not 1");
+  }
+  return true;
+}
+
 bool ShapePositions(const thread_shape_t& msg, std::string* why) {
   if (msg.positions.size() != static_cast<size_t>(msg.num_nodes)) {
     return Fail(why, "positions has " + std::to_string(msg.positions.size()) +
@@ -63,6 +76,8 @@ const Field<D> kDeviceState[] = {
     Member<&D::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&D::auth_seq>("auth_seq"),
     Member<&D::mac>("mac"),
+    Member<&D::grasp>("grasp"),
+    Member<&D::snap_fold_id>("snap_fold_id"),
 };
 
 using F = force_model_t;
@@ -84,6 +99,18 @@ const Field<F> kForceModel[] = {
     Member<&F::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&F::auth_seq>("auth_seq"),
     Member<&F::mac>("mac"),
+    Member<&F::has_wrench>("has_wrench", 0, 1),
+    Member<&F::q0>("q0"),
+    Member<&F::K6>("K6"),
+    Member<&F::grasp>("grasp"),
+    With(Member<&F::has_fold>("has_fold", 0, 1), &FoldNormal),  // snap-ahead (issue 17)
+    Member<&F::fold_id>("fold_id"),
+    Member<&F::fold_point>("fold_point"),
+    Member<&F::fold_normal>("fold_normal"),
+    Member<&F::fold_curvature>("fold_curvature"),
+    Member<&F::post_u0>("post_u0"),
+    Member<&F::post_f0>("post_f0"),
+    Member<&F::post_K>("post_K"),
 };
 
 using S = thread_shape_t;
@@ -126,6 +153,10 @@ const Field<V> kSolverStatus[] = {
     Member<&V::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&V::auth_seq>("auth_seq"),
     Member<&V::mac>("mac"),
+    Member<&V::knot>("knot"),
+    Member<&V::knot_determinant>("knot_determinant"),
+    Member<&V::contacts>("contacts"),
+    Member<&V::max_update_hz>("max_update_hz"),
 };
 
 using T = device_status_t;
@@ -152,6 +183,8 @@ const Field<T> kDeviceStatus[] = {
     Member<&T::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&T::auth_seq>("auth_seq"),
     Member<&T::mac>("mac"),
+    Member<&T::grasp>("grasp"),
+    Member<&T::snap_ahead_switches>("snap_ahead_switches"),
 };
 
 using C = command_t;
