@@ -73,11 +73,11 @@ const Field<D> kDeviceState[] = {
     Member<&D::position>("position"),
     With(Member<&D::orientation>("orientation"), &QuaternionNorm),
     Member<&D::buttons>("buttons"),
+    Member<&D::grasp>("grasp"),
+    Member<&D::snap_fold_id>("snap_fold_id"),
     Member<&D::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&D::auth_seq>("auth_seq"),
     Member<&D::mac>("mac"),
-    Member<&D::grasp>("grasp"),
-    Member<&D::snap_fold_id>("snap_fold_id"),
 };
 
 using F = force_model_t;
@@ -96,9 +96,6 @@ const Field<F> kForceModel[] = {
     Member<&F::torque0>("torque0"),
     Member<&F::iterations>("iterations", 0, kInt32Max),
     Member<&F::residual>("residual"),
-    Member<&F::epoch>("epoch"),  // authentication (docs/security.md)
-    Member<&F::auth_seq>("auth_seq"),
-    Member<&F::mac>("mac"),
     Member<&F::has_wrench>("has_wrench", 0, 1),
     Member<&F::q0>("q0"),
     Member<&F::K6>("K6"),
@@ -111,6 +108,9 @@ const Field<F> kForceModel[] = {
     Member<&F::post_u0>("post_u0"),
     Member<&F::post_f0>("post_f0"),
     Member<&F::post_K>("post_K"),
+    Member<&F::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&F::auth_seq>("auth_seq"),
+    Member<&F::mac>("mac"),
 };
 
 using S = thread_shape_t;
@@ -150,13 +150,13 @@ const Field<V> kSolverStatus[] = {
     Member<&V::snaps>("snaps"),
     Member<&V::dropped_poses>("dropped_poses"),
     Member<&V::rejected_messages>("rejected_messages"),
-    Member<&V::epoch>("epoch"),  // authentication (docs/security.md)
-    Member<&V::auth_seq>("auth_seq"),
-    Member<&V::mac>("mac"),
     Member<&V::knot>("knot"),
     Member<&V::knot_determinant>("knot_determinant"),
     Member<&V::contacts>("contacts"),
     Member<&V::max_update_hz>("max_update_hz"),
+    Member<&V::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&V::auth_seq>("auth_seq"),
+    Member<&V::mac>("mac"),
 };
 
 using T = device_status_t;
@@ -180,11 +180,11 @@ const Field<T> kDeviceStatus[] = {
     Member<&T::slew_limits>("slew_limits"),
     Member<&T::fades>("fades"),
     Member<&T::snaps_felt>("snaps_felt"),
+    Member<&T::grasp>("grasp"),
+    Member<&T::snap_ahead_switches>("snap_ahead_switches"),
     Member<&T::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&T::auth_seq>("auth_seq"),
     Member<&T::mac>("mac"),
-    Member<&T::grasp>("grasp"),
-    Member<&T::snap_ahead_switches>("snap_ahead_switches"),
 };
 
 using C = command_t;
