@@ -15,6 +15,9 @@ packages=(
   clang libclang-rt-14-dev
   libceres-dev liblapack-dev
   iproute2 procps
+  # snapthread-web: Boost.Beast (header-only) for its HTTP/WebSocket server, and Debian's
+  # Chromium for its browser tests (driven by playwright-core from the page's npm install).
+  libboost-dev chromium
 )
 
 missing=()
@@ -32,6 +35,22 @@ else
 fi
 
 "$here/deploy/multicast-route.sh" || true
+
+# snapthread-web's page is bundled at build time: the build runs `npm ci` from
+# web/page/package-lock.json (three.js, uPlot, esbuild, playwright-core) with Node.js >= 20.
+# The machine's Node.js is used; Debian's (nodejs + npm) only when there is none.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  echo "setup: installing Debian's nodejs and npm (snapthread-web's page needs Node.js >= 20)"
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends nodejs npm
+fi
+node_major=$(node -p 'process.versions.node.split(".")[0]')
+if [ "$node_major" -lt 20 ]; then
+  echo "setup: Node.js $(node --version) is older than 20; snapthread-web's page and browser tests need >= 20" >&2
+  echo "setup: install a newer Node.js, or configure with -DSNAPTHREAD_BUILD_WEB=OFF" >&2
+  exit 1
+fi
 
 if [ "${1:-}" != "--no-build" ]; then
   cmake -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release

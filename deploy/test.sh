@@ -16,8 +16,9 @@ if [ "${1:-}" != "--quick" ]; then
   echo "test: sanitizer build (ASan + UBSan) in build-asan/"
   # -Werror stays on the Release build: GCC 12 reports false maybe-uninitialized warnings
   # in libstdc++ under the sanitizers.
+  # snapthread-web is left out: its tests are browser tests (process), not run here.
   cmake -S "$here" -B "$here/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSNAPTHREAD_SANITIZE=ON \
-    -DSNAPTHREAD_WERROR=OFF >/dev/null
+    -DSNAPTHREAD_WERROR=OFF -DSNAPTHREAD_BUILD_WEB=OFF >/dev/null
   cmake --build "$here/build-asan" -j"$(nproc)"
   cd "$here/build-asan"
   # Under the sanitizers: the unit and report tests (models, linear algebra, solvers,
@@ -41,7 +42,7 @@ if [ "${1:-}" != "--quick" ]; then
   echo "test: libFuzzer smoke runs (clang) in build-fuzz/"
   cmake -S "$here" -B "$here/build-fuzz" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSNAPTHREAD_FUZZ=ON -DSNAPTHREAD_WERROR=OFF \
-    -DSNAPTHREAD_BUILD_TESTS=OFF >/dev/null
+    -DSNAPTHREAD_BUILD_TESTS=OFF -DSNAPTHREAD_BUILD_WEB=OFF >/dev/null
   cmake --build "$here/build-fuzz" -j"$(nproc)" --target scene_fuzzer message_fuzzer
   seeds=$(mktemp -d)
   trap 'rm -rf "$seeds"' EXIT

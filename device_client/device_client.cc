@@ -62,6 +62,8 @@ DeviceClient::DeviceClient(HapticDevice* device, DeviceTransport* transport,
       loop_(&tick_, config_.loop) {
   state_msg_.device_id = config_.device_id;
   if (config_.snap_ahead) tick_.SetSnapAhead(&snap_ahead_);
+  state_msg_.grasp = config_.grasp;
+  receiver_.SetGrasp(config_.grasp);
   start_us_ = Now();
   last_status_us_ = last_log_us_ = start_us_;
 }
@@ -216,6 +218,7 @@ device_status_t DeviceClient::BuildStatus(int64_t now_us, double tick_rate_hz, i
   st.utime = now_us;
   st.seq = seq;
   st.device_id = config_.device_id;
+  st.grasp = config_.grasp;
   st.tick_rate_hz = tick_rate_hz;
   const auto lat = lateness_window_.Compute();
   st.lateness_us_p50 = lat.p50;

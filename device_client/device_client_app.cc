@@ -97,6 +97,7 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
       ->capture_default_str();
   app.add_option("--scene", o->scene_file, "scene YAML (device mapping, limits, grasp path)")
       ->check(CLI::ExistingFile);
+  app.add_option("--grasp", o->grasp, "the scene grasp this device holds (a scene with grasps:; default: the first)");
   app.add_option("--path-csv", o->path_csv, "scripted path CSV x,y[,z] in metres (instead of the scene's)")
       ->check(CLI::ExistingFile);
   app.add_option("--session", o->session, "session name, [A-Za-z0-9_]+")->capture_default_str();
@@ -198,13 +199,26 @@ int RunDeviceClient(const DeviceClientOptions& o) {
       return kExitBadArguments;
     }
   }
+  int grasp = 0;
+  if (!o.grasp.empty()) {
+    grasp = scene ? FindGrasp(*scene, o.grasp) : -1;
+    if (grasp < 0) {
+      std::string names;
+      if (scene)
+        for (const SceneGrasp& g : scene->grasps) names += (names.empty() ? "" : ", ") + g.name;
+      std::fprintf(stderr, "snapthread-device: --grasp: %s\n",
+                   scene ? ("no grasp '" + o.grasp + "' in the scene (its grasps: " + (names.empty() ? "one, unnamed" : names) + ")").c_str()
+                         : "needs --scene (the scene names the grasps)");
+      return kExitBadArguments;
+    }
+  }
   BackendConfig config;
   config.name = o.backend;
   try {
     if (!o.path_csv.empty()) {
       config.path = ScriptedPath::FromCsv(o.path_csv, o.speed_m_per_s);
     } else if (scene && BackendNeedsPath(o.backend)) {
-      config.path = ScriptedPath::FromScene(*scene, o.speed_m_per_s);
+      config.path = ScriptedPath::FromScene(*scene, o.speed_m_per_s, grasp);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "snapthread-device: %s: %s\n",
@@ -234,7 +248,8 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   }
   const DeviceCapabilities caps = device->capabilities();
   DeviceClientConfig cc;
-  cc.limits = LimitsFrom(caps, scene ? &scene->device : nullptr);
+  const DeviceMapping mapping = scene ? GraspDeviceMapping(*scene, grasp) : DeviceMapping{};
+  cc.limits = LimitsFrom(caps, scene ? &mapping : nullptr);
   cc.limits.model_timeout_s = 1e-3 * o.model_timeout_ms;
   cc.limits.fade_time_s = 1e-3 * o.fade_ms;
   cc.limits.tick_period_s = 1.0 / o.rate_hz;
@@ -250,6 +265,9 @@ int RunDeviceClient(const DeviceClientOptions& o) {
                  config.path->max_radius_m(), limits.workspace_radius_m);
   }
   cc.device_id = o.backend == caps.model_name ? o.backend : o.backend + ":" + caps.model_name;
+  // Each hand is its own sender (the server keeps one sequence filter per device id).
+  if (scene && !scene->grasps.empty()) cc.grasp = scene->grasps[grasp].name;
+  if (!cc.grasp.empty()) cc.device_id += "@" + cc.grasp;
   cc.device_has_orientation = caps.has_orientation;
   cc.tick.publish_divisor = o.publish_divisor;
   cc.tick.trace_divisor = o.trace_divisor;

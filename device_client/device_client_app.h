@@ -10,6 +10,7 @@ namespace snapthread::device {
 struct DeviceClientOptions {
   std::string backend = "virtual-hand";  // sim-path | virtual-hand | phantom | delta
   std::string scene_file;                // scene YAML: DeviceMapping + grasp path
+  std::string grasp;                     // scene grasp to hold (--grasp); "" = the first
   std::string path_csv;                  // alternative scripted path, metres
   std::string session = "SNAPTHREAD";
   std::string lcm_url;                   // empty: LCM_DEFAULT_URL or the udpm default

@@ -147,7 +147,10 @@ class Server {
   void ReceiveLoop();
   void SolveLoop();
   // Solve thread.
-  void SolveAndPublish(const PoseSample& pose);
+  void SolveAndPublish(const std::vector<PoseSample>& poses);
+  // The force model of one grasp for the pose that moved it (its block of F and K).
+  void PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, const TrackResult* result,
+                         double solve_us, bool first);
   void ApplyCommand(const command_t& command);
   // LOAD_SCENE off the solve thread (commands.cc): starts the loader; the solve loop polls
   // it and swaps the session in when it is ready (true when the session changed or a

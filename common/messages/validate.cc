@@ -17,44 +17,62 @@ bool Fail(std::string* why, const std::string& text) {
 
 // ---- rules of their own --------------------------------------------------------------------
 
-bool QuaternionNorm(const device_state_t& msg, std::string* why) {
+bool UnitQuaternion(const double (&q)[4], const char* name, std::string* why) {
   double n2 = 0.0;
-  for (double q : msg.orientation) n2 += q * q;
+  for (double v : q) n2 += v * v;
   const double n = std::sqrt(n2);
   if (n < kMinQuaternionNorm || n > kMaxQuaternionNorm) {
-    return Fail(why, "orientation quaternion norm " + std::to_string(n) + " outside [" +
-                         std::to_string(kMinQuaternionNorm) + ", " +
+    return Fail(why, std::string(name) + " quaternion norm " + std::to_string(n) +
+                         " outside [" + std::to_string(kMinQuaternionNorm) + ", " +
                          std::to_string(kMaxQuaternionNorm) + "]");
   }
   return true;
 }
 
-// Snap-ahead (issue 17): a fold's normal is a unit vector (the device's side test
-// n.(p - point) assumes it), its id positive; a message without a fold carries none.
+bool QuaternionNorm(const device_state_t& msg, std::string* why) {
+  return UnitQuaternion(msg.orientation, "orientation", why);
+}
+
+// A force model's expansion orientation must be a quaternion when the wrench is used.
+bool WrenchOrientation(const force_model_t& msg, std::string* why) {
+  return msg.has_wrench == 0 || UnitQuaternion(msg.q0, "q0", why);
+}
+
+// A fold boundary's normal must be a unit vector when the fold is used.
 bool FoldNormal(const force_model_t& msg, std::string* why) {
   if (msg.has_fold == 0) return true;
-  if (msg.fold_id <= 0) return Fail(why, "fold_id must be > 0 when has_fold is 1");
   double n2 = 0.0;
   for (double v : msg.fold_normal) n2 += v * v;
-  if (std::abs(std::sqrt(n2) - 1.0) > 1e-6) {
-    return Fail(why, "fold_normal norm " + std::to_string(std::sqrt(n2)) + " is not 1");
+  if (std::abs(std::sqrt(n2) - 1.0) > 1e-3) {
+    return Fail(why, "fold_normal is not a unit vector (norm " + std::to_string(std::sqrt(n2)) + ")");
   }
   return true;
 }
 
-bool ShapePositions(const thread_shape_t& msg, std::string* why) {
-  if (msg.positions.size() != static_cast<size_t>(msg.num_nodes)) {
-    return Fail(why, "positions has " + std::to_string(msg.positions.size()) +
-                         " rows, num_nodes says " + std::to_string(msg.num_nodes));
+// Rows of a variable array: as many as its count says, `per_row` finite values each.
+template <auto Rows, auto Count, int PerRow>
+bool CountedRowsAgree(const thread_shape_t& msg, std::string* why) {
+  const auto& rows = msg.*Rows;
+  const std::string name = Rows == &thread_shape_t::positions ? "positions"
+                           : Rows == &thread_shape_t::frames  ? "frames"
+                           : Rows == &thread_shape_t::grasps  ? "grasps"
+                                                              : "contacts";
+  const std::string count = Count == &thread_shape_t::num_nodes    ? "num_nodes"
+                            : Count == &thread_shape_t::num_frames ? "num_frames"
+                            : Count == &thread_shape_t::num_grasps ? "num_grasps"
+                                                                   : "num_contacts";
+  if (rows.size() != static_cast<size_t>(msg.*Count)) {
+    return Fail(why, name + " has " + std::to_string(rows.size()) + " rows, " + count + " says " +
+                         std::to_string(msg.*Count));
   }
-  for (size_t i = 0; i < msg.positions.size(); ++i) {
-    const auto& row = msg.positions[i];
-    if (row.size() != 3) {
-      return Fail(why, "positions row " + std::to_string(i) + " has " +
-                           std::to_string(row.size()) + " entries, expected 3");
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto& row = rows[i];
+    if (row.size() != static_cast<size_t>(PerRow)) {
+      return Fail(why, name + " row " + std::to_string(i) + " has " + std::to_string(row.size()) +
+                           " entries, expected " + std::to_string(PerRow));
     }
     for (double v : row) {
-      if (!std::isfinite(v)) return Fail(why, "positions row " + std::to_string(i) + " is not finite");
+      if (!std::isfinite(v)) return Fail(why, name + " row " + std::to_string(i) + " is not finite");
     }
   }
   return true;
@@ -97,13 +115,13 @@ const Field<F> kForceModel[] = {
     Member<&F::iterations>("iterations", 0, kInt32Max),
     Member<&F::residual>("residual"),
     Member<&F::has_wrench>("has_wrench", 0, 1),
-    Member<&F::q0>("q0"),
+    With(Member<&F::q0>("q0"), &WrenchOrientation),
     Member<&F::K6>("K6"),
     Member<&F::grasp>("grasp"),
-    With(Member<&F::has_fold>("has_fold", 0, 1), &FoldNormal),  // snap-ahead (issue 17)
+    Member<&F::has_fold>("has_fold", 0, 1),
     Member<&F::fold_id>("fold_id"),
     Member<&F::fold_point>("fold_point"),
-    Member<&F::fold_normal>("fold_normal"),
+    With(Member<&F::fold_normal>("fold_normal"), &FoldNormal),
     Member<&F::fold_curvature>("fold_curvature"),
     Member<&F::post_u0>("post_u0"),
     Member<&F::post_f0>("post_f0"),
@@ -120,13 +138,21 @@ const Field<S> kThreadShape[] = {
     Member<&S::scene>("scene"),
     Member<&S::model>("model"),
     Count<&S::num_nodes>("num_nodes", 0, kMaxShapeNodes),
-    CountedRows<S>("positions", 3, &ShapePositions),
+    CountedRows<S>("positions", 3, &CountedRowsAgree<&S::positions, &S::num_nodes, 3>),
     Member<&S::grasp>("grasp"),
     Member<&S::grip_direction>("grip_direction"),
     Member<&S::force>("force"),
     Member<&S::force_newtons>("force_newtons"),
     Member<&S::status>("status", F::STATUS_REGULAR, F::STATUS_SNAPPING),
     Member<&S::snaps>("snaps"),
+    Count<&S::num_frames>("num_frames", 0, kMaxShapeNodes),
+    CountedRows<S>("frames", 4, &CountedRowsAgree<&S::frames, &S::num_frames, 4>),
+    Member<&S::grasp_names>("grasp_names"),
+    Count<&S::num_grasps>("num_grasps", 0, kMaxGrasps),
+    CountedRows<S>("grasps", 6, &CountedRowsAgree<&S::grasps, &S::num_grasps, 6>),
+    Count<&S::num_contacts>("num_contacts", 0, kMaxShapeNodes),
+    CountedRows<S>("contacts", 6, &CountedRowsAgree<&S::contacts, &S::num_contacts, 6>),
+    Member<&S::knot>("knot"),
     Member<&S::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&S::auth_seq>("auth_seq"),
     Member<&S::mac>("mac"),
@@ -151,8 +177,8 @@ const Field<V> kSolverStatus[] = {
     Member<&V::dropped_poses>("dropped_poses"),
     Member<&V::rejected_messages>("rejected_messages"),
     Member<&V::knot>("knot"),
-    Member<&V::knot_determinant>("knot_determinant"),
-    Member<&V::contacts>("contacts"),
+    Member<&V::knot_determinant>("knot_determinant", 0, kInt32Max),
+    Member<&V::contacts>("contacts", 0, kInt32Max),
     Member<&V::max_update_hz>("max_update_hz"),
     Member<&V::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&V::auth_seq>("auth_seq"),

@@ -25,6 +25,8 @@ inline constexpr int kMaxShapeNodes = 100000;
 // is a corrupted message, not a rounding error.
 inline constexpr double kMinQuaternionNorm = 0.5;
 inline constexpr double kMaxQuaternionNorm = 2.0;
+// Most grasps a scene may name (thread_shape_t.grasps rows).
+inline constexpr int kMaxGrasps = 16;
 
 // Each returns true when the message is usable; otherwise false with the reason in
 // *why (if why is non-null). Never throws. The rules are the message's field table

@@ -40,16 +40,26 @@ class ChainModel : public Model {
   const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
 
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
-    const SparseMatrix& pattern = assembly_.Pattern();
-    const int nx = NumStates();
-    if (h->rows() != nx || h->cols() != nx || h->nonZeros() != pattern.nonZeros() || !h->isCompressed()) {
-      *h = pattern;
-    }
-    double* values = h->valuePtr();
-    std::fill(values, values + pattern.nonZeros(), 0.0);
+    double* values = HessianValues(h);
+    // StoreHessian: every slot is reached by some term, so no clearing pass.
     for (int t = 0; t < assembly_.NumTerms(); ++t) {
       Self().Local(t, x, u, /*want_h=*/true, [&](const double*, const double* lh, int ld) {
-        assembly_.AddHessian(t, lh, ld, values);
+        assembly_.StoreHessian(t, lh, ld, values);
+      });
+    }
+  }
+
+  // One pass over the terms for both: each term's local derivatives are computed once
+  // (Gradient() alone costs a third of Hessian()). The same operations as the two
+  // separate passes, so the same bits.
+  void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override {
+    if (g->size() != NumStates()) g->resize(NumStates());
+    g->setZero();
+    double* values = HessianValues(h);
+    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+      Self().Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int ld) {
+        assembly_.AddGradient(t, lg, g->data());
+        assembly_.StoreHessian(t, lh, ld, values);
       });
     }
   }
@@ -82,6 +92,24 @@ class ChainModel : public Model {
     euu->setZero();
     for (int t : control_terms_) {
       Self().Local(t, x, u, true, [&](const double*, const double* lh, int ld) {
+        assembly_.AddControlHessian(t, lh, ld, euu);
+      });
+    }
+  }
+
+  // One pass over the control terms for all three (the same operations, the same bits).
+  void ControlDerivatives(const Vec& x, const Vec& u, Vec* eu, Mat* exu, Mat* euu) const override {
+    const int nx = NumStates(), nu = NumControls();
+    if (eu->size() != nu) eu->resize(nu);
+    if (exu->rows() != nx || exu->cols() != nu) exu->resize(nx, nu);
+    if (euu->rows() != nu || euu->cols() != nu) euu->resize(nu, nu);
+    eu->setZero();
+    exu->setZero();
+    euu->setZero();
+    for (int t : control_terms_) {
+      Self().Local(t, x, u, true, [&](const double* lg, const double* lh, int ld) {
+        assembly_.AddControlGradient(t, lg, eu->data());
+        assembly_.AddMixedHessian(t, lh, ld, exu);
         assembly_.AddControlHessian(t, lh, ld, euu);
       });
     }
@@ -137,6 +165,15 @@ class ChainModel : public Model {
 
  private:
   const Derived& Self() const { return static_cast<const Derived&>(*this); }
+  // h with the pattern's structure (set on first use); its values to be stored.
+  double* HessianValues(SparseMatrix* h) const {
+    const SparseMatrix& pattern = assembly_.Pattern();
+    const int nx = NumStates();
+    if (h->rows() != nx || h->cols() != nx || h->nonZeros() != pattern.nonZeros() || !h->isCompressed()) {
+      *h = pattern;
+    }
+    return h->valuePtr();
+  }
 
   std::vector<int> control_terms_;
 };

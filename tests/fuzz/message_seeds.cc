@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "messages/validate.h"
+#include "sample_messages.h"
 
 namespace {
 
@@ -35,32 +36,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string dir = argv[1];
-  device_state_t ds{};
-  ds.utime = 1000;
-  ds.seq = 7;
-  ds.device_id = "sim-path";
-  ds.position[0] = 0.01;
-  ds.orientation[0] = 1.0;
-  force_model_t fm{};
-  fm.seq = 3;
-  fm.device_seq = 7;
-  fm.f0[1] = 0.5;
-  for (int i = 0; i < 3; ++i) fm.K[i][i] = -100.0;
-  thread_shape_t sh{};
-  sh.scene = "curve2d_snap";
-  sh.model = "curve2d";
-  sh.num_nodes = 3;
-  sh.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0.5, 0}};
-  solver_status_t st{};
-  st.scene = "curve2d_snap";
-  st.method = "higher-order";
-  device_status_t dst{};
-  dst.device_id = "sim-path";
-  command_t cmd{};
-  cmd.command = command_t::SET_METHOD;
-  cmd.argument = "newton-ls";
-  const bool ok = Write(dir, 0, "device_state", ds) && Write(dir, 1, "force_model", fm) &&
-                  Write(dir, 2, "thread_shape", sh) && Write(dir, 3, "solver_status", st) &&
-                  Write(dir, 4, "device_status", dst) && Write(dir, 5, "command", cmd);
+  // The samples fill every field (tests/support/sample_messages.h), so the fuzzer starts
+  // from messages that reach every row of every field table.
+  using snapthread::test_support::Sample;
+  const bool ok = Write(dir, 0, "device_state", Sample<device_state_t>()) &&
+                  Write(dir, 1, "force_model", Sample<force_model_t>()) &&
+                  Write(dir, 2, "thread_shape", Sample<thread_shape_t>()) &&
+                  Write(dir, 3, "solver_status", Sample<solver_status_t>()) &&
+                  Write(dir, 4, "device_status", Sample<device_status_t>()) &&
+                  Write(dir, 5, "command", Sample<command_t>());
   return ok ? 0 : 1;
 }

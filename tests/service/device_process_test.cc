@@ -218,7 +218,7 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   // kernel, not the device).
   auto Pace = [] { std::this_thread::sleep_for(std::chrono::milliseconds(3)); };
   for (int i = 0; i < 40; ++i) {  // random garbage, some with the right type hash
-    std::vector<uint8_t> buf(1 + (i * 37) % 400);
+    std::vector<uint8_t> buf(1 + (i * 37) % 1000);
     for (auto& b : buf) b = static_cast<uint8_t>(byte(rng));
     if (i % 2 == 0 && buf.size() >= 8) {
       force_model_t ref{};

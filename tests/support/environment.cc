@@ -38,6 +38,25 @@ std::string ReadFile(const std::string& path) {
   return s.str();
 }
 
+std::map<std::string, double> ReadJsonNumbers(const std::string& path) {
+  std::map<std::string, double> out;
+  const std::string text = ReadFile(path);
+  size_t pos = 0;
+  while ((pos = text.find('"', pos)) != std::string::npos) {
+    const size_t end = text.find('"', pos + 1);
+    if (end == std::string::npos) break;
+    const std::string key = text.substr(pos + 1, end - pos - 1);
+    size_t colon = text.find_first_not_of(" \t", end + 1);
+    pos = end + 1;
+    if (colon == std::string::npos || text[colon] != ':') continue;
+    const char* start = text.c_str() + colon + 1;
+    char* stop = nullptr;
+    const double v = std::strtod(start, &stop);
+    if (stop != start) out[key] = v;
+  }
+  return out;
+}
+
 bool WaitUntil(const std::function<bool()>& condition, double timeout_s, double poll_s) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (std::chrono::steady_clock::now() < deadline) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 
 namespace snapthread::test_support {
@@ -21,6 +22,8 @@ std::string UniqueSession(const std::string& prefix);
 
 // The whole file ("" when it cannot be read).
 std::string ReadFile(const std::string& path);
+// The numbers of a flat JSON object ({"key": number, ...}) in a file, e.g. a --summary.
+std::map<std::string, double> ReadJsonNumbers(const std::string& path);
 
 // Polls `condition` every poll_s until it holds (true) or timeout_s has passed (false;
 // the condition is asked once more at the deadline).

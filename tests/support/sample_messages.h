@@ -23,7 +23,8 @@ namespace snapthread::test_support {
 inline device_state_t Sample(const device_state_t*) {
   return {.utime = 123456789, .seq = 42, .device_id = "virtual-hand",
           .position = {0.01, -0.02, 0.03}, .orientation = {1.0, 0.0, 0.0, 0.0}, .buttons = 1,
-          .grasp = "", .snap_fold_id = 3, .epoch = 0, .auth_seq = 0, .mac = {}};
+          .grasp = "", .snap_fold_id = 3,
+          .epoch = 0, .auth_seq = 0, .mac = {}};
 }
 
 inline force_model_t Sample(const force_model_t*) {
@@ -33,11 +34,12 @@ inline force_model_t Sample(const force_model_t*) {
           .f0 = {-0.5, -1.0, -1.5}, .K = {{-300.0, 10.0, 20.0}, {10.0, -300.0, 30.0},
                                           {20.0, 30.0, -300.0}},
           .has_torque = 1, .torque0 = {0.0, 0.001, 0.002}, .iterations = 3, .residual = 1e-9,
-          .has_wrench = 0, .q0 = {1.0, 0.0, 0.0, 0.0},
-          .K6 = {}, .grasp = "", .has_fold = 1, .fold_id = 5, .fold_point = {0.0, 0.01, 0.0},
-          .fold_normal = {0.0, 1.0, 0.0}, .fold_curvature = 2.0, .post_u0 = {0.0, 0.01, 0.0},
-          .post_f0 = {0.5, 1.0, 0.0}, .post_K = {{-200.0, 0.0, 0.0}, {0.0, -200.0, 0.0},
-                                                 {0.0, 0.0, -400.0}},
+          .has_wrench = 1, .q0 = {1.0, 0.0, 0.0, 0.0},
+          .K6 = {{-300.0, 0, 0, 0, 0, 0}, {0, -300.0, 0, 0, 0, 0}, {0, 0, -300.0, 0, 0, 0},
+                 {0, 0, 0, -0.5, 0, 0}, {0, 0, 0, 0, -0.5, 0}, {0, 0, 0, 0, 0, -0.5}},
+          .grasp = "", .has_fold = 1, .fold_id = 5, .fold_point = {0.02, 0.0, 0.0},
+          .fold_normal = {1.0, 0.0, 0.0}, .fold_curvature = 0.5, .post_u0 = {0.02, 0.0, 0.0},
+          .post_f0 = {0.5, 0.0, 0.0}, .post_K = {{-100.0, 0, 0}, {0, -100.0, 0}, {0, 0, -100.0}},
           .epoch = 0, .auth_seq = 0, .mac = {}};
 }
 
@@ -49,6 +51,10 @@ inline thread_shape_t SampleShape(int nodes) {
           .positions = std::move(positions), .grasp = {1.0 * nodes, 0.0, 0.0},
           .grip_direction = {1.0, 0.0, 0.0}, .force = {0.0, 2.0, 0.0},
           .force_newtons = {0.0, 0.2, 0.0}, .status = force_model_t::STATUS_SNAPPED, .snaps = 3,
+          .num_frames = 1,
+          .frames = {{0.0, 1.0, 0.0, 0.25}}, .grasp_names = "left,right", .num_grasps = 2,
+          .grasps = {{0.0, 0.0, 0.0, -1.0, 0.0, 0.0}, {1.0 * nodes, 0.0, 0.0, 1.0, 0.0, 0.0}},
+          .num_contacts = 1, .contacts = {{1.0, 0.5, 0.0, 1.0, 0.5, 0.1}}, .knot = "unknot",
           .epoch = 0, .auth_seq = 0, .mac = {}};
 }
 
@@ -59,8 +65,9 @@ inline solver_status_t Sample(const solver_status_t*) {
           .residual = 1e-11, .lambda_min = -0.25, .negative_pivots = 1,
           .status = force_model_t::STATUS_REGULAR, .update_rate_hz = 950.0,
           .solve_us_p50 = 40.0, .solve_us_p99 = 120.0, .updates = 1000, .snaps = 2,
-          .dropped_poses = 5, .rejected_messages = 1, .knot = "", .knot_determinant = 0,
-          .contacts = 0, .max_update_hz = 100.0, .epoch = 0, .auth_seq = 0, .mac = {}};
+          .dropped_poses = 5, .rejected_messages = 1, .knot = "trefoil",
+          .knot_determinant = 3, .contacts = 2, .max_update_hz = 100.0,
+          .epoch = 0, .auth_seq = 0, .mac = {}};
 }
 
 inline device_status_t Sample(const device_status_t*) {
@@ -69,8 +76,9 @@ inline device_status_t Sample(const device_status_t*) {
           .model_age_ms = 1.5, .round_trip_us_p50 = 400, .round_trip_us_p99 = 1200,
           .force_norm_n = 0.7, .ticks = 10000, .models_received = 9000, .models_rejected = 1,
           .force_clamps = 2, .stiffness_clamps = 3, .slew_limits = 4, .fades = 5,
-          .snaps_felt = 6, .grasp = "", .snap_ahead_switches = 2, .epoch = 0, .auth_seq = 0,
-          .mac = {}};
+          .snaps_felt = 6, .grasp = "",
+          .snap_ahead_switches = 1,
+          .epoch = 0, .auth_seq = 0, .mac = {}};
 }
 
 inline command_t Sample(const command_t*) {

@@ -259,7 +259,8 @@ TEST(ReportTest, DamagedMiddleIsSkippedAndTheRestStillRead) {
   {
     std::fstream f(log, std::ios::in | std::ios::out | std::ios::binary);
     f.seekp(std::streamoff(size / 2));
-    const std::string junk(300, '\xAB');
+    // Longer than any one event, so it always hits an event header.
+    const std::string junk(2000, '\xAB');
     f.write(junk.data(), std::streamsize(junk.size()));
   }
   std::string summary;

@@ -22,6 +22,7 @@ EXTERNAL = {
     "PkgConfig::sodium": "libsodium",
     "glfw": "OpenGL (glfw, epoxy)",
     "PkgConfig::EPOXY": "OpenGL (glfw, epoxy)",
+    "Boost::headers": "Boost.Beast (asio)",
 }
 # Which external library or room a target must never reach (DESIGN.md, "Layout").
 FORBIDDEN = [
@@ -35,6 +36,11 @@ FORBIDDEN = [
     ("messages", {"solvers", "linalg", "tracking", "CHOLMOD"}),
     ("snapthread-device", {"solvers", "linalg", "tracking", "CHOLMOD"}),
     ("device_client", {"solvers", "linalg", "tracking", "CHOLMOD"}),
+    # Knot identification is geometry only: no physics, no messages.
+    ("topology", {"models", "solvers", "linalg", "tracking", "scene", "messages", "LCM"}),
+    # The browser bridge only observes: it never solves.
+    ("snapthread-web", {"solvers", "linalg", "tracking", "CHOLMOD"}),
+    ("web_core", {"solvers", "linalg", "tracking", "CHOLMOD", "Boost.Beast (asio)"}),
 ]
 
 

@@ -1,0 +1,66 @@
+// snapthread-web's LCM side against real LCM traffic: only what the session key signed
+// reaches the pages (the viewer's checks: MAC, the epoch of a signed status, fresh sequence).
+#include <mutex>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include "auth/message_mac.h"
+#include "auth/session_epoch.h"
+#include "environment.h"
+#include "live_feed.h"
+#include "messages/channels.h"
+#include "sample_messages.h"
+
+namespace snapthread::web {
+namespace {
+
+// Over udpm loopback (a unique session): the feed takes the key's signed messages in the
+// epoch of the signed status, and refuses an unsigned shape and one of another key.
+TEST(LiveFeed, PassesOnlyMessagesSignedWithTheSessionKey) {
+  const auth::SessionKey key = auth::SessionKey::Generate();
+  const auth::SessionKey other = auth::SessionKey::Generate();
+  const std::string session = test_support::UniqueSession("WEBFEED");
+  const transport::Channels channels(session);
+  std::mutex mutex;
+  std::string last_shape;
+  LiveFeed feed(test_support::kLoopbackLcmUrl, session, key, [&](FeedKind k, Text t) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (k == FeedKind::kShape) last_shape = *t;
+  });
+  feed.Start();
+  lcm::LCM lcm(test_support::kLoopbackLcmUrl);
+  ASSERT_TRUE(lcm.good());
+  const int64_t epoch = auth::NewEpoch();
+  auth::AuthSequence seq;
+  auto publish = [&](const std::string& channel, auto msg, const auth::SessionKey* with) {
+    if (with != nullptr) {
+      ASSERT_TRUE(auth::Sign(&msg, channel, epoch, seq.Next(), *with));
+    }
+    lcm.publish(channel, &msg);
+  };
+  // Until the status taught the epoch, even a signed shape is refused.
+  publish(channels.shape, test_support::SampleShape(4), &key);
+  ASSERT_TRUE(test_support::WaitUntil([&] { return feed.counts().auth_rejected == 1; }, 5.0));
+  publish(channels.solver_status, test_support::Sample<solver_status_t>(), &key);
+  ASSERT_TRUE(test_support::WaitUntil([&] { return feed.counts().epoch == epoch; }, 5.0));
+  publish(channels.shape, test_support::SampleShape(4), &key);
+  publish(channels.force_model, test_support::Sample<force_model_t>(), &key);
+  publish(channels.device_status, test_support::Sample<device_status_t>(), &key);
+  publish(channels.shape, test_support::SampleShape(5), nullptr);
+  publish(channels.shape, test_support::SampleShape(6), &other);
+  ASSERT_TRUE(test_support::WaitUntil([&] { return feed.counts().auth_rejected == 3; }, 5.0));
+  ASSERT_TRUE(test_support::WaitUntil([&] { return feed.counts().received[3] == 1; }, 5.0));
+  const FeedCounts c = feed.counts();
+  EXPECT_EQ(c.received[Index(FeedKind::kShape)], 1);
+  EXPECT_EQ(c.received[Index(FeedKind::kForceModel)], 1);
+  EXPECT_EQ(c.received[Index(FeedKind::kSolverStatus)], 1);
+  EXPECT_EQ(c.malformed, 0);
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_NE(last_shape.find(R"("positions":[0,0,0,1,0.5,0,2,1,0,3,1.5,0])"), std::string::npos)
+      << "the 4-node signed shape, not the refused 5- or 6-node ones: " << last_shape;
+}
+
+}  // namespace
+}  // namespace snapthread::web

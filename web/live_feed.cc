@@ -1,0 +1,139 @@
+#include "live_feed.h"
+
+#include <chrono>
+#include <cstdio>
+#include <stdexcept>
+
+#include "auth/message_gate.h"
+#include "message_json.h"
+#include "messages/channels.h"
+#include "messages/lcm_url.h"
+#include "messages/validate.h"
+#include "snapthread/device_status_t.hpp"
+#include "snapthread/force_model_t.hpp"
+#include "snapthread/solver_status_t.hpp"
+#include "snapthread/thread_shape_t.hpp"
+
+namespace snapthread::web {
+namespace {
+
+// Devices tracked separately; more are refused (a flood of invented ids stays bounded).
+constexpr size_t kMaxDevices = 16;
+
+std::string ToJson(const thread_shape_t& m) { return ShapeJson(m, DrawsSmooth(m.model)); }
+std::string ToJson(const force_model_t& m) { return ForceModelJson(m); }
+std::string ToJson(const solver_status_t& m) { return SolverStatusJson(m); }
+std::string ToJson(const device_status_t& m) { return DeviceStatusJson(m); }
+
+FeedKind KindOf(const thread_shape_t&) { return FeedKind::kShape; }
+FeedKind KindOf(const force_model_t&) { return FeedKind::kForceModel; }
+FeedKind KindOf(const solver_status_t&) { return FeedKind::kSolverStatus; }
+FeedKind KindOf(const device_status_t&) { return FeedKind::kDeviceStatus; }
+
+int64_t NowUs() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+LiveFeed::LiveFeed(const std::string& lcm_url, const std::string& session,
+                   const auth::SessionKey& key, PublishFn publish)
+    : lcm_(lcm_url), key_(key), publish_(std::move(publish)) {
+  if (!lcm_.good()) {
+    throw std::runtime_error("cannot open LCM at " + lcm_url + ". " + transport::LcmStartHint(lcm_url));
+  }
+  const transport::Channels channels(session);
+  // Shapes come at ~60 Hz and force models at the update rate; LCM's default queue of 30
+  // would drop bursts while this thread is off the CPU, so give them seconds of room.
+  auto* shape = lcm_.subscribe(channels.shape, &LiveFeed::OnMessage<thread_shape_t>, this);
+  auto* model = lcm_.subscribe(channels.force_model, &LiveFeed::OnMessage<force_model_t>, this);
+  auto* solver = lcm_.subscribe(channels.solver_status, &LiveFeed::OnMessage<solver_status_t>, this);
+  auto* device = lcm_.subscribe(channels.device_status, &LiveFeed::OnMessage<device_status_t>, this);
+  if (shape) shape->setQueueCapacity(240);
+  if (model) model->setQueueCapacity(4000);
+  subscriptions_ = {shape, model, solver, device};
+}
+
+LiveFeed::~LiveFeed() {
+  Stop();
+  for (auto* s : subscriptions_) {
+    if (s != nullptr) lcm_.unsubscribe(s);
+  }
+}
+
+void LiveFeed::Start() {
+  if (running_.exchange(true)) return;
+  thread_ = std::thread(&LiveFeed::Loop, this);
+}
+
+void LiveFeed::Stop() {
+  running_ = false;
+  if (thread_.joinable()) thread_.join();
+}
+
+void LiveFeed::Loop() {
+  while (running_) {
+    if (lcm_.handleTimeout(50) < 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+template <class Msg>
+auth::FreshnessFilter* LiveFeed::FilterFor(const Msg& msg) {
+  if constexpr (std::is_same_v<Msg, solver_status_t>) {
+    return &status_filter_;
+  } else {
+    auth::FreshnessFilter* filter = nullptr;
+    if constexpr (std::is_same_v<Msg, thread_shape_t>) filter = &shape_filter_;
+    if constexpr (std::is_same_v<Msg, force_model_t>) filter = &model_filter_;
+    if constexpr (std::is_same_v<Msg, device_status_t>) {
+      auto it = device_filters_.find(msg.device_id);
+      if (it == device_filters_.end()) {
+        if (device_filters_.size() >= kMaxDevices) return nullptr;
+        it = device_filters_
+                 .emplace(msg.device_id, std::make_unique<auth::FreshnessFilter>(
+                                             "DEVICE_STATUS " + msg.device_id))
+                 .first;
+      }
+      filter = it->second.get();
+    }
+    // Everything but the solver status is taken in the epoch that status taught us.
+    if (filter->epoch() != status_filter_.epoch()) filter->SetEpoch(status_filter_.epoch());
+    return filter;
+  }
+}
+
+template <class Msg>
+void LiveFeed::OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  Msg msg;
+  std::string why;
+  if (!transport::DecodeAndValidate(rbuf, &msg, &why)) {
+    malformed_++;
+    return;
+  }
+  auth::FreshnessFilter* filter = FilterFor(msg);
+  if (filter == nullptr ||
+      auth::Admit(rbuf->data, rbuf->data_size, msg, channel, key_, filter) !=
+          auth::Reason::kAccepted) {
+    auth_rejected_++;
+    if (filter == nullptr) return;
+    std::string line;
+    if (filter->TakeLogLine(NowUs(), &line)) {
+      std::fprintf(stderr, "snapthread-web: refused %s\n", line.c_str());
+    }
+    return;
+  }
+  received_[Index(KindOf(msg))]++;
+  publish_(KindOf(msg), std::make_shared<const std::string>(ToJson(msg)));
+}
+
+FeedCounts LiveFeed::counts() const {
+  FeedCounts c;
+  for (int i = 0; i < 4; ++i) c.received[i] = received_[i].load();
+  c.malformed = malformed_.load();
+  c.auth_rejected = auth_rejected_.load();
+  c.epoch = status_filter_.epoch();
+  return c;
+}
+
+}  // namespace snapthread::web

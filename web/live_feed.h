@@ -1,0 +1,75 @@
+// The bridge's LCM side in live mode: subscribes to <SESSION>_SHAPE, _FORCE_MODEL,
+// _SOLVER_STATUS and _DEVICE_STATUS, vets every message as the viewer does
+// (transport::DecodeAndValidate, then auth::Admit with the session key: MAC, the server
+// epoch learned from an authenticated solver status, a strictly increasing auth_seq per
+// sender) and hands each accepted one, as JSON, to `publish`. Bad and refused messages
+// are dropped and counted; handlers never throw. LCM is handled on the feed's own thread.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "auth/freshness_filter.h"
+#include "auth/session_key.h"
+#include "feed_kind.h"
+#include "client_pacer.h"
+
+namespace snapthread::web {
+
+// Called on the feed's thread with each accepted message.
+using PublishFn = std::function<void(FeedKind, Text)>;
+
+struct FeedCounts {
+  std::array<int64_t, 4> received{};  // accepted, per session kind (FeedKind 0..3)
+  int64_t malformed = 0;              // failed DecodeAndValidate
+  int64_t auth_rejected = 0;          // bad MAC, foreign epoch, stale sequence
+  int64_t epoch = 0;                  // the server epoch learned (0: none yet)
+};
+
+class LiveFeed {
+ public:
+  // Opens LCM at `lcm_url` and subscribes; throws std::runtime_error when LCM cannot start
+  // or `session` is not a valid session name. `key` must outlive the feed.
+  LiveFeed(const std::string& lcm_url, const std::string& session, const auth::SessionKey& key,
+           PublishFn publish);
+  ~LiveFeed();
+  LiveFeed(const LiveFeed&) = delete;
+  LiveFeed& operator=(const LiveFeed&) = delete;
+
+  void Start();
+  void Stop();
+  FeedCounts counts() const;
+
+ private:
+  template <class Msg>
+  void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  template <class Msg>
+  auth::FreshnessFilter* FilterFor(const Msg& msg);
+  void Loop();
+
+  lcm::LCM lcm_;
+  const auth::SessionKey& key_;
+  PublishFn publish_;
+  std::vector<lcm::Subscription*> subscriptions_;
+  auth::FreshnessFilter status_filter_{"SOLVER_STATUS", auth::FreshnessFilter::EpochPolicy::kAdopt};
+  auth::FreshnessFilter shape_filter_{"SHAPE"};
+  auth::FreshnessFilter model_filter_{"FORCE_MODEL"};
+  // One sequence per device (each signs its statuses with its own auth_seq).
+  std::map<std::string, std::unique_ptr<auth::FreshnessFilter>> device_filters_;
+  std::thread thread_;
+  std::atomic<bool> running_{false};
+  std::array<std::atomic<int64_t>, 4> received_{};
+  std::atomic<int64_t> malformed_{0};
+  std::atomic<int64_t> auth_rejected_{0};  // refused by any filter, or a 17th device
+};
+
+}  // namespace snapthread::web

@@ -1,0 +1,45 @@
+// The WebSocket to the bridge: /ws on the page's own host, with the page's ?token= (the
+// bridge refuses the upgrade without it when it needs one), reconnecting after a drop.
+// Sends "ping <ms>" once a second; the bridge's "pong" gives the browser round trip.
+export class Connection {
+  constructor(onMessage, onState) {
+    this.onMessage = onMessage;
+    this.onState = onState;
+    this.roundTripMs = NaN;
+    this.open();
+    setInterval(() => this.send(`ping ${performance.now()}`), 1000);
+  }
+
+  url() {
+    const token = new URLSearchParams(location.search).get('token');
+    const scheme = location.protocol === 'https:' ? 'wss:' : 'ws:';
+    return `${scheme}//${location.host}/ws${token ? `?token=${encodeURIComponent(token)}` : ''}`;
+  }
+
+  open() {
+    this.ws = new WebSocket(this.url());
+    this.onState('connecting');
+    this.ws.onopen = () => this.onState('open');
+    this.ws.onclose = () => {
+      this.onState('closed');
+      setTimeout(() => this.open(), 1000);
+    };
+    this.ws.onmessage = (event) => {
+      let message;
+      try {
+        message = JSON.parse(event.data);
+      } catch {
+        return;
+      }
+      if (message.type === 'pong') {
+        this.roundTripMs = performance.now() - message.t;
+        return;
+      }
+      this.onMessage(message);
+    };
+  }
+
+  send(text) {
+    if (this.ws && this.ws.readyState === WebSocket.OPEN) this.ws.send(text);
+  }
+}

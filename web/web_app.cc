@@ -1,0 +1,119 @@
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <optional>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/address.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "auth/key_file.h"
+#include "http_server.h"
+#include "hub.h"
+#include "live_feed.h"
+#include "observer_token.h"
+#include "replay_feed.h"
+#include "web_options.h"
+
+namespace snapthread::web {
+namespace {
+
+namespace asio = boost::asio;
+
+// The once-a-second "bridge" counters, on the io thread.
+void ScheduleStats(asio::steady_timer* timer, Hub* hub) {
+  timer->expires_after(std::chrono::seconds(1));
+  timer->async_wait([timer, hub](const boost::system::error_code& ec) {
+    if (ec) return;
+    hub->PublishStats();
+    ScheduleStats(timer, hub);
+  });
+}
+
+}  // namespace
+
+int RunWeb(WebOptions o) {
+  asio::io_context io;
+  boost::system::error_code ec;
+  const asio::ip::address address = asio::ip::make_address(o.bind, ec);
+  if (ec) {
+    std::fprintf(stderr, "snapthread-web: --bind '%s' is not an IP address\n", o.bind.c_str());
+    return 1;
+  }
+  // Beyond loopback the page is for the observers holding the token only (observer_token.h).
+  if (!address.is_loopback() && o.token.empty()) o.token = GenerateObserverToken();
+
+  std::unique_ptr<LiveFeed> live;
+  std::unique_ptr<ReplayFeed> replay;
+  std::optional<auth::SessionKey> key;
+  std::shared_ptr<Hub> hub;
+  std::shared_ptr<const PageFiles> files;
+  try {
+    files = std::make_shared<const PageFiles>(o.page_dir);
+    if (!o.log_path.empty()) {
+      // Set below, once the hub exists: the feed publishes to it.
+      replay = std::make_unique<ReplayFeed>(o.log_path, o.session,
+                                            [&hub](FeedKind k, Text t) { hub->Publish(k, std::move(t)); });
+      hub = std::make_shared<Hub>(io, "replay", replay->session(), [&replay] { return replay->counts(); });
+      hub->SetCommandHandler([&replay](const std::string& c) { return replay->Command(c); });
+      const ReplayPosition p = replay->position();
+      std::printf("snapthread-web: replaying %s: session %s, %lld shapes over %.1f s (last seq %lld)\n",
+                  o.log_path.c_str(), replay->session().c_str(), static_cast<long long>(p.shape_count),
+                  p.duration_s, static_cast<long long>(p.last_seq));
+    } else {
+      key.emplace(auth::LoadKey(auth::ResolveKeyPath(o.key_path)));
+      hub = std::make_shared<Hub>(io, "live", o.session, [&live] { return live->counts(); });
+      live = std::make_unique<LiveFeed>(o.lcm_url, o.session, *key,
+                                        [&hub](FeedKind k, Text t) { hub->Publish(k, std::move(t)); });
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-web: %s\n", e.what());
+    return 1;
+  }
+
+  std::optional<HttpServer> server;
+  try {
+    server.emplace(io, asio::ip::tcp::endpoint(address, static_cast<unsigned short>(o.port)),
+                   ServeConfig{hub, files, o.token, o.max_rate_hz});
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-web: %s\n", e.what());
+    return 1;
+  }
+  const std::string host = address.is_v6() ? "[" + o.bind + "]" : o.bind;
+  std::printf("snapthread-web: serving %s of session %s at http://%s:%u/%s\n",
+              replay ? "a replay" : "the live view",
+              replay ? replay->session().c_str() : o.session.c_str(),
+              host.c_str(), server->port(), o.token.empty() ? "" : ("?token=" + o.token).c_str());
+  std::fflush(stdout);
+
+  asio::signal_set signals(io, SIGINT, SIGTERM);
+  asio::steady_timer stats(io);
+  asio::steady_timer deadline(io);
+  auto stop = [&] {
+    server->Stop();
+    io.stop();
+  };
+  signals.async_wait([&](const boost::system::error_code&, int) { stop(); });
+  if (o.duration_s > 0) {
+    deadline.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(o.duration_s)));
+    deadline.async_wait([&](const boost::system::error_code& e) {
+      if (!e) stop();
+    });
+  }
+  ScheduleStats(&stats, hub.get());
+  server->Start();
+  if (live) live->Start();
+  if (replay) replay->Start();
+  io.run();
+  // The feeds stop before the hub and the io_context go (they post to both).
+  if (live) live->Stop();
+  if (replay) replay->Stop();
+  std::printf("snapthread-web: stopped\n");
+  return 0;
+}
+
+}  // namespace snapthread::web
