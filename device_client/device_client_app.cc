@@ -72,6 +72,7 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
       "  \"models_received\": %llu,\n  \"models_rejected\": %llu,\n  \"invalid_models\": %llu,\n"
       "  \"poses_rejected\": %llu,\n  \"force_clamps\": %llu,\n  \"stiffness_clamps\": %llu,\n"
       "  \"slew_limits\": %llu,\n  \"fade_ticks\": %llu,\n  \"snaps_felt\": %llu,\n"
+      "  \"snap_ahead_switches\": %llu,\n"
       "  \"max_force_n\": %.6f,\n  \"final_force_n\": %.6f,\n  \"nonfinite_outputs\": %llu,\n  \"overruns\": %llu,\n"
       "  \"read_failures\": %llu,\n  \"pose_ring_drops\": %llu,\n  \"trace_ring_drops\": %llu,\n"
       "  \"invalid_poses_unpublished\": %llu,\n  \"realtime\": %s\n}\n",
@@ -79,7 +80,7 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
       s.lateness_us.p50, s.lateness_us.p99, s.lateness_us_max, s.round_trip_us.p50,
       s.round_trip_us.p99, u(s.models_received), u(s.models_rejected), u(s.invalid_models),
       u(s.poses_rejected), u(s.force_clamps), u(s.stiffness_clamps), u(s.slew_limits),
-      u(s.fade_ticks), u(s.snaps_felt), s.max_force_n, s.final_force_n, u(s.nonfinite_outputs), u(s.overruns),
+      u(s.fade_ticks), u(s.snaps_felt), u(s.snap_ahead_switches), s.max_force_n, s.final_force_n, u(s.nonfinite_outputs), u(s.overruns),
       u(s.read_failures), u(s.pose_ring_drops), u(s.trace_ring_drops),
       u(s.invalid_poses_unpublished), s.realtime ? "true" : "false");
   std::fclose(f);
@@ -119,6 +120,10 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
       ->capture_default_str();
   bool no_rt = false;
   app.add_flag("--no-rt", no_rt, "do not try SCHED_FIFO / mlockall");
+  bool no_snap_ahead = false;
+  app.add_flag("--no-snap-ahead", no_snap_ahead,
+               "render only the server's models: no switch to a post-snap model at a fold "
+               "boundary (docs/snap-ahead.md)");
   app.add_option("--log-level", o->log_level, "trace | debug | info | warn | error | off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}))
       ->capture_default_str();
@@ -137,6 +142,7 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
     return code == 0 ? kExitOk : kExitBadArguments;
   }
   o->realtime = !no_rt;
+  o->snap_ahead = !no_snap_ahead;
   if (!transport::IsValidSessionName(o->session)) {
     std::fprintf(stderr, "snapthread-device: --session '%s': expected [A-Za-z0-9_]+\n",
                  o->session.c_str());
@@ -270,6 +276,7 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   cc.trace_file = o.trace_file;
   cc.key = &*key;
   cc.session = o.session;
+  cc.snap_ahead = o.snap_ahead;
   spdlog::info("device: {} session {} on {}; limits |F| <= {} N, stiffness <= {} N/m, "
                "slew {} N/s, timeout {} ms, fade {} ms, workspace {} m",
                cc.device_id, o.session, url, limits.max_force_n, limits.max_stiffness_n_per_m,

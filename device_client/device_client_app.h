@@ -21,6 +21,7 @@ struct DeviceClientOptions {
   double fade_ms = 100.0;
   double speed_m_per_s = 0.02;           // scripted path speed
   bool realtime = true;                  // --no-rt turns off SCHED_FIFO / mlockall
+  bool snap_ahead = true;                // --no-snap-ahead: never switch at a fold boundary
   std::string log_level = "info";
   std::string trace_file;                // CSV, empty = none
   int trace_divisor = 1;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "scene_dir.h"
 #include "server_messages.h"
 #include "server_session.h"
+#include "update_cap.h"
 #include "tracking/make_tracker.h"
 #include "realtime/clock.h"
 #include "messages/lcm_url.h"
@@ -119,6 +121,9 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
   session->scene.solver = options;
   // The one scene -> tracker path (SceneError for invalid parameters or options).
   session->tracker = MakeTracker(session->scene);
+  // Snap-ahead's boundary is in the one grasp's position space (issue 17).
+  if (params_.snap_ahead && scene.grasps.size() <= 1)
+    session->fold = std::make_unique<FoldBoundary>(session->scene);
   // Every grasp takes the layout's controls (issue 15: several grasps concatenate theirs).
   const int grasp_controls =
       scene.grasp_layout.NumControls() * std::max<int>(1, static_cast<int>(scene.grasps.size()));
@@ -288,9 +293,13 @@ void Server::SolveLoop() {
   auto next_status = now;
   auto next_checkpoint = checkpoint_writer_ ? now : SteadyClock::time_point::max();
   last_status_time_ = now;
+  UpdateCap cap;  // --max-update-hz / solver.max_update_hz
   while (true) {
-    ServerInbox::Taken taken = inbox_.Wait(std::min({next_shape, next_status, next_checkpoint}));
+    const double cap_hz = params_.max_update_hz > 0.0 ? params_.max_update_hz : session_->scene.max_update_hz;
+    ServerInbox::Taken taken = inbox_.Wait(std::min({next_shape, next_status, next_checkpoint, cap.Wake()}));
     if (taken.stop) break;
+    dropped_poses_.fetch_add(cap.Hold(&taken.poses));
+    cap.Release(cap_hz, SteadyClock::now(), &taken.poses);
     bool changed_session = false;
     for (const command_t& command : taken.commands) {
       ApplyCommand(command);
@@ -339,6 +348,14 @@ void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
   const TrackResult* result = nullptr;
   const auto t0 = SteadyClock::now();
   try {
+    // The device felt the post-snap model of the current fold: start on the new branch.
+    Vec x_after, u_after;
+    for (const PoseSample& pose : poses) {
+      if (session_->fold && session_->fold->TakeSwitch(pose.state.snap_fold_id, &x_after, &u_after)) {
+        tracker.Resume(x_after, u_after);
+        break;
+      }
+    }
     result = &tracker.Update(u);
   } catch (const std::exception& e) {
     if (ShouldLog(&last_solve_error_log_us_)) {
@@ -347,6 +364,7 @@ void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
   }
   const double solve_us = std::chrono::duration<double, std::micro>(SteadyClock::now() - t0).count();
   if (hooks_.after_update && result != nullptr) hooks_.after_update(u, tracker);
+  if (session_->fold && result != nullptr) session_->fold->AfterUpdate(tracker, u);
 
   updates_.fetch_add(1);
   if (ClassifyStatus(result) == force_model_t::STATUS_SNAPPED) {
@@ -402,6 +420,7 @@ void Server::PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, 
                                            in.server_receive_utime, 0.0, in.seq, in.utime,
                                            in.grasp_offset, in.grasp_controls});
   }
+  if (session_->fold) session_->fold->Fill(&msg);
   msg.grasp = scene.grasps.empty() ? std::string() : scene.grasps[grasp].name;
   // Statistics of the update (counted by SolveAndPublish before any model leaves, so
   // whoever receives one sees them); the first grasp's model is the one reported.
@@ -462,6 +481,7 @@ void Server::PublishStatus() {
   in.rejected_messages = rejected_messages_.load();
   in.knot = knot_watch_.name();
   in.knot_determinant = knot_watch_.determinant();
+  in.max_update_hz = params_.max_update_hz > 0.0 ? params_.max_update_hz : session_->scene.max_update_hz;
   in.seq = status_seq_++;
   in.utime = transport::RealtimeMicros();
   solver_status_t msg = BuildSolverStatus(in);

@@ -185,6 +185,7 @@ solver_status_t BuildSolverStatus(const StatusInputs& in) {
   msg.rejected_messages = in.rejected_messages;
   msg.knot = in.knot;
   msg.knot_determinant = in.knot_determinant;
+  msg.max_update_hz = Finite(in.max_update_hz) ? in.max_update_hz : 0.0;
   return msg;
 }
 

@@ -83,6 +83,7 @@ struct StatusInputs {
   int64_t rejected_messages = 0;
   std::string knot;              // KnotWatch: "" = not computed
   int32_t knot_determinant = 0;  // 0 = not computed
+  double max_update_hz = 0.0;  // the update cap in force (0 = none)
   int64_t seq = 0;
   int64_t utime = 0;
 };

@@ -392,7 +392,12 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
   if (root["solver"]) {
     const YAML::Node s = root["solver"];
     rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "time_budget_us", "max_time_us",
-                               "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor"});
+                               "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor",
+                               "max_update_hz"});
+    sc.max_update_hz = rd.Number(s, "max_update_hz", "solver.max_update_hz", 0.0);
+    if (!(sc.max_update_hz >= 0.0 && sc.max_update_hz <= 100000.0))
+      throw SceneError(file_label + ": solver.max_update_hz: expected a rate in [0, 100000] Hz (0 = no cap), got " +
+                       std::to_string(sc.max_update_hz));
     if (s["method"]) {
       // A registered solver's name: checked where the solver is made (MakeSolver), since
       // a scene links no solver code (the device client reads scenes).

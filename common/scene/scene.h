@@ -52,6 +52,9 @@ struct Scene {
   // backends and the tests.
   std::vector<Vec> path;
   SolverOptions solver;
+  // solver.max_update_hz: the server's cap on equilibrium updates per second (issue 17;
+  // 0 = none). The server's --max-update-hz overrides it.
+  double max_update_hz = 0.0;
   DeviceMapping device;
   // Optional targets for "model no more than a scene needs".
   double target_force_error = 0.0;  // relative to the model's force scale; 0 = none
