@@ -25,6 +25,7 @@
 
 #include "allocation_counter.h"
 #include "models/models.h"
+#include "models/rod_model.h"
 
 namespace snapthread {
 namespace {
@@ -79,6 +80,24 @@ std::vector<Case> AllCases() {
     p.Set("natural_curvature_2", -0.3);
     cases.push_back({"rod_n" + std::to_string(n), p});
   }
+  // Self-contact (issue 15): capsules of radius 0.02 on edges of 0.1 with an activation
+  // gap of 0.04, at curled states where several pairs are active (ContactPoints).
+  for (const char* model : {"rod", "thread3d"}) {
+    ModelParams p;
+    p.model = model;
+    p.Set("n", 14);
+    if (p.model == "rod") {
+      p.Set("length", 1.4);
+      p.Set("twist_stiffness", 0.7);
+    } else {
+      p.Set("segment_length", 0.1);
+    }
+    p.Set("radius", 0.02);
+    p.Set("contact", true);
+    p.Set("contact_distance", 0.04);
+    p.Set("contact_stiffness", 0.5);
+    cases.push_back({std::string(model) + "_contact", p});
+  }
   return cases;
 }
 
@@ -88,11 +107,68 @@ struct Point {
   Vec u;
 };
 
+bool HasContact(const ModelParams& p) { return p.Has("contact") && p.Bool("contact"); }
+
+// States of a contact case: the free nodes on a curling random walk of edge-length steps
+// (each direction turned by up to ~70 degrees from the last) from the clamp, kept when
+// every pair that may touch is apart by more than 2r + d̂/10 and at least two pairs are
+// active, one of them with the grasped end when `with_grasp` (E_u, E_xu, E_uu).
+std::vector<Point> ContactPoints(const Model& m, const ModelParams& p, int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const bool rod = p.model == "rod";
+  const int n = p.Integer("n");
+  const double l = rod ? p.Number("length") / n : p.Number("segment_length");
+  const double r = p.Number("radius"), dhat = p.Number("contact_distance");
+  std::vector<Point> points;
+  for (int attempt = 0; attempt < 200000 && static_cast<int>(points.size()) < count; ++attempt) {
+    Eigen::Matrix3Xd nodes(3, n + 1);
+    nodes.col(0).setZero();
+    Eigen::Vector3d dir = Eigen::Vector3d::UnitX();
+    nodes.col(1) = l * dir;
+    for (int k = 2; k <= n; ++k) {
+      dir = (dir + 1.2 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng))).normalized();
+      nodes.col(k) = nodes.col(k - 1) + l * dir;
+    }
+    Point pt;
+    pt.u = Vec::Zero(m.NumControls());
+    if (rod) {
+      // The grasp holds the last edge: orientation φ with R(φ) e_x along it.
+      const Eigen::Vector3d e = (nodes.col(n) - nodes.col(n - 1)).normalized();
+      const Eigen::Vector3d axis = Eigen::Vector3d::UnitX().cross(e);
+      const double angle = std::atan2(axis.norm(), e.x());
+      pt.u.head<3>() = nodes.col(n);
+      if (axis.norm() > 1e-12) pt.u.tail<3>() = angle * axis.normalized();
+      pt.x = m.InitialState(pt.u);
+      const auto& rm = dynamic_cast<const RodModel&>(m);
+      for (int k = 2; k <= n - 2; ++k) pt.x.segment<3>(rm.NodeIndex(k)) = nodes.col(k);
+      for (int j = 1; j <= n - 2; ++j) pt.x[rm.ThetaIndex(j)] = 0.3 * unit(rng);
+    } else {
+      pt.u = nodes.col(n);
+      pt.x.resize(m.NumStates());
+      pt.x[0] = nodes(0, 1);
+      for (int k = 2; k <= n - 1; ++k) pt.x.segment<3>(1 + 3 * (k - 2)) = nodes.col(k);
+    }
+    const std::vector<contact::ContactPoint> active = m.ActiveContacts(pt.x, pt.u);
+    int with_grasp = 0;
+    bool apart = true;
+    for (const auto& c : active) {
+      apart = apart && c.distance > 2 * r + 0.1 * dhat;
+      with_grasp += c.segment_b >= (rod ? n - 2 : n - 1) ? 1 : 0;
+    }
+    const bool need_grasp = points.empty();
+    if (!apart || active.size() < 2 || (need_grasp && with_grasp == 0)) continue;
+    points.push_back(pt);
+  }
+  return points;
+}
+
 // Random states: for chains, controls near a compressed chord (|chord| = 0.8 n l, random
 // direction, out of plane too in 3D), a grip direction roughly along the chord with a
 // non-unit length, and the InitialState perturbed by ~0.1 l per coordinate.
 std::vector<Point> RandomPoints(const Model& model, const ModelParams& p, int count,
                                 unsigned seed) {
+  if (HasContact(p)) return ContactPoints(model, p, count, seed);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::vector<Point> points;
@@ -236,13 +312,18 @@ TEST_P(ModelDerivativeTest, SizesAndPatternAreConsistent) {
   // O(n) non-zeros for chains: at most 3 nodes per term, so a row couples at most 5
   // nodes' coordinates (the rod: at most its band, 2 x 10 + 1 entries a row).
   const long per_row = p.model == "rod" ? 2L * m.HessianBandwidth() + 1 : 5L * m.SpatialDimension();
-  EXPECT_LE(pattern.nonZeros(), per_row * m.NumStates());
+  // (With self-contact every pair that may touch is in the pattern: dense among them.)
+  if (!HasContact(p)) {
+    EXPECT_LE(pattern.nonZeros(), per_row * m.NumStates());
+  }
 }
 
 TEST_P(ModelDerivativeTest, DerivativesMatchFiniteDifferences) {
   const Model& m = *model_;
   const ModelParams& p = GetParam().params;
-  for (const Point& pt : RandomPoints(m, p, 4, 12345u)) {
+  const std::vector<Point> points = RandomPoints(m, p, 4, 12345u);
+  ASSERT_EQ(points.size(), 4u);
+  for (const Point& pt : points) {
     const Vec& x = pt.x;
     const Vec& u = pt.u;
     ASSERT_TRUE(std::isfinite(m.Energy(x, u)));
@@ -307,6 +388,12 @@ TEST_P(ModelDerivativeTest, PresizedOutputsAreReusedWithoutAllocation) {
     { Vec scratch(1000); scratch.setZero(); }
     sanity.Stop();
     ASSERT_GE(sanity.mallocs(), 1) << "malloc counter is not counting";
+  }
+  // Self-contact keeps broad-phase scratch that one warm-up call sizes.
+  if (HasContact(GetParam().params)) {
+    m.Energy(pt.x, pt.u);
+    m.Hessian(pt.x, pt.u, &h);
+    m.ControlHessian(pt.x, pt.u, &euu);
   }
   test_support::AllocationCounter counter;
   double e = 0.0;

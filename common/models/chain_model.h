@@ -31,22 +31,26 @@ class ChainModel : public Model {
   void Gradient(const Vec& x, const Vec& u, Vec* g) const override {
     if (g->size() != NumStates()) g->resize(NumStates());
     g->setZero();
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+    for (int t = 0; t < chain_terms_; ++t) {
       Self().Local(t, x, u, /*want_h=*/false,
                    [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
     }
+    Self().AddContactGradient(x, u, g);
   }
 
   const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
 
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
     double* values = HessianValues(h);
-    // StoreHessian: every slot is reached by some term, so no clearing pass.
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+    // StoreHessian: every chain slot is reached by a chain term first, so no clearing pass;
+    // slots only a contact pair reaches are cleared when the model has contact.
+    if (chain_terms_ < assembly_.NumTerms()) std::fill(values, values + h->nonZeros(), 0.0);
+    for (int t = 0; t < chain_terms_; ++t) {
       Self().Local(t, x, u, /*want_h=*/true, [&](const double*, const double* lh, int ld) {
         assembly_.StoreHessian(t, lh, ld, values);
       });
     }
+    Self().AddContactHessian(x, u, values);
   }
 
   // One pass over the terms for both: each term's local derivatives are computed once
@@ -56,12 +60,15 @@ class ChainModel : public Model {
     if (g->size() != NumStates()) g->resize(NumStates());
     g->setZero();
     double* values = HessianValues(h);
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+    if (chain_terms_ < assembly_.NumTerms()) std::fill(values, values + h->nonZeros(), 0.0);
+    for (int t = 0; t < chain_terms_; ++t) {
       Self().Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int ld) {
         assembly_.AddGradient(t, lg, g->data());
         assembly_.StoreHessian(t, lh, ld, values);
       });
     }
+    Self().AddContactGradient(x, u, g);
+    Self().AddContactHessian(x, u, values);
   }
 
   void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override {
@@ -73,6 +80,7 @@ class ChainModel : public Model {
         assembly_.AddControlGradient(t, lg, eu->data());
       });
     }
+    Self().AddContactControlGradient(x, u, eu);
   }
 
   void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override {
@@ -84,6 +92,7 @@ class ChainModel : public Model {
         assembly_.AddMixedHessian(t, lh, ld, exu);
       });
     }
+    Self().AddContactMixedHessian(x, u, exu);
   }
 
   void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override {
@@ -95,6 +104,7 @@ class ChainModel : public Model {
         assembly_.AddControlHessian(t, lh, ld, euu);
       });
     }
+    Self().AddContactControlHessian(x, u, euu);
   }
 
   // One pass over the control terms for all three (the same operations, the same bits).
@@ -113,6 +123,9 @@ class ChainModel : public Model {
         assembly_.AddControlHessian(t, lh, ld, euu);
       });
     }
+    Self().AddContactControlGradient(x, u, eu);
+    Self().AddContactMixedHessian(x, u, exu);
+    Self().AddContactControlHessian(x, u, euu);
   }
 
   int HessianBandwidth() const override { return assembly_.Bandwidth(); }
@@ -123,13 +136,16 @@ class ChainModel : public Model {
       : n_(params.Integer("n")), nx_(num_states), assembly_(num_states, num_controls) {}
 
   // Registers the terms in the chains' order (stretching of segments 1..n, then bending
-  // at joints 1..n-1), then builds the pattern once and notes the terms that touch u.
+  // at joints 1..n-1) and a model's self-contact pairs after them (RegisterContact), then
+  // builds the pattern once and notes the chain terms that touch u.
   void AddChainTerms() {
     Derived& self = static_cast<Derived&>(*this);
     for (int i = 1; i <= n_; ++i) self.AddTerm(false, i - 1);
     for (int j = 1; j <= n_ - 1; ++j) self.AddTerm(true, j - 1);
+    chain_terms_ = assembly_.NumTerms();
+    self.RegisterContact();
     assembly_.Finalize();
-    for (int t = 0; t < assembly_.NumTerms(); ++t) {
+    for (int t = 0; t < chain_terms_; ++t) {
       if (assembly_.TouchesControls(t)) control_terms_.push_back(t);
     }
   }
@@ -159,9 +175,18 @@ class ChainModel : public Model {
     return 20.19 * c * l / (total * total);
   }
 
+  // Self-contact hooks (thread3d defines them; a chain without contact has none).
+  void RegisterContact() {}
+  void AddContactGradient(const Vec&, const Vec&, Vec*) const {}
+  void AddContactHessian(const Vec&, const Vec&, double*) const {}
+  void AddContactControlGradient(const Vec&, const Vec&, Vec*) const {}
+  void AddContactMixedHessian(const Vec&, const Vec&, Mat*) const {}
+  void AddContactControlHessian(const Vec&, const Vec&, Mat*) const {}
+
   const int n_;   // segments; nodes p_0 .. p_n
   const int nx_;  // states
   HessianAssembly assembly_;
+  int chain_terms_ = 0;  // assembly terms 0 .. chain_terms_-1 are the chain's own
 
  private:
   const Derived& Self() const { return static_cast<const Derived&>(*this); }

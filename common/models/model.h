@@ -16,9 +16,11 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
+#include "contact/self_contact.h"
 #include "numeric/types.h"
 
 namespace snapthread {
@@ -103,6 +105,24 @@ class Model {
   // reset starts from the same model a fresh one would be (the rod untwists: its grasp
   // turn count goes back to the rest frames').
   virtual void ResetHistory() {}
+
+  // Self-contact (issue 15; models/contact_terms.h), for models whose segments are
+  // capsules that must not pass through each other. Continuous collision detection: the
+  // largest alpha in (0, 1] such that the straight step from x to x + alpha dx at
+  // controls u moves no segment through another and keeps every pair's gap above a
+  // tenth of its value at x (0 if two segments already touch). Every solver step is
+  // scaled by it. Models without contact: 1.
+  virtual double MaxStepFraction(const Vec& /*x*/, const Vec& /*dx*/, const Vec& /*u*/) const { return 1.0; }
+  // The same for a motion that also moves the controls (the tracker's predictor): the
+  // node positions go on a straight line from those of (x0, u0) to those of (x1, u1).
+  virtual double MaxMotionFraction(const Vec& /*x0*/, const Vec& /*u0*/, const Vec& /*x1*/,
+                                   const Vec& /*u1*/) const {
+    return 1.0;
+  }
+  // The active contact pairs with their closest points (status and drawing; allocates).
+  virtual std::vector<contact::ContactPoint> ActiveContacts(const Vec& /*x*/, const Vec& /*u*/) const {
+    return {};
+  }
 
   // Continuous symmetries: one-parameter groups of rotations x -> S_k(t) x (period 2 pi)
   // that leave E(., u) unchanged for controls on the rotation's axis and nearly so near

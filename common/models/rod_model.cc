@@ -28,6 +28,9 @@ bool RodParams::IsValid(std::string* error) const {
   };
   if (n < 3) return fail("n must be at least 3 (the clamp and the grasp hold one edge each)");
   if (free_start && n < 5) return fail("n must be at least 5 without a clamp (two grasps)");
+  // Self-contact maps the grasped nodes through one grasp's controls (rod_contact.cc).
+  if (free_start && contact.enabled)
+    return fail("self-contact (params.contact) is not yet supported with clamp: false");
   if (!(length > 0.0) || !std::isfinite(length)) return fail("length must be positive");
   const double stiffnesses[] = {stretch_stiffness, bend_stiffness, bend_stiffness_2,
                                 twist_stiffness};
@@ -46,21 +49,6 @@ bool RodParams::IsValid(std::string* error) const {
   }
   return true;
 }
-
-// u -> x_{n-1}, x_n, θ_{n-1}: values, Jacobian (7 x 6 over (p, φ)) and, for each of the
-// seven coordinates, the Hessian in φ (the map is linear in p).
-struct RodModel::GraspMap {
-  V3 xn1, xn;
-  double theta = 0.0;
-  Eigen::Matrix<double, 7, 6> jac;
-  std::array<M3, 7> hess_phi;
-};
-
-// The grasp of edge n-1 and, without a clamp, the one of edge 0 (unused otherwise).
-struct RodModel::GraspMaps {
-  GraspMap end;
-  GraspMap start;
-};
 
 RodModel::RodModel(const RodParams& params) : p_(params) {
   std::string error;
@@ -160,8 +148,9 @@ void RodModel::BuildTerms() {
     term.code[10] = theta_code(i);
     add(term);
   }
+  RegisterContact();
   assembly_.Finalize();
-  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     if (assembly_.TouchesControls(t)) control_terms_.push_back(t);
   }
 }
@@ -340,6 +329,7 @@ double RodModel::Energy(const Vec& x, const Vec& u) const {
                              nullptr);
     }
   }
+  if (contact_.enabled()) e += contact_.Energy(ContactNodes(x, gm));
   return e;
 }
 
@@ -347,10 +337,11 @@ void RodModel::Gradient(const Vec& x, const Vec& u, Vec* g) const {
   if (g->size() != nx_) g->resize(nx_);
   g->setZero();
   const GraspMaps gm = Grasp(u, true);
-  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, x, gm, false,
           [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
   }
+  if (contact_.enabled()) contact_.AddGradient(ContactNodes(x, gm), g->data());
 }
 
 void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
@@ -360,9 +351,11 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
     *h = pattern;
   }
   double* values = h->valuePtr();
-  // StoreHessian: every slot is reached by some term, so no clearing pass.
+  // StoreHessian: every elastic slot is reached by an elastic term first, so no clearing
+  // pass; slots only a contact pair reaches are cleared when contact is on.
+  if (contact_.enabled()) std::fill(values, values + pattern.nonZeros(), 0.0);
   const GraspMaps gm = Grasp(u, true);
-  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
       assembly_.StoreHessian(t, lh, ld, values);
     });
@@ -378,12 +371,17 @@ void RodModel::GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatr
     *h = pattern;
   }
   double* values = h->valuePtr();
+  if (contact_.enabled()) std::fill(values, values + pattern.nonZeros(), 0.0);
   const GraspMaps gm = Grasp(u, true);
-  for (int t = 0; t < assembly_.NumTerms(); ++t) {
+  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, x, gm, true, [&](const double* lg, const double* lh, int ld) {
       assembly_.AddGradient(t, lg, g->data());
       assembly_.StoreHessian(t, lh, ld, values);
     });
+  }
+  if (contact_.enabled()) {
+    contact_.AddGradient(ContactNodes(x, gm), g->data());
+    contact_.AddHessian(ContactNodes(x, gm), values);
   }
 }
 
@@ -396,6 +394,7 @@ void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
       assembly_.AddControlGradient(t, lg, eu->data());
     });
   }
+  if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, gm), ContactControls(gm), eu->data());
 }
 
 bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const {
@@ -409,6 +408,7 @@ bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) 
       assembly_.AddControlGradient(t, lg, e.data());
     });
   }
+  if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, gm), ContactControls(gm), e.data());
   *torque = -e.segment<3>(3);  // the first grasp's (edge 0's without a clamp)
   return true;
 }
@@ -422,6 +422,7 @@ void RodModel::MixedHessian(const Vec& x, const Vec& u, Mat* exu) const {
       assembly_.AddMixedHessian(t, lh, ld, exu);
     });
   }
+  if (contact_.enabled()) contact_.AddMixedHessian(ContactNodes(x, gm), ContactControls(gm), exu);
 }
 
 void RodModel::ControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
@@ -433,6 +434,7 @@ void RodModel::ControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
       assembly_.AddControlHessian(t, lh, ld, euu);
     });
   }
+  if (contact_.enabled()) contact_.AddControlHessian(ContactNodes(x, gm), ContactControls(gm), euu);
 }
 
 Vec RodModel::InitialState(const Vec& u) const {
@@ -554,8 +556,9 @@ ModelRegistration RodRegistration() {
       {.name = "clamp", .kind = ParamKind::kBool, .default_value = 1.0,
        .doc = "false: no clamp, a first grasp holds edge 0 (u = (its pose, the last edge's pose))"},
       {.name = "radius", .default_value = 0.01, .min = 0.0, .units = "m",
-       .doc = "tube radius (drawing only; contact is not modelled)"},
+       .doc = "tube radius (drawing; the capsule radius of self-contact)"},
   };
+  for (ParamSpec& spec : internal::ContactParamSpecs()) r.params.push_back(std::move(spec));
   r.factory = [](const ModelParams& mp) -> std::unique_ptr<Model> {
     RodParams p;
     p.n = mp.Integer("n");
@@ -569,6 +572,7 @@ ModelRegistration RodRegistration() {
     p.natural_curvature_2 = mp.Number("natural_curvature_2");
     p.radius = mp.Number("radius");
     p.free_start = !mp.Bool("clamp");
+    p.contact = internal::ReadContactParams(mp);
     return std::make_unique<RodModel>(p);
   };
   r.check = [](const ModelParams& mp, std::string* error) {

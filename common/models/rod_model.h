@@ -25,6 +25,7 @@
 
 #include <Eigen/Core>
 
+#include "models/contact_terms.h"
 #include "models/hessian_assembly.h"
 #include "models/model.h"
 #include "models/rod_energy.h"
@@ -40,7 +41,10 @@ struct RodParams {
   double twist_stiffness = 1.0;     // GJ (N m²)
   double natural_curvature = 0.0;   // κ̄1 (1/m), bending towards m1
   double natural_curvature_2 = 0.0; // κ̄2 (1/m), bending towards m2
-  double radius = 0.01;             // drawing only (m)
+  double radius = 0.01;             // tube radius: drawing, and contact (m)
+  // Self-contact (issue 15): capsules of `radius` with IPC's barrier; off by default.
+  // contact.radius is ignored: `radius` is the capsule radius.
+  contact::ContactParams contact{};
   Eigen::Vector3d clamp_position = Eigen::Vector3d::Zero();
   Eigen::Matrix3d clamp_rotation = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d grasp_rotation = Eigen::Matrix3d::Identity();  // R_start (φ = 0)
@@ -88,6 +92,11 @@ class RodModel final : public Model {
   void AcceptState(const Vec& x, const Vec& u) override;
   // Back to the rest frames (straight along the clamp, no turns at the grasp).
   void ResetHistory() override;
+  // Self-contact (rod_contact.cc).
+  double MaxStepFraction(const Vec& x, const Vec& dx, const Vec& u) const override;
+  double MaxMotionFraction(const Vec& x0, const Vec& u0, const Vec& x1, const Vec& u1) const override;
+  std::vector<contact::ContactPoint> ActiveContacts(const Vec& x, const Vec& u) const override;
+  const contact::SelfContact& self_contact() const { return contact_.self(); }
 
   // Layout, for tests and scene code: the state index of coordinate 0 of node k and of
   // θ_j, or -1 when the clamp or the grasp sets it.
@@ -101,8 +110,20 @@ class RodModel final : public Model {
 
  private:
   static constexpr int kMaxLocal = 11;  // a vertex term: three nodes and two angles
-  struct GraspMap;
-  struct GraspMaps;
+  // u -> x_{n-1}, x_n, θ_{n-1}: values, Jacobian (7 x 6 over (p, φ)) and, for each of the
+  // seven coordinates, the Hessian in φ (the map is linear in p).
+  struct GraspMap {
+    Eigen::Vector3d xn1, xn;
+    double theta = 0.0;
+    Eigen::Matrix<double, 7, 6> jac;
+    std::array<Eigen::Matrix3d, 7> hess_phi;
+  };
+
+  // The grasp of edge n-1 and, without a clamp, the one of edge 0 (unused otherwise).
+  struct GraspMaps {
+    GraspMap end;
+    GraspMap start;
+  };
   // One energy term (stretching of an edge, or bending and twist at a vertex). Local
   // coordinate codes: >= 0 a state index, -1 fixed by the clamp, -2 - g grasp
   // coordinate g (0..2 x_{n-1}, 3..5 x_n, 6 θ_{n-1}); free_start: -9 - g coordinate g of
@@ -117,6 +138,12 @@ class RodModel final : public Model {
     std::array<int, kMaxLocal> pos{};  // grasp terms: assembly position of state coordinates
   };
   void BuildTerms();
+  // Self-contact (rod_contact.cc): pair terms registered after the elastic ones, node
+  // positions into contact_nodes_, and the grasped nodes' map for E_u, E_xu, E_uu
+  // (a clamped rod only: with clamp false the model refuses contact).
+  void RegisterContact();
+  const Eigen::Matrix3Xd& ContactNodes(const Vec& x, const GraspMaps& gm) const;
+  static internal::ControlMap ContactControls(const GraspMaps& gm);
   GraspMaps Grasp(const Vec& u, bool derivatives, bool world_rotation = false) const;
   // The map of one grasp: the one of edge n-1 (at_start false) or of edge 0.
   GraspMap OneGrasp(const Vec& u, bool at_start, bool derivatives, bool world_rotation) const;
@@ -134,8 +161,11 @@ class RodModel final : public Model {
   double rest_;  // ℓ
   rod::VertexStiffness stiffness_;
   internal::HessianAssembly assembly_;
-  std::vector<Term> terms_;
+  std::vector<Term> terms_;  // the elastic terms (assembly terms 0 .. size-1)
   std::vector<int> control_terms_;
+  internal::ContactTerms contact_;
+  mutable Eigen::Matrix3Xd contact_nodes_, contact_to_;
+  mutable Vec contact_trial_;
   // Lagged data (AcceptState): per edge the frame source, per vertex the reference twist,
   // and the grasp's material angle, each the value at the last accepted state.
   std::vector<rod::FrameSource> sources_;

@@ -23,6 +23,7 @@
 #include <Eigen/Geometry>
 
 #include "models/chain_model.h"
+#include "models/contact_terms.h"
 #include "models/registry.h"
 
 namespace snapthread {
@@ -54,7 +55,8 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
         half_beta_(0.5 * params.Number("bending")),
         half_gamma_(0.5 * params.Number("stretching")),
         energy_shift_(-n_ * params.Number("bending") * params.Number("reference_bend") / 2.0),
-        grip_(params.Bool("grip_direction")) {
+        grip_(params.Bool("grip_direction")),
+        contact_params_(internal::ReadContactParams(params)) {
     AddChainTerms();
   }
 
@@ -63,7 +65,8 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
 
   // (3.7), (3.9) as the sums above: Σ γ/2 (l_i - L)² + Σ β/2 (1 - w_j·w_{j+1}) - N β B / 2.
   double Energy(const Vec& x, const Vec& u) const override {
-    return ChainEnergy<3>(x, u, energy_shift_, half_beta_, half_gamma_, rest_);
+    const double e = ChainEnergy<3>(x, u, energy_shift_, half_beta_, half_gamma_, rest_);
+    return contact_.enabled() ? e + contact_.Energy(ContactNodes(x, u)) : e;
   }
 
   // Nodes evenly spaced on the chord from 0 to p_N, plus a bump 1e-3 L sin(π i / N) in a
@@ -307,6 +310,68 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   const double energy_shift_;  // -N β B / 2
   const bool grip_;
   std::vector<Term> terms_;
+
+  // Self-contact (issue 15; models/contact_terms.h): p_0 and y_1, z_1 fixed, x_1 and
+  // p_2 .. p_{N-1} state variables, p_N = u. Not with a grip (the scene check says so).
+  void RegisterContact() {
+    contact_.Register(contact_params_, n_, rest_,
+                      [&](int i, int k) {
+                        internal::NodeCoord nc;
+                        if (i == n_) nc.control = k;
+                        else nc.state = NodeVar(i, k);
+                        return nc;
+                      },
+                      &assembly_);
+    if (contact_.enabled()) {
+      for (int k = 0; k < 3; ++k) controls_.jac(k, k) = 1.0;
+      for (auto& h : controls_.hess) h.setZero();
+    }
+  }
+  const Eigen::Matrix3Xd& ContactNodes(const Vec& x, const Vec& u) const {
+    NodePositions(x, u, &contact_nodes_);
+    return contact_nodes_;
+  }
+  void AddContactGradient(const Vec& x, const Vec& u, Vec* g) const {
+    if (contact_.enabled()) contact_.AddGradient(ContactNodes(x, u), g->data());
+  }
+  void AddContactHessian(const Vec& x, const Vec& u, double* values) const {
+    if (contact_.enabled()) contact_.AddHessian(ContactNodes(x, u), values);
+  }
+  void AddContactControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
+    if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, u), controls_, eu->data());
+  }
+  void AddContactMixedHessian(const Vec& x, const Vec& u, Mat* exu) const {
+    if (contact_.enabled()) contact_.AddMixedHessian(ContactNodes(x, u), controls_, exu);
+  }
+  void AddContactControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
+    if (contact_.enabled()) contact_.AddControlHessian(ContactNodes(x, u), controls_, euu);
+  }
+
+ public:
+  double MaxStepFraction(const Vec& x, const Vec& dx, const Vec& u) const override {
+    if (!contact_.enabled()) return 1.0;
+    contact_trial_ = x + dx;
+    return MaxMotionFraction(x, u, contact_trial_, u);
+  }
+  double MaxMotionFraction(const Vec& x0, const Vec& u0, const Vec& x1, const Vec& u1) const override {
+    if (!contact_.enabled()) return 1.0;
+    NodePositions(x0, u0, &contact_nodes_);
+    NodePositions(x1, u1, &contact_to_);
+    return contact_.self().MaxStepFraction(contact_nodes_, contact_to_);
+  }
+  std::vector<contact::ContactPoint> ActiveContacts(const Vec& x, const Vec& u) const override {
+    if (!contact_.enabled()) return {};
+    Eigen::Matrix3Xd nodes;
+    NodePositions(x, u, &nodes);
+    return contact_.self().ActivePairs(nodes);
+  }
+
+ private:
+  const contact::ContactParams contact_params_;
+  internal::ContactTerms contact_;
+  internal::ControlMap controls_;
+  mutable Eigen::Matrix3Xd contact_nodes_, contact_to_;
+  mutable Vec contact_trial_;
 };
 
 }  // namespace
@@ -319,8 +384,15 @@ ModelRegistration Thread3dRegistration() {
   r.params.push_back({.name = "reference_bend", .default_value = 0.0, .doc = "B (3.9); shifts the energy only"});
   r.params.push_back({.name = "grip_direction", .kind = ParamKind::kBool, .default_value = 0.0,
                       .doc = "the grip also holds the last segment's direction: u = (X, Y, Z, dx, dy, dz)"});
+  r.params.push_back({.name = "radius", .default_value = 0.0, .min = 0.0, .units = "model length",
+                      .doc = "capsule radius of self-contact (0: the centrelines only must not cross)"});
+  for (ParamSpec& spec : internal::ContactParamSpecs()) r.params.push_back(std::move(spec));
   // A grip needs N >= 3: node N-1 must not be the clamped node 1.
   r.check = [](const ModelParams& p, std::string* error) {
+    if (p.Bool("grip_direction") && p.Bool("contact")) {
+      if (error) *error = "params.contact: not available with grip_direction (the gripped node is not yet carried)";
+      return false;
+    }
     if (!p.Bool("grip_direction") || p.Integer("n") >= 3) return true;
     if (error) *error = "params.n: expected an integer >= 3, got " + std::to_string(p.Integer("n"));
     return false;

@@ -195,6 +195,13 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
   for (int it = 0; it < 12; ++it) {
     const double ss = alpha * s_star;
     xs_ = *x + alpha * delta_ + ss * vt_ + (ss * ss) * w_;
+    // Self-contact: the chord to the new state must not pass a segment through another
+    // (CCD); a shorter step along the curve is tried instead.
+    gm_ = xs_ - *x;
+    if (model().MaxStepFraction(*x, gm_, u) < 1.0) {
+      alpha *= 0.5;
+      continue;
+    }
     const double e = model().Energy(xs_, u);
     if (std::isfinite(e) && e <= e0 + 1e-14 * std::abs(e0)) {
       x->swap(xs_);
@@ -267,7 +274,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       }
     }
     if (!degenerate) {
-      TakeNewtonStep(&xr);
+      TakeNewtonStep(u, &xr);
       // Where E_xx is regular Newton converges quadratically; a step that does not
       // even halve |E_x| says the quadratic model has failed (a fold is close): the
       // next iteration uses the reduction.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -88,7 +89,12 @@ bool SolverBase::ContinueSnap(const Vec& u, Vec* x, SolverSummary* s) {
 // third of its cost. Near folds steps are far larger and the factor is always fresh.
 constexpr double kReuseStep = 1e-6;
 
-void SolverBase::TakeNewtonStep(Vec* x) {
+void SolverBase::TakeNewtonStep(const Vec& u, Vec* x) {
+  // Continuous collision detection (self-contact): a step that would carry one segment
+  // through another is shortened to where every gap keeps a tenth of its size.
+  ws_.dx_scratch = -ws_.dx;
+  const double alpha = model_.MaxStepFraction(*x, ws_.dx_scratch, u);
+  if (alpha < 1.0) ws_.dx *= alpha;
   *x -= ws_.dx;
   factor_before_tiny_step_ = ws_.dx.lpNorm<Eigen::Infinity>() <= kReuseStep;
 }
@@ -255,7 +261,9 @@ bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, SolverSummary* s) {
   // full step is accepted when it reduces |E_x| (a gradient-norm fallback).
   const double noise = 1e-13 * (1.0 + std::abs(e0));
   const double g0 = g->norm();
-  double alpha = 1.0;
+  // The line search starts where the step stops crossing nothing (self-contact CCD).
+  double alpha = model_.MaxStepFraction(*x, dx, u);
+  if (!(alpha > 0.0)) return false;
   for (int k = 0; k < 40; ++k) {
     w.trial = *x + alpha * dx;
     const double e = model_.Energy(w.trial, u);
@@ -325,11 +333,17 @@ bool SolverBase::MinimizeFully(const Vec& u, Vec* x, SolverSummary* s) {
       // again at once (a pitchfork's quartic): halve the step until E decreases.
       double step = 0.2 * options_.max_reduction_step / std::max(v.lpNorm<Eigen::Infinity>(), 1e-300);
       bool moved = false;
+      constexpr double kInf = std::numeric_limits<double>::infinity();
       for (int k = 0; k < 30 && !moved; ++k, step *= 0.5) {
-        trial = *x + step * v;
-        const double ep = model_.Energy(trial, u);
-        trial = *x - step * v;
-        const double em = model_.Energy(trial, u);
+        // Either way only where no segment passes through another (self-contact CCD).
+        ws_.dx_scratch = step * v;
+        const bool plus_ok = model_.MaxStepFraction(*x, ws_.dx_scratch, u) >= 1.0;
+        trial = *x + ws_.dx_scratch;
+        const double ep = plus_ok ? model_.Energy(trial, u) : kInf;
+        ws_.dx_scratch = -ws_.dx_scratch;
+        const bool minus_ok = model_.MaxStepFraction(*x, ws_.dx_scratch, u) >= 1.0;
+        trial = *x + ws_.dx_scratch;
+        const double em = minus_ok ? model_.Energy(trial, u) : kInf;
         if (std::min(ep, em) < e0) {
           *x += (ep < em ? step : -step) * v;
           moved = true;
@@ -386,7 +400,7 @@ SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
         s.message = std::string("factorisation failed: ") + HessianFactor().message();
         break;
       }
-      TakeNewtonStep(x);
+      TakeNewtonStep(u, x);
     }
     r = EvalGradient(*x, u, &s);
   }

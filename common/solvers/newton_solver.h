@@ -77,9 +77,10 @@ class SolverBase : public EquilibriumSolver {
   // The Newton step (2.18) d = E_xx^-1 E_x with HessianFactor() and Gradient().
   LinearSolverStatus ComputeNewtonStep() { return ws_.factor->Solve(ws_.g, &ws_.dx); }
   const Vec& NewtonStep() const { return ws_.dx; }
-  // Takes x -= NewtonStep() and records whether it was small enough for Finish() to
+  // Takes x -= NewtonStep() (shortened by the model's collision bound, MaxStepFraction,
+  // so no segment passes through another) and records whether it was small enough for Finish() to
   // keep using the factorisation (see kReuseStep in newton_solver.cc).
-  void TakeNewtonStep(Vec* x);
+  void TakeNewtonStep(const Vec& u, Vec* x);
   // Newton-ls step: inertia-corrected Newton direction + Armijo backtracking from x with
   // Gradient(). Returns false if no decrease could be found.
   bool GlobalizedStep(const Vec& u, Vec* x, SolverSummary* s);

@@ -68,6 +68,10 @@ bool SymmetryOrbits::MoveDownhill(const Vec& u, Vec* x) {
     const double t = ec < ed ? c : d;
     if (std::min(ec, ed) < best_e) best_t = t;
     model_.ApplySymmetry(k, best_t, *x, u, &best_);
+    // Self-contact: the move is a jump to the orbit's point; it must not carry a segment
+    // through another on the way (CCD on the chord), else the orbit is left alone.
+    trial_ = best_ - *x;
+    if (model_.MaxStepFraction(*x, trial_, u) < 1.0) continue;
     x->swap(best_);
     moved = true;
   }

@@ -118,6 +118,7 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
       x_pred_ += a * (x_ - x_prev_);
     }
   }
+  LimitPrediction(u);
   x_prev_ = x_;
   u_prev_ = u_;
   x_ = x_pred_;
@@ -136,6 +137,20 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   ComputeForces();
   model_->AcceptState(x_, u_);
   return result_;
+}
+
+void EquilibriumTracker::LimitPrediction(const Vec& u) {
+  // Self-contact (CCD): the prediction moves the nodes from the accepted state at the
+  // old controls to x_pred_ at the new ones; it must not carry a segment through another.
+  // Shorten the predicted change of the state (to none at all, where only the grasp
+  // moves) until it does not.
+  if (model_->MaxMotionFraction(x_, u_, x_pred_, u) >= 1.0) return;
+  scratch_ = x_pred_ - x_;
+  for (int k = 1; k <= 4; ++k) {
+    x_pred_ = x_ + std::ldexp(1.0, -k) * scratch_;
+    if (model_->MaxMotionFraction(x_, u_, x_pred_, u) >= 1.0) return;
+  }
+  x_pred_ = x_;
 }
 
 void EquilibriumTracker::ComputeForces() {

@@ -51,6 +51,9 @@ class EquilibriumTracker {
   const Vec& state() const { return x_; }
   const Vec& control() const { return u_; }
   const TrackResult& last() const { return result_; }
+  // Self-contact of the current state: the active pairs and their closest points (the
+  // server's solver_status_t.contacts and thread_shape_t.contacts; allocates).
+  std::vector<contact::ContactPoint> ActiveContacts() const { return model_->ActiveContacts(x_, u_); }
   // A state change larger than this (max norm, model units) against the predicted
   // state counts as a jump to another branch (default 0.1; scenes set 0.1 l).
   void SetSnapThreshold(double t) { snap_threshold_ = t; }
@@ -59,6 +62,9 @@ class EquilibriumTracker {
   // The end of Reset and Resume: solve at (x_, u_) with the tracking solver and make that
   // state the start of the path (no predictor history, force and K, lagged model data).
   const TrackResult& SolveAndStartHere();
+  // Shortens the predicted state change x_pred_ - x_ until the node motion from (x_, u_)
+  // to (x_pred_, u) passes no segment through another (self-contact; model.h).
+  void LimitPrediction(const Vec& u);
   void ComputeForces();
 
   std::unique_ptr<Model> model_;

@@ -1,0 +1,36 @@
+// Broad phase: which axis-aligned boxes overlap, in O(m + pairs) for m boxes of similar
+// size, through a uniform grid hashed into a table (counting sort, no search trees).
+//
+// The cell size is the mean box extent (at least 1e-12 of the scene), every box goes
+// into each cell it covers, and a pair is reported once: in the cell that holds the
+// lower corner of the two boxes' intersection. When boxes span very many cells (one
+// long swept box), the cell size doubles until the entries stay below 16 m. The scratch
+// vectors keep their capacity, so a warm broad phase does not allocate.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace snapthread::contact {
+
+class BroadPhase {
+ public:
+  // Pairs (i < j) of boxes [lo_i, hi_i] (columns of 3 x m matrices) that overlap,
+  // written to *pairs (cleared first), sorted by (i, j).
+  void Overlaps(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi,
+                std::vector<std::pair<int, int>>* pairs);
+
+ private:
+  struct Entry {
+    std::int64_t cell[3];
+    int box;
+  };
+  std::vector<Entry> entries_;
+  std::vector<Entry> sorted_;
+  std::vector<int> bucket_start_;
+};
+
+}  // namespace snapthread::contact

@@ -1,0 +1,102 @@
+#include "contact/self_contact.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "contact/ccd.h"
+
+namespace snapthread::contact {
+
+SelfContact::SelfContact(const ContactParams& params, int segments, double rest_length)
+    : params_(params), barrier_(params), segments_(segments) {
+  // Excluded: (j - i - 1) ℓ ≤ 2r, and always neighbours.
+  min_gap_ = 2;
+  while ((min_gap_ - 1) * rest_length <= params_.ContactDistance()) ++min_gap_;
+  lo_.resize(3, segments_);
+  hi_.resize(3, segments_);
+}
+
+void SelfContact::FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to,
+                            double reach) const {
+  const double half = 0.5 * reach;
+  if (lo_.cols() != segments_) {
+    lo_.resize(3, segments_);
+    hi_.resize(3, segments_);
+  }
+  for (int i = 0; i < segments_; ++i) {
+    Eigen::Vector3d l = nodes.col(i).cwiseMin(nodes.col(i + 1));
+    Eigen::Vector3d h = nodes.col(i).cwiseMax(nodes.col(i + 1));
+    if (to != nullptr) {
+      l = l.cwiseMin(to->col(i)).cwiseMin(to->col(i + 1));
+      h = h.cwiseMax(to->col(i)).cwiseMax(to->col(i + 1));
+    }
+    lo_.col(i) = l.array() - half;
+    hi_.col(i) = h.array() + half;
+  }
+  broad_.Overlaps(lo_, hi_, &pairs_);
+  pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(),
+                              [&](const std::pair<int, int>& p) { return !Included(p.first, p.second); }),
+               pairs_.end());
+}
+
+double SelfContact::Energy(const Eigen::Matrix3Xd& nodes) const {
+  FindPairs(nodes, nullptr, params_.ActivationDistance());
+  double e = 0.0;
+  for (const auto& [i, j] : pairs_) {
+    const double dsq = ClosestPoints(nodes.col(i), nodes.col(i + 1), nodes.col(j), nodes.col(j + 1)).distance_sq;
+    e += barrier_.Value(dsq, nullptr, nullptr);
+  }
+  return e;
+}
+
+double SelfContact::MaxStepFraction(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const {
+  // Pairs whose swept boxes come within the activation distance: any other pair stays
+  // farther apart than 2r + d̂ (so it keeps its gap above d̂ > 0).
+  FindPairs(from, &to, params_.ActivationDistance());
+  double alpha = 1.0;
+  for (const auto& [i, j] : pairs_) {
+    const double t = CapsuleCcd(from.col(i), from.col(i + 1), from.col(j), from.col(j + 1),
+                                to.col(i) - from.col(i), to.col(i + 1) - from.col(i + 1),
+                                to.col(j) - from.col(j), to.col(j + 1) - from.col(j + 1),
+                                params_.ContactDistance(), kKeep, alpha);
+    alpha = std::min(alpha, t);
+    if (alpha <= 0.0) return 0.0;
+  }
+  return alpha;
+}
+
+std::vector<ContactPoint> SelfContact::ActivePairs(const Eigen::Matrix3Xd& nodes) const {
+  std::vector<ContactPoint> out;
+  FindPairs(nodes, nullptr, params_.ActivationDistance());
+  for (const auto& [i, j] : pairs_) {
+    const SegmentClosest c = ClosestPoints(nodes.col(i), nodes.col(i + 1), nodes.col(j), nodes.col(j + 1));
+    if (c.distance_sq >= barrier_.ActivationSq()) continue;
+    ContactPoint p;
+    p.segment_a = i;
+    p.segment_b = j;
+    p.point_a = nodes.col(i) + c.s * (nodes.col(i + 1) - nodes.col(i));
+    p.point_b = nodes.col(j) + c.t * (nodes.col(j + 1) - nodes.col(j));
+    p.distance = std::sqrt(c.distance_sq);
+    out.push_back(p);
+  }
+  return out;
+}
+
+double SelfContact::MinDistance(const Eigen::Matrix3Xd& nodes, int* seg_a, int* seg_b) const {
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < segments_; ++i) {
+    for (int j = i + min_gap_; j < segments_; ++j) {
+      const double d = std::sqrt(
+          ClosestPoints(nodes.col(i), nodes.col(i + 1), nodes.col(j), nodes.col(j + 1)).distance_sq);
+      if (d < best) {
+        best = d;
+        if (seg_a != nullptr) *seg_a = i;
+        if (seg_b != nullptr) *seg_b = j;
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace snapthread::contact
