@@ -2,7 +2,7 @@
 # The whole test suite (what CI runs, issue 12 item 7):
 #  1. set-up (packages + Release build: -O3 -DNDEBUG, warnings as errors), then every test;
 #  2. a second build with AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/), then
-#     the unit and report tests under it (what is left out, and why, is below);
+#     every test but the multi-process ones under it (what is left out, and why, is below);
 #  3. short libFuzzer runs of the scene loader and the message decoders (build-fuzz/, clang),
 #     FUZZ_SECONDS each (default 30; docs on the long runs in the README's Tests section).
 # Usage: deploy/test.sh [--quick]   (--quick: step 1 only, for a local edit-test loop)
@@ -21,21 +21,20 @@ if [ "${1:-}" != "--quick" ]; then
     -DSNAPTHREAD_WERROR=OFF -DSNAPTHREAD_BUILD_WEB=OFF >/dev/null
   cmake --build "$here/build-asan" -j"$(nproc)"
   cd "$here/build-asan"
-  # Under the sanitizers: the unit and report tests (models, linear algebra, solvers,
-  # scenes, sweep, stability, auth, messages, report). Left out, and why:
-  #  - timed multi-process, soak and namespace tests, and the wall-clock time-budget test:
-  #    under the 2-3x slowdown they measure the sanitizer, not the code;
-  #  - the allocation-counting tests: they replace malloc/operator new, which ASan owns;
-  #  - the tests that dispatch LCM subscriptions (labels service, viewer, GraspMapping):
-  #    under UBSan, liblcm 1.3.1 (uninstrumented) calls the C++ subscription callback with a
-  #    user_data that is not the subscription object (lcm-cpp-impl.hpp:88/108, misaligned
-  #    or wrong dynamic type) in 32 of 97 such tests. OPEN, cause not found: it happens
-  #    in ScenePath, where every subscription is made before the handling thread starts
-  #    and none is removed while it runs, so it is not only the upstream dispatch-vs-
-  #    unsubscribe race of liblcm 1.3.1 (lcm-proj/lcm#619, fixed upstream by #621).
-  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --output-on-failure -j2 --timeout 900 -L 'unit|report' -LE 'process|soak|netns' \
-      -E 'Allocat|NotAllocate|WithoutAllocation|NeverAllocate|architecture_test|TimeBudget|GraspMapping'
+  # Under the sanitizers: every in-process test (labels unit, report, service, viewer: the
+  # models, linear algebra, solvers, scenes, sweep, stability, auth, messages, report, the
+  # in-process server and device over memq://, the viewer core and screenshot, and the
+  # allocation counters, which count through ASan's malloc hook there). LCM subscriptions
+  # go through messages::Subscribe (common/messages/subscribe.h): liblcm's own
+  # member-function subscriptions trip a GCC 12 UBSan false report (see that header).
+  # SNAPTHREAD_SPEED_SCALE: this build is slower, so wall-clock budgets that are about
+  # speed (time_budget_test's 300 us) are multiplied by it; no safety bound is.
+  # Left out, and why: the multi-process, soak and namespace tests (labels process, soak,
+  # netns): not yet run under the sanitizers (they start the sanitized binaries as
+  # processes over udpm; their timing under the slowdown is not measured). OPEN.
+  SNAPTHREAD_SPEED_SCALE=4 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --output-on-failure -j2 --timeout 900 -LE 'process|soak|netns'
 fi
 
 if [ "${1:-}" != "--quick" ]; then

@@ -61,6 +61,9 @@ DeviceClient::DeviceClient(HapticDevice* device, DeviceTransport* transport,
             trace_file_ ? trace_ring_.get() : nullptr, lateness_.get(), config_.tick),
       loop_(&tick_, config_.loop) {
   state_msg_.device_id = config_.device_id;
+  if (config_.snap_ahead) tick_.SetSnapAhead(&snap_ahead_);
+  state_msg_.grasp = config_.grasp;
+  receiver_.SetGrasp(config_.grasp);
   start_us_ = Now();
   last_status_us_ = last_log_us_ = start_us_;
 }
@@ -157,6 +160,7 @@ void DeviceClient::Drain() {
     for (int k = 0; k < 3; ++k) state_msg_.position[k] = p.position_m[k];
     for (int k = 0; k < 4; ++k) state_msg_.orientation[k] = p.orientation[k];
     state_msg_.buttons = p.buttons;
+    state_msg_.snap_fold_id = p.snap_fold_id;
     // The servo already refused bad positions; this also catches a backend's bad
     // orientation, so the server never receives a pose it would have to reject.
     if (!transport::Validate(state_msg_, nullptr) || !SignPose()) {
@@ -214,6 +218,7 @@ device_status_t DeviceClient::BuildStatus(int64_t now_us, double tick_rate_hz, i
   st.utime = now_us;
   st.seq = seq;
   st.device_id = config_.device_id;
+  st.grasp = config_.grasp;
   st.tick_rate_hz = tick_rate_hz;
   const auto lat = lateness_window_.Compute();
   st.lateness_us_p50 = lat.p50;
@@ -233,6 +238,7 @@ device_status_t DeviceClient::BuildStatus(int64_t now_us, double tick_rate_hz, i
   st.slew_limits = static_cast<int64_t>(safety_.counters().slew_limits.load());
   st.fades = static_cast<int64_t>(safety_.counters().fade_ticks.load());
   st.snaps_felt = static_cast<int64_t>(receiver_.snaps_felt());
+  st.snap_ahead_switches = static_cast<int64_t>(snap_ahead_.switches());
   return st;
 }
 
@@ -255,6 +261,7 @@ DeviceClientSummary DeviceClient::Summary(int64_t now_us) const {
   s.slew_limits = sc.slew_limits.load();
   s.fade_ticks = sc.fade_ticks.load();
   s.snaps_felt = receiver_.snaps_felt();
+  s.snap_ahead_switches = snap_ahead_.switches();
   s.nonfinite_outputs = sc.nonfinite_outputs.load();
   s.overruns = loop_.overruns();
   s.read_failures = tick_.counters().read_failures.load();

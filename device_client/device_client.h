@@ -35,6 +35,9 @@ namespace snapthread::device {
 
 struct DeviceClientConfig {
   std::string device_id = "device";  // device_state_t.device_id, e.g. "virtual-hand"
+  // The scene grasp this device holds (device_state_t.grasp, issue 15; "" = the scene's
+  // only grasp): force models for another grasp are not for this device.
+  std::string grasp;
   SafetyLimits limits;               // must be valid (SafetyLimits::IsValid)
   bool device_has_orientation = false;
   ServoTickOptions tick;
@@ -49,6 +52,9 @@ struct DeviceClientConfig {
   // sets it; nullptr (no authentication) is for in-process tests of other concerns.
   const auth::SessionKey* key = nullptr;
   std::string session = transport::kDefaultSession;  // channel prefix (for the MACs)
+  // Snap-ahead (snap_ahead.h): switch to a fold's post-snap model at the tick the hand
+  // crosses its boundary. --no-snap-ahead turns it off.
+  bool snap_ahead = true;
 };
 
 // Statistics of the run so far (the --summary JSON and the last log line).
@@ -62,6 +68,7 @@ struct DeviceClientSummary {
   uint64_t models_received = 0, models_rejected = 0, invalid_models = 0;
   uint64_t poses_rejected = 0, force_clamps = 0, stiffness_clamps = 0, slew_limits = 0;
   uint64_t fade_ticks = 0, snaps_felt = 0, nonfinite_outputs = 0, overruns = 0;
+  uint64_t snap_ahead_switches = 0;
   uint64_t read_failures = 0, pose_ring_drops = 0, trace_ring_drops = 0;
   uint64_t invalid_poses_unpublished = 0, publish_failures = 0, poses_published = 0;
   double max_force_n = 0.0;
@@ -128,6 +135,7 @@ class DeviceClient {
   transport::Channels channels_;
   std::unique_ptr<auth::PoseEchoWindow> sent_poses_;  // written by the io thread
   ModelReceiver receiver_;
+  SnapAhead snap_ahead_;  // servo thread (via tick_)
   ServoTick tick_;
   ServoLoop loop_;
 

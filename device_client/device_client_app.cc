@@ -72,6 +72,7 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
       "  \"models_received\": %llu,\n  \"models_rejected\": %llu,\n  \"invalid_models\": %llu,\n"
       "  \"poses_rejected\": %llu,\n  \"force_clamps\": %llu,\n  \"stiffness_clamps\": %llu,\n"
       "  \"slew_limits\": %llu,\n  \"fade_ticks\": %llu,\n  \"snaps_felt\": %llu,\n"
+      "  \"snap_ahead_switches\": %llu,\n"
       "  \"max_force_n\": %.6f,\n  \"final_force_n\": %.6f,\n  \"nonfinite_outputs\": %llu,\n  \"overruns\": %llu,\n"
       "  \"read_failures\": %llu,\n  \"pose_ring_drops\": %llu,\n  \"trace_ring_drops\": %llu,\n"
       "  \"invalid_poses_unpublished\": %llu,\n  \"realtime\": %s\n}\n",
@@ -79,7 +80,7 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
       s.lateness_us.p50, s.lateness_us.p99, s.lateness_us_max, s.round_trip_us.p50,
       s.round_trip_us.p99, u(s.models_received), u(s.models_rejected), u(s.invalid_models),
       u(s.poses_rejected), u(s.force_clamps), u(s.stiffness_clamps), u(s.slew_limits),
-      u(s.fade_ticks), u(s.snaps_felt), s.max_force_n, s.final_force_n, u(s.nonfinite_outputs), u(s.overruns),
+      u(s.fade_ticks), u(s.snaps_felt), u(s.snap_ahead_switches), s.max_force_n, s.final_force_n, u(s.nonfinite_outputs), u(s.overruns),
       u(s.read_failures), u(s.pose_ring_drops), u(s.trace_ring_drops),
       u(s.invalid_poses_unpublished), s.realtime ? "true" : "false");
   std::fclose(f);
@@ -96,6 +97,7 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
       ->capture_default_str();
   app.add_option("--scene", o->scene_file, "scene YAML (device mapping, limits, grasp path)")
       ->check(CLI::ExistingFile);
+  app.add_option("--grasp", o->grasp, "the scene grasp this device holds (a scene with grasps:; default: the first)");
   app.add_option("--path-csv", o->path_csv, "scripted path CSV x,y[,z] in metres (instead of the scene's)")
       ->check(CLI::ExistingFile);
   app.add_option("--session", o->session, "session name, [A-Za-z0-9_]+")->capture_default_str();
@@ -118,6 +120,10 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
       ->capture_default_str();
   bool no_rt = false;
   app.add_flag("--no-rt", no_rt, "do not try SCHED_FIFO / mlockall");
+  bool no_snap_ahead = false;
+  app.add_flag("--no-snap-ahead", no_snap_ahead,
+               "render only the server's models: no switch to a post-snap model at a fold "
+               "boundary (docs/snap-ahead.md)");
   app.add_option("--log-level", o->log_level, "trace | debug | info | warn | error | off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}))
       ->capture_default_str();
@@ -136,6 +142,7 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
     return code == 0 ? kExitOk : kExitBadArguments;
   }
   o->realtime = !no_rt;
+  o->snap_ahead = !no_snap_ahead;
   if (!transport::IsValidSessionName(o->session)) {
     std::fprintf(stderr, "snapthread-device: --session '%s': expected [A-Za-z0-9_]+\n",
                  o->session.c_str());
@@ -192,13 +199,26 @@ int RunDeviceClient(const DeviceClientOptions& o) {
       return kExitBadArguments;
     }
   }
+  int grasp = 0;
+  if (!o.grasp.empty()) {
+    grasp = scene ? FindGrasp(*scene, o.grasp) : -1;
+    if (grasp < 0) {
+      std::string names;
+      if (scene)
+        for (const SceneGrasp& g : scene->grasps) names += (names.empty() ? "" : ", ") + g.name;
+      std::fprintf(stderr, "snapthread-device: --grasp: %s\n",
+                   scene ? ("no grasp '" + o.grasp + "' in the scene (its grasps: " + (names.empty() ? "one, unnamed" : names) + ")").c_str()
+                         : "needs --scene (the scene names the grasps)");
+      return kExitBadArguments;
+    }
+  }
   BackendConfig config;
   config.name = o.backend;
   try {
     if (!o.path_csv.empty()) {
       config.path = ScriptedPath::FromCsv(o.path_csv, o.speed_m_per_s);
     } else if (scene && BackendNeedsPath(o.backend)) {
-      config.path = ScriptedPath::FromScene(*scene, o.speed_m_per_s);
+      config.path = ScriptedPath::FromScene(*scene, o.speed_m_per_s, grasp);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "snapthread-device: %s: %s\n",
@@ -228,7 +248,8 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   }
   const DeviceCapabilities caps = device->capabilities();
   DeviceClientConfig cc;
-  cc.limits = LimitsFrom(caps, scene ? &scene->device : nullptr);
+  const DeviceMapping mapping = scene ? GraspDeviceMapping(*scene, grasp) : DeviceMapping{};
+  cc.limits = LimitsFrom(caps, scene ? &mapping : nullptr);
   cc.limits.model_timeout_s = 1e-3 * o.model_timeout_ms;
   cc.limits.fade_time_s = 1e-3 * o.fade_ms;
   cc.limits.tick_period_s = 1.0 / o.rate_hz;
@@ -244,6 +265,9 @@ int RunDeviceClient(const DeviceClientOptions& o) {
                  config.path->max_radius_m(), limits.workspace_radius_m);
   }
   cc.device_id = o.backend == caps.model_name ? o.backend : o.backend + ":" + caps.model_name;
+  // Each hand is its own sender (the server keeps one sequence filter per device id).
+  if (scene && !scene->grasps.empty()) cc.grasp = scene->grasps[grasp].name;
+  if (!cc.grasp.empty()) cc.device_id += "@" + cc.grasp;
   cc.device_has_orientation = caps.has_orientation;
   cc.tick.publish_divisor = o.publish_divisor;
   cc.tick.trace_divisor = o.trace_divisor;
@@ -252,6 +276,7 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   cc.trace_file = o.trace_file;
   cc.key = &*key;
   cc.session = o.session;
+  cc.snap_ahead = o.snap_ahead;
   spdlog::info("device: {} session {} on {}; limits |F| <= {} N, stiffness <= {} N/m, "
                "slew {} N/s, timeout {} ms, fade {} ms, workspace {} m",
                cc.device_id, o.session, url, limits.max_force_n, limits.max_stiffness_n_per_m,

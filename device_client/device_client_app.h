@@ -10,6 +10,7 @@ namespace snapthread::device {
 struct DeviceClientOptions {
   std::string backend = "virtual-hand";  // sim-path | virtual-hand | phantom | delta
   std::string scene_file;                // scene YAML: DeviceMapping + grasp path
+  std::string grasp;                     // scene grasp to hold (--grasp); "" = the first
   std::string path_csv;                  // alternative scripted path, metres
   std::string session = "SNAPTHREAD";
   std::string lcm_url;                   // empty: LCM_DEFAULT_URL or the udpm default
@@ -20,6 +21,7 @@ struct DeviceClientOptions {
   double fade_ms = 100.0;
   double speed_m_per_s = 0.02;           // scripted path speed
   bool realtime = true;                  // --no-rt turns off SCHED_FIFO / mlockall
+  bool snap_ahead = true;                // --no-snap-ahead: never switch at a fold boundary
   std::string log_level = "info";
   std::string trace_file;                // CSV, empty = none
   int trace_divisor = 1;

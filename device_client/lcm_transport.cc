@@ -1,13 +1,16 @@
 #include "lcm_transport.h"
 
+#include "messages/subscribe.h"
+
 namespace snapthread::device {
 
 LcmDeviceTransport::LcmDeviceTransport(const std::string& url, const std::string& session)
     : lcm_(url), channels_(session) {
   if (lcm_.good()) {
-    subscription_ = lcm_.subscribe(channels_.force_model, &LcmDeviceTransport::Handle, this);
+    subscription_ =
+        messages::Subscribe<&LcmDeviceTransport::Handle>(lcm_, channels_.force_model, this);
     status_subscription_ =
-        lcm_.subscribe(channels_.solver_status, &LcmDeviceTransport::HandleStatus, this);
+        messages::Subscribe<&LcmDeviceTransport::HandleStatus>(lcm_, channels_.solver_status, this);
   }
 }
 

@@ -50,6 +50,11 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
       Reject(why);
       return false;
     }
+    // Another hand's model (issue 15): it answers that device's poses, never this one's.
+    if (msg.grasp != grasp_) {
+      other_grasp_.fetch_add(1);
+      return false;
+    }
     if (auth_.key != nullptr) {
       // Models must carry the epoch learned from the server's status (0: none yet, so
       // everything is refused and the device stays in its fade).

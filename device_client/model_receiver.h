@@ -37,6 +37,12 @@ class ModelReceiver {
   // epoch becomes the one force models must carry (FreshnessFilter kAdopt). Same thread
   // as Receive. Never throws.
   bool ReceiveStatus(const void* data, int size);
+  // The grasp this device holds (issue 15): a model whose force_model_t.grasp differs is
+  // another hand's and is passed over before any check (counted in other_grasp(), not
+  // rejected: on a session with two hands every other model is the other hand's). Call
+  // before the first Receive.
+  void SetGrasp(std::string grasp) { grasp_ = std::move(grasp); }
+  uint64_t other_grasp() const { return other_grasp_.load(); }
   // The server epoch learned from an authenticated status; 0 until one was heard.
   int64_t epoch() const { return status_filter_.epoch(); }
   uint64_t statuses_rejected() const { return status_filter_.rejected(); }
@@ -68,12 +74,13 @@ class ModelReceiver {
   SafetyLimits limits_;
   ModelSlot* slot_;
   ModelAuth auth_;
+  std::string grasp_;
   ModelOrder order_;  // receive thread only
   auth::FreshnessFilter status_filter_{"SOLVER_STATUS",
                                        auth::FreshnessFilter::EpochPolicy::kAdopt};
   auth::FreshnessFilter model_filter_{"FORCE_MODEL"};
   std::atomic<uint64_t> received_{0}, rejected_{0}, stiffness_clamps_{0}, invalid_models_{0},
-      snaps_felt_{0}, out_of_order_{0};
+      snaps_felt_{0}, out_of_order_{0}, other_grasp_{0};
   mutable std::mutex mutex_;  // the round-trip windows (receiver and status threads)
   transport::SampleWindow round_trip_window_{2000};
   transport::SampleWindow round_trip_run_{200000};

@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "messages/validate.h"
+#include "snap_ahead.h"
 
 namespace snapthread::device {
 
@@ -47,6 +48,47 @@ SafetyLimits LimitsFrom(const DeviceCapabilities& caps, const DeviceMapping* map
   return l;
 }
 
+bool ClampStiffness(const double K_in[3][3], const SafetyLimits& limits, double out[3][3],
+                    bool* clamped, std::string* why) {
+  // Stiffness S = -sym(K); clamp its eigenvalues to [0, max stable stiffness].
+  Eigen::Matrix3d K;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) K(i, j) = K_in[i][j];
+  }
+  // Halved before adding: K + K^T overflows for entries above half the double range.
+  const Eigen::Matrix3d S = -(0.5 * K + 0.5 * K.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(S);
+  if (eig.info() != Eigen::Success || !eig.eigenvalues().allFinite() ||
+      !eig.eigenvectors().allFinite()) {
+    if (why) *why = "stiffness eigen-decomposition failed";
+    return false;
+  }
+  Eigen::Vector3d lambda = eig.eigenvalues();
+  *clamped = false;
+  // Round-off tolerance: a symmetric K computed in double carries ~1e-12 relative noise.
+  const double tol = 1e-9 * std::max(1.0, limits.max_stiffness_n_per_m);
+  for (int i = 0; i < 3; ++i) {
+    const double c = std::clamp(lambda[i], 0.0, limits.max_stiffness_n_per_m);
+    if (std::abs(c - lambda[i]) > tol) *clamped = true;
+    lambda[i] = c;
+  }
+  const Eigen::Matrix3d S_clamped =
+      eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) out[i][j] = -0.5 * (S_clamped(i, j) + S_clamped(j, i));
+  }
+  // The servo trusts K to be finite (an absurd K must never become a NaN force).
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (!std::isfinite(out[i][j])) {
+        if (why) *why = "K is not finite after clamping its stiffness";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 ModelVerdict PrepareModel(const force_model_t& msg, int64_t receive_us,
                           const SafetyLimits& limits, LocalModel* out, std::string* why) {
   if (!transport::Validate(msg, why)) return ModelVerdict::kRejected;
@@ -70,42 +112,10 @@ ModelVerdict PrepareModel(const force_model_t& msg, int64_t receive_us,
     m.f0_n[i] = msg.f0[i];
     m.torque0_nm[i] = m.has_torque ? msg.torque0[i] : 0.0;
   }
-  // Stiffness S = -sym(K); clamp its eigenvalues to [0, max stable stiffness].
-  Eigen::Matrix3d K;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) K(i, j) = msg.K[i][j];
-  }
-  // Halved before adding: K + K^T overflows for entries above half the double range.
-  const Eigen::Matrix3d S = -(0.5 * K + 0.5 * K.transpose());
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(S);
-  if (eig.info() != Eigen::Success || !eig.eigenvalues().allFinite() ||
-      !eig.eigenvectors().allFinite()) {
-    if (why) *why = "stiffness eigen-decomposition failed";
-    return ModelVerdict::kRejected;
-  }
-  Eigen::Vector3d lambda = eig.eigenvalues();
   bool clamped = false;
-  // Round-off tolerance: a symmetric K computed in double carries ~1e-12 relative noise.
-  const double tol = 1e-9 * std::max(1.0, limits.max_stiffness_n_per_m);
-  for (int i = 0; i < 3; ++i) {
-    const double c = std::clamp(lambda[i], 0.0, limits.max_stiffness_n_per_m);
-    if (std::abs(c - lambda[i]) > tol) clamped = true;
-    lambda[i] = c;
-  }
-  const Eigen::Matrix3d S_clamped =
-      eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) m.K_n_per_m[i][j] = -0.5 * (S_clamped(i, j) + S_clamped(j, i));
-  }
-  // The servo trusts K to be finite (an absurd K must never become a NaN force).
-  for (const auto& row : m.K_n_per_m) {
-    for (double k : row) {
-      if (!std::isfinite(k)) {
-        if (why) *why = "K is not finite after clamping its stiffness";
-        return ModelVerdict::kRejected;
-      }
-    }
-  }
+  if (!ClampStiffness(msg.K, limits, m.K_n_per_m, &clamped, why)) return ModelVerdict::kRejected;
+  // A bad fold refuses the whole model: it never reaches the servo (snap_ahead.h).
+  if (!PrepareFold(msg, limits, &m, &clamped, why)) return ModelVerdict::kRejected;
   *out = m;
   return clamped ? ModelVerdict::kStiffnessClamped : ModelVerdict::kAccepted;
 }

@@ -56,7 +56,22 @@ struct LocalModel {
   double f0_n[3] = {0.0, 0.0, 0.0};
   double K_n_per_m[3][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
   double torque0_nm[3] = {0.0, 0.0, 0.0};
+  // Snap-ahead (issue 17, snap_ahead.h): the fold boundary and the post-snap model, checked
+  // and with the post-snap stiffness clamped like K.
+  bool has_fold = false;
+  int64_t fold_id = 0;
+  double fold_point_m[3] = {0.0, 0.0, 0.0};
+  double fold_normal[3] = {0.0, 0.0, 0.0};
+  double fold_curvature_per_m = 0.0;
+  double post_u0_m[3] = {0.0, 0.0, 0.0};
+  double post_f0_n[3] = {0.0, 0.0, 0.0};
+  double post_K_n_per_m[3][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
 };
+
+// K (dF/du, N/m) with the stiffness S = -sym(K) clamped to [0, max stable stiffness] into
+// out (finite); *clamped when a clamp acted. False (with *why) when it cannot be done.
+bool ClampStiffness(const double K[3][3], const SafetyLimits& limits, double out[3][3],
+                    bool* clamped, std::string* why);
 
 enum class ModelVerdict {
   kAccepted,          // usable as sent (K symmetrised)

@@ -37,10 +37,14 @@ ScriptedPath::ScriptedPath(std::vector<std::array<double, 3>> waypoints_m, doubl
   total_length_m_ = cumulative_m_.back();
 }
 
-ScriptedPath ScriptedPath::FromScene(const Scene& scene, double speed_m_per_s) {
+ScriptedPath ScriptedPath::FromScene(const Scene& scene, double speed_m_per_s, int grasp) {
   std::vector<std::array<double, 3>> pts;
-  auto add = [&](const Vec& control) {
-    const Eigen::Vector3d p = messages::ControlsToPosition(scene.device, scene.grasp_layout, control);
+  const DeviceMapping mapping = GraspDeviceMapping(scene, grasp);
+  const int m = scene.grasp_layout.NumControls();
+  const int offset = grasp > 0 && grasp < static_cast<int>(scene.grasps.size()) ? scene.grasps[grasp].offset : 0;
+  auto add = [&](const Vec& controls) {
+    const Vec control = controls.size() >= offset + m ? Vec(controls.segment(offset, m)) : controls;
+    const Eigen::Vector3d p = messages::ControlsToPosition(mapping, scene.grasp_layout, control);
     pts.push_back({p[0], p[1], p[2]});
   };
   if (scene.path.empty()) {

@@ -18,7 +18,9 @@ class ScriptedPath {
 
   // The scene's grasp.path (or grasp.start when it has no path), model units, mapped to
   // device metres with messages::ControlsToPosition (planar scenes: on the model plane).
-  static ScriptedPath FromScene(const Scene& scene, double speed_m_per_s);
+  // The path of scene grasp `grasp` (an index into scene.grasps; 0 for a single grasp),
+  // in that grasp's device mapping.
+  static ScriptedPath FromScene(const Scene& scene, double speed_m_per_s, int grasp = 0);
   // A CSV file of positions in metres, one "x,y,z" (or "x,y") per line; lines starting
   // with '#' and a non-numeric header line are skipped. Throws std::runtime_error with the
   // file and line on a bad file.

@@ -33,6 +33,7 @@ void ServoTick::Tick(int64_t now_us, int64_t lateness_us) {
   if (!read_ok) counters_.read_failures.fetch_add(1, std::memory_order_relaxed);
 
   const LocalModel* model = models_->Latest();  // wait-free
+  if (snap_ahead_ != nullptr && read_ok) model = snap_ahead_->Select(model, state_.position_m, pose_seq_);
   safety_->Step(state_.position_m, read_ok, model, now_us, &last_);
   if (!device_->Command(last_.force_n, last_.torque_nm)) {
     counters_.command_failures.fetch_add(1, std::memory_order_relaxed);
@@ -46,6 +47,7 @@ void ServoTick::Tick(int64_t now_us, int64_t lateness_us) {
     for (int k = 0; k < 3; ++k) p.position_m[k] = state_.position_m[k];
     for (int k = 0; k < 4; ++k) p.orientation[k] = state_.orientation[k];
     p.buttons = state_.buttons;
+    p.snap_fold_id = snap_ahead_ != nullptr ? snap_ahead_->snap_fold_id() : 0;
     if (poses_->TryPush(p)) ++pose_seq_;
   }
   if (trace_ != nullptr && tick_ % options_.trace_divisor == 0) {

@@ -13,6 +13,7 @@
 
 #include "haptic_device.h"
 #include "safety.h"
+#include "snap_ahead.h"
 #include "realtime/latest_value.h"
 #include "realtime/spsc_ring.h"
 
@@ -25,6 +26,7 @@ struct PoseSample {
   double position_m[3] = {0.0, 0.0, 0.0};
   double orientation[4] = {1.0, 0.0, 0.0, 0.0};
   int32_t buttons = 0;
+  int64_t snap_fold_id = 0;  // the fold whose post-snap model the device switched to last
 };
 
 // One row of the --trace CSV.
@@ -67,6 +69,8 @@ class ServoTick {
 
   // One tick at now_us (CLOCK_MONOTONIC), lateness_us after its deadline. Allocation-free.
   void Tick(int64_t now_us, int64_t lateness_us);
+  // Snap-ahead (snap_ahead.h): each tick renders what it selects. Null (the default): off.
+  void SetSnapAhead(SnapAhead* snap_ahead) { snap_ahead_ = snap_ahead; }
 
   const ServoCounters& counters() const { return counters_; }
   const SafetyOutput& last_output() const { return last_; }
@@ -79,6 +83,7 @@ class ServoTick {
   PoseRing* poses_;
   TraceRing* trace_;
   LatenessRing* lateness_;
+  SnapAhead* snap_ahead_ = nullptr;
   ServoTickOptions options_;
   ServoCounters counters_;
   DeviceState state_;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "messages/lcm_url.h"
+#include "messages/subscribe.h"
 
 namespace snapthread::logger {
 namespace {
@@ -38,7 +39,7 @@ SessionLogger::SessionLogger(const LoggerOptions& options) : options_(options), 
   }
   log_ = std::make_unique<lcm::LogFile>(options_.path, "w");
   if (!log_->good()) throw std::runtime_error("cannot write the log file " + options_.path);
-  subscription_ = lcm_.subscribe(options_.channel, &SessionLogger::OnMessage, this);
+  subscription_ = messages::Subscribe<&SessionLogger::OnMessage>(lcm_, options_.channel, this);
   if (subscription_ == nullptr) {
     throw std::runtime_error("cannot subscribe to channels '" + options_.channel + "'");
   }

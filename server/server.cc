@@ -1,10 +1,13 @@
 #include "server.h"
 
+#include "grasp_poses.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -16,9 +19,11 @@
 #include "scene_dir.h"
 #include "server_messages.h"
 #include "server_session.h"
+#include "update_cap.h"
 #include "tracking/make_tracker.h"
 #include "realtime/clock.h"
 #include "messages/lcm_url.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "solvers/registry.h"
 
@@ -116,9 +121,15 @@ std::unique_ptr<Server::Session> Server::MakeSession(const Scene& scene) const {
   session->scene.solver = options;
   // The one scene -> tracker path (SceneError for invalid parameters or options).
   session->tracker = MakeTracker(session->scene);
-  if (scene.grasp_layout.NumControls() != session->tracker->model().NumControls()) {
+  // Snap-ahead's boundary is in the one grasp's position space (issue 17).
+  if (params_.snap_ahead && scene.grasps.size() <= 1)
+    session->fold = std::make_unique<FoldBoundary>(session->scene);
+  // Every grasp takes the layout's controls (issue 15: several grasps concatenate theirs).
+  const int grasp_controls =
+      scene.grasp_layout.NumControls() * std::max<int>(1, static_cast<int>(scene.grasps.size()));
+  if (grasp_controls != session->tracker->model().NumControls()) {
     throw SceneError(scene.file + ": the scene's grasp layout has " +
-                     std::to_string(scene.grasp_layout.NumControls()) + " controls, model " +
+                     std::to_string(grasp_controls) + " controls, model " +
                      std::string(session->tracker->model().Name()) + " has " +
                      std::to_string(session->tracker->model().NumControls()));
   }
@@ -138,8 +149,8 @@ void Server::SetInfo(const std::string& scene, const std::string& method,
 void Server::Start() {
   if (started_) return;
   started_ = true;
-  state_sub_ = lcm_->subscribe(channels_.device_state, &Server::HandleDeviceState, this);
-  command_sub_ = lcm_->subscribe(channels_.command, &Server::HandleCommand, this);
+  state_sub_ = messages::Subscribe<&Server::HandleDeviceState>(lcm_, channels_.device_state, this);
+  command_sub_ = messages::Subscribe<&Server::HandleCommand>(lcm_, channels_.command, this);
   running_ = true;
   solve_thread_ = std::thread([this] { SolveLoop(); });
   receive_thread_ = std::thread([this] { ReceiveLoop(); });
@@ -282,17 +293,23 @@ void Server::SolveLoop() {
   auto next_status = now;
   auto next_checkpoint = checkpoint_writer_ ? now : SteadyClock::time_point::max();
   last_status_time_ = now;
+  UpdateCap cap;  // --max-update-hz / solver.max_update_hz
   while (true) {
-    ServerInbox::Taken taken = inbox_.Wait(std::min({next_shape, next_status, next_checkpoint}));
+    const double cap_hz = params_.max_update_hz > 0.0 ? params_.max_update_hz : session_->scene.max_update_hz;
+    ServerInbox::Taken taken = inbox_.Wait(std::min({next_shape, next_status, next_checkpoint, cap.Wake()}));
     if (taken.stop) break;
+    dropped_poses_.fetch_add(cap.Hold(&taken.poses));
+    cap.Release(cap_hz, SteadyClock::now(), &taken.poses);
     bool changed_session = false;
     for (const command_t& command : taken.commands) {
       ApplyCommand(command);
       changed_session = true;
     }
     if (PollSceneLoad()) changed_session = true;
-    if (taken.pose) SolveAndPublish(*taken.pose);
+    if (!taken.poses.empty()) SolveAndPublish(taken.poses);
     now = SteadyClock::now();
+    if (changed_session) knot_watch_.Reset();
+    knot_watch_.Tick(now, session_->scene, *session_->tracker);
     if (now >= next_shape || changed_session) {
       PublishShape();
       next_shape += shape_period;
@@ -311,21 +328,34 @@ void Server::SolveLoop() {
   }
 }
 
-void Server::SolveAndPublish(const PoseSample& pose) {
+void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
   EquilibriumTracker& tracker = *session_->tracker;
-  const Model& model = tracker.model();
   const Scene& scene = session_->scene;
-  const Eigen::Vector3d position(pose.state.position[0], pose.state.position[1],
-                                 pose.state.position[2]);
-  const Eigen::Vector4d quaternion(pose.state.orientation[0], pose.state.orientation[1],
-                                   pose.state.orientation[2], pose.state.orientation[3]);
-  const Vec u = messages::PoseToControls(scene.device, scene.grasp_layout, position, quaternion,
-                                         session_->rest_direction);
+  // Each pose moves its own grasp (grasp_poses.h); the others keep their controls.
+  Vec u = tracker.control();
+  const std::vector<int> grasp_of = ApplyGraspPoses(scene, session_->rest_direction, poses, &u);
+  bool any = false;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    if (grasp_of[k] >= 0) {
+      any = true;
+    } else {
+      Reject(channels_.device_state, "no grasp '" + poses[k].state.grasp + "' in scene " + scene.name);
+    }
+  }
+  if (!any) return;
 
   if (hooks_.before_update) hooks_.before_update();
   const TrackResult* result = nullptr;
   const auto t0 = SteadyClock::now();
   try {
+    // The device felt the post-snap model of the current fold: start on the new branch.
+    Vec x_after, u_after;
+    for (const PoseSample& pose : poses) {
+      if (session_->fold && session_->fold->TakeSwitch(pose.state.snap_fold_id, &x_after, &u_after)) {
+        tracker.Resume(x_after, u_after);
+        break;
+      }
+    }
     result = &tracker.Update(u);
   } catch (const std::exception& e) {
     if (ShouldLog(&last_solve_error_log_us_)) {
@@ -334,13 +364,46 @@ void Server::SolveAndPublish(const PoseSample& pose) {
   }
   const double solve_us = std::chrono::duration<double, std::micro>(SteadyClock::now() - t0).count();
   if (hooks_.after_update && result != nullptr) hooks_.after_update(u, tracker);
+  if (session_->fold && result != nullptr) session_->fold->AfterUpdate(tracker, u);
 
+  updates_.fetch_add(1);
+  if (ClassifyStatus(result) == force_model_t::STATUS_SNAPPED) {
+    snaps_.fetch_add(1);
+    ++snaps_since_reset_;
+    if (spdlog::should_log(spdlog::level::debug)) spdlog::debug("server: snap at u = ({})", Format(u));
+  }
+  status_window_.Push(solve_us);
+  {
+    const int64_t now_us = SteadyMicros();
+    std::lock_guard<std::mutex> lock(info_mutex_);
+    run_window_.Push(solve_us);
+    if (first_update_us_ == 0) first_update_us_ = now_us;
+    last_update_us_ = now_us;
+  }
+  // One force model per pose that named a grasp: that grasp's block of F and K.
+  bool first = true;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    if (grasp_of[k] < 0) continue;
+    PublishGraspModel(poses[k], grasp_of[k], u, result, solve_us, first);
+    first = false;
+  }
+}
+
+void Server::PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, const TrackResult* result,
+                               double solve_us, bool first) {
+  const Model& model = session_->tracker->model();
+  const Scene& scene = session_->scene;
+  const DeviceMapping mapping = GraspDeviceMapping(scene, grasp);
   ForceModelInputs in;
-  in.mapping = &scene.device;
+  in.mapping = &mapping;
   in.model = &model;
   in.u = u;
-  in.position_m = position;
+  in.position_m = Eigen::Vector3d(pose.state.position[0], pose.state.position[1], pose.state.position[2]);
   in.result = result;
+  if (!scene.grasps.empty()) {
+    in.grasp_offset = scene.grasps[grasp].offset;
+    in.grasp_controls = scene.grasp_layout.NumControls();
+  }
   in.device_seq = pose.state.seq;
   in.device_utime = pose.state.utime;
   in.server_receive_utime = pose.receive_utime;
@@ -354,27 +417,17 @@ void Server::SolveAndPublish(const PoseSample& pose) {
     spdlog::error("server: refusing to publish an invalid force model: {}", why);
     msg = BuildForceModel(ForceModelInputs{in.mapping, in.model, in.u, Eigen::Vector3d::Zero(),
                                            nullptr, in.device_seq, in.device_utime,
-                                           in.server_receive_utime, 0.0, in.seq, in.utime});
+                                           in.server_receive_utime, 0.0, in.seq, in.utime,
+                                           in.grasp_offset, in.grasp_controls});
   }
-  // Statistics before the message leaves: whoever receives the model sees them counted.
-  last_status_ = msg.status;
-  for (int i = 0; i < 3; ++i) last_force_n_[i] = msg.f0[i];
-  updates_.fetch_add(1);
-  if (msg.status == force_model_t::STATUS_INVALID) invalid_models_.fetch_add(1);
-  if (msg.status == force_model_t::STATUS_SNAPPED) {
-    snaps_.fetch_add(1);
-    ++snaps_since_reset_;
-    if (spdlog::should_log(spdlog::level::debug)) {
-      spdlog::debug("server: snap at u = ({})", Format(u));
-    }
-  }
-  status_window_.Push(solve_us);
-  {
-    const int64_t now_us = SteadyMicros();
-    std::lock_guard<std::mutex> lock(info_mutex_);
-    run_window_.Push(solve_us);
-    if (first_update_us_ == 0) first_update_us_ = now_us;
-    last_update_us_ = now_us;
+  if (session_->fold) session_->fold->Fill(&msg);
+  msg.grasp = scene.grasps.empty() ? std::string() : scene.grasps[grasp].name;
+  // Statistics of the update (counted by SolveAndPublish before any model leaves, so
+  // whoever receives one sees them); the first grasp's model is the one reported.
+  if (first) {
+    last_status_ = msg.status;
+    for (int i = 0; i < 3; ++i) last_force_n_[i] = msg.f0[i];
+    if (msg.status == force_model_t::STATUS_INVALID) invalid_models_.fetch_add(1);
   }
   if (!SignForChannel(&msg, channels_.force_model)) return;
   if (lcm_->publish(channels_.force_model, &msg) != 0) publish_failures_.fetch_add(1);
@@ -392,6 +445,7 @@ void Server::PublishShape() {
   in.force_newtons = Eigen::Vector3d(last_force_n_[0], last_force_n_[1], last_force_n_[2]);
   in.status = last_status_;
   in.snaps = snaps_since_reset_;
+  in.knot = knot_watch_.name();
   in.seq = shape_seq_++;
   in.utime = transport::RealtimeMicros();
   thread_shape_t msg = BuildShape(in);
@@ -426,6 +480,9 @@ void Server::PublishStatus() {
   in.dropped_poses = dropped_poses_.load();
   in.rejected_messages = rejected_messages_.load();
   in.contacts = static_cast<int32_t>(session_->tracker->ActiveContacts().size());
+  in.knot = knot_watch_.name();
+  in.knot_determinant = knot_watch_.determinant();
+  in.max_update_hz = params_.max_update_hz > 0.0 ? params_.max_update_hz : session_->scene.max_update_hz;
   in.seq = status_seq_++;
   in.utime = transport::RealtimeMicros();
   solver_status_t msg = BuildSolverStatus(in);

@@ -34,6 +34,7 @@
 
 #include "background_job.h"
 #include "checkpoint_writer.h"
+#include "knot_watch.h"
 #include "server_inbox.h"
 #include "server_params.h"
 #include "scene/scene.h"
@@ -147,7 +148,10 @@ class Server {
   void ReceiveLoop();
   void SolveLoop();
   // Solve thread.
-  void SolveAndPublish(const PoseSample& pose);
+  void SolveAndPublish(const std::vector<PoseSample>& poses);
+  // The force model of one grasp for the pose that moved it (its block of F and K).
+  void PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, const TrackResult* result,
+                         double solve_us, bool first);
   void ApplyCommand(const command_t& command);
   // LOAD_SCENE off the solve thread (commands.cc): starts the loader; the solve loop polls
   // it and swaps the session in when it is ready (true when the session changed or a
@@ -202,6 +206,7 @@ class Server {
   std::unique_ptr<Session> session_;
   std::string method_override_;  // "" = the scene's method
   BackgroundJob<Session> load_;   // the LOAD_SCENE in progress, if any
+  KnotWatch knot_watch_;          // the shape's knot type, a few times a second
   std::string load_name_;         // its argument
   int64_t model_seq_ = 0, shape_seq_ = 0, status_seq_ = 0;
   int64_t snaps_since_reset_ = 0;

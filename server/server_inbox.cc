@@ -8,8 +8,16 @@ bool ServerInbox::PutPose(const PoseSample& pose) {
   bool superseded = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    superseded = pose_.has_value();
-    pose_ = pose;
+    bool stored = false;
+    for (PoseSample& p : poses_) {
+      if (p.state.grasp == pose.state.grasp) {
+        p = pose;
+        superseded = stored = true;
+        break;
+      }
+    }
+    if (!stored && poses_.size() >= kMaxGrasps) return true;
+    if (!stored) poses_.push_back(pose);
   }
   cv_.notify_one();
   return superseded;
@@ -36,11 +44,11 @@ void ServerInbox::RequestStop() {
 ServerInbox::Taken ServerInbox::Wait(Clock::time_point deadline) {
   std::unique_lock<std::mutex> lock(mutex_);
   cv_.wait_until(lock, deadline,
-                 [this] { return stop_ || pose_.has_value() || !commands_.empty(); });
+                 [this] { return stop_ || !poses_.empty() || !commands_.empty(); });
   Taken taken;
   taken.stop = stop_;
-  taken.pose = std::move(pose_);
-  pose_.reset();
+  taken.poses.swap(poses_);
+  poses_.clear();
   taken.commands.assign(commands_.begin(), commands_.end());
   commands_.clear();
   return taken;

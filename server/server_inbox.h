@@ -1,5 +1,6 @@
 // The hand-over from the LCM receive thread to the solve thread: the newest device pose
-// (latest wins: a pose that arrives before the solver took the previous one replaces it,
+// of each grasp (issue 15; device_state_t.grasp) (latest wins: a pose that arrives before
+// the solver took the previous one of its grasp replaces it,
 // so the solver never works through a queue of stale poses) and a short FIFO of commands
 // (commands are rare and must not be lost). One mutex and one condition variable; the
 // receive thread is not real-time, so blocking for a few microseconds is fine there.
@@ -29,9 +30,12 @@ class ServerInbox {
   using Clock = std::chrono::steady_clock;
   // Commands beyond this many unprocessed ones are refused (a flood, not a user).
   static constexpr size_t kMaxPendingCommands = 64;
+  // Grasps with a pending pose at once; a pose for a further grasp name is dropped (and
+  // reported as superseded) until the solver took the others.
+  static constexpr size_t kMaxGrasps = 8;
 
-  // Stores the pose as the newest. True when it superseded a pose nobody took (the
-  // caller counts it as a dropped pose).
+  // Stores the pose as the newest of its grasp. True when it superseded a pose nobody
+  // took, or was dropped (kMaxGrasps) (the caller counts it as a dropped pose).
   bool PutPose(const PoseSample& pose);
   // Queues a command. False when the queue is full (the command is refused).
   bool PushCommand(const command_t& command);
@@ -40,7 +44,7 @@ class ServerInbox {
 
   struct Taken {
     bool stop = false;
-    std::optional<PoseSample> pose;
+    std::vector<PoseSample> poses;  // the newest of each grasp, in order of arrival
     std::vector<command_t> commands;
   };
   // Blocks until a pose or command is pending, stop was requested, or `deadline`;
@@ -50,7 +54,7 @@ class ServerInbox {
  private:
   std::mutex mutex_;
   std::condition_variable cv_;
-  std::optional<PoseSample> pose_;
+  std::vector<PoseSample> poses_;
   std::deque<command_t> commands_;
   bool stop_ = false;
 };

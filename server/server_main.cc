@@ -107,6 +107,13 @@ int main(int argc, char** argv) {
                  "Checkpoint the scene, method, grasp and state here (>= 5 Hz, atomically); "
                  "restarted with the same directory and --session the server resumes on the "
                  "same branch. Made (mode 0700) when missing. Default: no checkpoints");
+  app.add_option("--max-update-hz", params.max_update_hz,
+                 "At most this many equilibrium updates per second (0 = the scene's "
+                 "solver.max_update_hz; none there: no cap)")
+      ->check(CLI::NonNegativeNumber);
+  bool no_snap_ahead = false;
+  app.add_flag("--no-snap-ahead", no_snap_ahead,
+               "Do not send fold boundaries and post-snap models (snap-ahead, docs/snap-ahead.md)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -120,6 +127,7 @@ int main(int argc, char** argv) {
     return kExitUsage;
   }
 
+  params.snap_ahead = !no_snap_ahead;
   std::string error;
   if (!params.IsValid(&error)) return Usage(error);
   {

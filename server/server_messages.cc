@@ -78,14 +78,16 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
   const int dim = std::min(model.SpatialDimension(), 3);
   m.iterations = r.summary.iterations;
   m.residual = Finite(r.summary.residual) ? r.summary.residual : 0.0;
-  if (!ResultIsUsable(r, nu) || in.u.size() != nu || dim > nu) return m;
+  const int off = in.grasp_offset;
+  const int gnu = in.grasp_controls > 0 ? in.grasp_controls : nu;
+  if (!ResultIsUsable(r, nu) || in.u.size() != nu || dim > gnu || off < 0 || off + gnu > nu) return m;
 
   // Device force F_dev = N F_model; u_model = origin + s p  =>  dF_dev/dp = N s K_model.
   const double n_per_f = map.newtons_per_model_force;
   const double s = map.model_units_per_metre;
   for (int i = 0; i < dim; ++i) {
-    m.f0[i] = n_per_f * r.force[i];
-    for (int j = 0; j < dim; ++j) m.K[i][j] = n_per_f * s * r.stiffness(i, j);
+    m.f0[i] = n_per_f * r.force[off + i];
+    for (int j = 0; j < dim; ++j) m.K[i][j] = n_per_f * s * r.stiffness(off + i, off + j);
   }
   if (dim == 2) {
     // Planar models have no z: without a constraint the hand would drift freely out of
@@ -98,12 +100,12 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
     m.f0[2] = -k_plane * (m.u0[2] - messages::PlanarZ0(map));
     m.K[2][2] = -k_plane;
   }
-  if (nu >= dim + 3 && dim == 3) {
+  if (gnu >= dim + 3 && dim == 3) {
     // Grip direction d = u[3:6] (unit): the generalised force F_d = -E_d gives the torque
     // on the grip tau = d x F_d (a rotation w moves d by w x d, dE = w . (d x E_d)).
     // F_d is in model energy units = model force x model length: N / (units per metre).
-    const Eigen::Vector3d d = in.u.segment<3>(3).normalized();
-    const Eigen::Vector3d fd = r.force.segment<3>(3);
+    const Eigen::Vector3d d = in.u.segment<3>(off + 3).normalized();
+    const Eigen::Vector3d fd = r.force.segment<3>(off + 3);
     const Eigen::Vector3d tau = d.cross(fd) * (n_per_f / s);
     for (int i = 0; i < 3; ++i) m.torque0[i] = tau[i];
     m.has_torque = 1;
@@ -124,6 +126,7 @@ thread_shape_t BuildShape(const ShapeInputs& in) {
   msg.scene = in.scene;
   msg.status = in.status;
   msg.snaps = in.snaps;
+  msg.knot = in.knot;
   for (int i = 0; i < 3; ++i) {
     msg.grasp[i] = 0.0;
     msg.grip_direction[i] = 0.0;
@@ -193,6 +196,9 @@ solver_status_t BuildSolverStatus(const StatusInputs& in) {
   msg.dropped_poses = in.dropped_poses;
   msg.rejected_messages = in.rejected_messages;
   msg.contacts = in.contacts;
+  msg.knot = in.knot;
+  msg.knot_determinant = in.knot_determinant;
+  msg.max_update_hz = Finite(in.max_update_hz) ? in.max_update_hz : 0.0;
   return msg;
 }
 

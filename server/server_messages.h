@@ -45,6 +45,11 @@ struct ForceModelInputs {
   double solve_us = 0.0;
   int64_t seq = 0;
   int64_t utime = 0;                  // CLOCK_REALTIME now
+  // The grasp the model is for (issue 15): its controls u[offset, offset + count) and its
+  // block of F and K (count 0: all the model's controls, the single grasp). The server's
+  // predictor keeps the cross terms; the device gets its own block.
+  int grasp_offset = 0;
+  int grasp_controls = 0;
 };
 force_model_t BuildForceModel(const ForceModelInputs& in);
 
@@ -58,6 +63,7 @@ struct ShapeInputs {
   Eigen::Vector3d force_newtons = Eigen::Vector3d::Zero();
   int8_t status = force_model_t::STATUS_REGULAR;
   int64_t snaps = 0;
+  std::string knot;      // the shape's knot type (KnotWatch), "" = not computed
   int64_t seq = 0;
   int64_t utime = 0;
 };
@@ -76,6 +82,9 @@ struct StatusInputs {
   int64_t dropped_poses = 0;
   int64_t rejected_messages = 0;
   int32_t contacts = 0;  // active self-contact pairs at the last update
+  std::string knot;              // KnotWatch: "" = not computed
+  int32_t knot_determinant = 0;  // 0 = not computed
+  double max_update_hz = 0.0;  // the update cap in force (0 = none)
   int64_t seq = 0;
   int64_t utime = 0;
 };

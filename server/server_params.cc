@@ -70,6 +70,10 @@ bool ServerParams::IsValid(std::string* error) const {
     return Fail(error, "checkpoint rate: must be in [5, 1000] Hz, got " +
                            std::to_string(checkpoint_rate_hz));
   }
+  if (!std::isfinite(max_update_hz) || max_update_hz < 0.0 || max_update_hz > 100000.0) {
+    return Fail(error, "--max-update-hz: must be in [0, 100000] (0 = the scene's), got " +
+                           std::to_string(max_update_hz));
+  }
   if (!IsKnownLogLevel(log_level)) {
     return Fail(error, "--log-level: unknown level '" + log_level +
                            "' (expected trace, debug, info, warn, error, critical or off)");

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "fold_boundary.h"
 #include "scene/scene.h"
 #include "server.h"
 #include "tracking/tracker.h"
@@ -19,6 +20,8 @@ struct Server::Session {
   Eigen::Vector3d rest_direction = Eigen::Vector3d::UnitX();
   // The scene's YAML as loaded, for checkpoints (empty without --state-dir).
   std::string scene_text;
+  // Snap-ahead (issue 17): null with --no-snap-ahead.
+  std::unique_ptr<FoldBoundary> fold;
 };
 
 }  // namespace snapthread::server

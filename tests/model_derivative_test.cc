@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdlib>
+#include <cstring>
+#include <limits>
 #include <ostream>
 #include <random>
 #include <stdexcept>
@@ -402,6 +404,8 @@ TEST_P(ModelDerivativeTest, PresizedOutputsAreReusedWithoutAllocation) {
     m.ControlGradient(pt.x, pt.u, &eu);
     m.MixedHessian(pt.x, pt.u, &exu);
     m.ControlHessian(pt.x, pt.u, &euu);
+    m.GradientAndHessian(pt.x, pt.u, &g, &h);
+    m.ControlDerivatives(pt.x, pt.u, &eu, &exu, &euu);
   }
   counter.Stop();
   EXPECT_EQ(counter.mallocs(), 0) << "evaluation allocated on presized outputs";
@@ -413,6 +417,41 @@ TEST_P(ModelDerivativeTest, PresizedOutputsAreReusedWithoutAllocation) {
   EXPECT_EQ(exu.data(), exu_data);
   // And the values were written (not left at the pattern's zeros).
   EXPECT_GT(Mat(h).norm(), 0.0);
+}
+
+// The fused evaluations (one pass over the terms) give the separate ones' values to the
+// last bit, and E_xx does not depend on what the matrix held before (the assembly stores
+// each slot's first contribution instead of clearing): the solvers rely on both.
+TEST_P(ModelDerivativeTest, FusedEvaluationsEqualSeparateOnesBitForBit) {
+  const Model& m = *model_;
+  for (const Point& pt : RandomPoints(m, GetParam().params, 3, 4242u)) {
+    Vec g, g2;
+    SparseMatrix h, h2 = m.HessianPattern();
+    m.Gradient(pt.x, pt.u, &g);
+    m.Hessian(pt.x, pt.u, &h);
+    std::fill(h2.valuePtr(), h2.valuePtr() + h2.nonZeros(), std::numeric_limits<double>::quiet_NaN());
+    m.GradientAndHessian(pt.x, pt.u, &g2, &h2);
+    ASSERT_EQ(g2.size(), g.size());
+    ASSERT_EQ(h2.nonZeros(), h.nonZeros());
+    EXPECT_EQ(std::memcmp(g.data(), g2.data(), sizeof(double) * g.size()), 0) << "E_x";
+    EXPECT_EQ(std::memcmp(h.valuePtr(), h2.valuePtr(), sizeof(double) * h.nonZeros()), 0) << "E_xx";
+    m.Hessian(pt.x, pt.u, &h2);  // over the previous values: still the same
+    EXPECT_EQ(std::memcmp(h.valuePtr(), h2.valuePtr(), sizeof(double) * h.nonZeros()), 0) << "E_xx again";
+
+    Vec eu, eu2;
+    Mat exu, exu2, euu, euu2;
+    m.ControlGradient(pt.x, pt.u, &eu);
+    m.MixedHessian(pt.x, pt.u, &exu);
+    m.ControlHessian(pt.x, pt.u, &euu);
+    m.ControlDerivatives(pt.x, pt.u, &eu2, &exu2, &euu2);
+    ASSERT_EQ(eu2.size(), eu.size());
+    ASSERT_EQ(exu2.rows(), exu.rows());
+    ASSERT_EQ(exu2.cols(), exu.cols());
+    ASSERT_EQ(euu2.rows(), euu.rows());
+    EXPECT_EQ(std::memcmp(eu.data(), eu2.data(), sizeof(double) * eu.size()), 0) << "E_u";
+    EXPECT_EQ(std::memcmp(exu.data(), exu2.data(), sizeof(double) * exu.size()), 0) << "E_xu";
+    EXPECT_EQ(std::memcmp(euu.data(), euu2.data(), sizeof(double) * euu.size()), 0) << "E_uu";
+  }
 }
 
 TEST_P(ModelDerivativeTest, WrongSizedOutputsAreResized) {

@@ -73,11 +73,18 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
 }
 
 void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out,
-                   const GraspLayout& layout) {
+                   const GraspLayout& layout, int num_grasps) {
   const bool rotation = layout.grip_rotation;
   out << "step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,"
          "solve_us,status,termination,gradient_evals,hessian_evals"
-      << (rotation ? ",roll_deg,t_x,t_y,t_z,negative_pivots" : "") << '\n';
+      << (rotation ? ",roll_deg,t_x,t_y,t_z,negative_pivots" : "");
+  // Further grasps (issue 15): u2_*, f2_*, u3_*, ... after every single-grasp column.
+  for (int g = 2; g <= num_grasps; ++g) {
+    for (const char* q : {"u", "f"})
+      for (const char* c : {"x", "y", "z"}) out << ',' << q << g << '_' << c;
+  }
+  out << '\n';
+  const int m = layout.NumControls();
   out << std::setprecision(12);
   for (const SweepRow& r : rows) {
     auto comp = [](const Vec& v, int i) { return i < v.size() ? v[i] : 0.0; };
@@ -91,6 +98,10 @@ void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method,
     if (rotation) {
       out << ',' << comp(r.u, 3) * 180.0 / std::numbers::pi << ',' << r.torque.x() << ',' << r.torque.y()
           << ',' << r.torque.z() << ',' << r.negative_pivots;
+    }
+    for (int g = 1; g < num_grasps; ++g) {
+      for (const Vec* v : {&r.u, &r.force})
+        for (int c = 0; c < 3; ++c) out << ',' << (c < layout.spatial_dimension ? comp(*v, g * m + c) : 0.0);
     }
     out << '\n';
   }

@@ -38,7 +38,7 @@ struct SweepRow {
 // scene stays at the scene's grasp direction).
 std::vector<Vec> SweepControls(const Scene& scene, const SweepSpec& spec);
 
-// The scene's grasp.path, each leg cut into `steps_per_leg` equal steps (positions
+// The scene's grasp.path (every grasp's, issue 15), each leg cut into `steps_per_leg` equal steps (positions
 // linear, grip directions normalised-linear); first waypoint first.
 std::vector<Vec> PathControls(const Scene& scene, int steps_per_leg);
 
@@ -52,8 +52,10 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
 // roll_deg (the x component of the grasp's rotation vector, degrees: the roll about the
 // start tangent), t_x,t_y,t_z (Model::GraspTorque: the torque of the model on the hand
 // about the grasp point, world frame) and negative_pivots (the inertia of E_xx: an unstable equilibrium has > 0).
+// A scene with several grasps keeps those columns for its first grasp and adds, at the
+// end, u2_x,u2_y,u2_z,f2_x,f2_y,f2_z for the second (u3_*, f3_* for a third, ...).
 void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out,
-                   const GraspLayout& layout = {});
+                   const GraspLayout& layout = {}, int num_grasps = 1);
 
 // Node positions of every row (Model::NodePositions): step,node,x,y,z, for drawing.
 void WriteShapeCsv(const std::vector<SweepRow>& rows, const Model& model, std::ostream& out);

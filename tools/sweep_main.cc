@@ -1,5 +1,6 @@
 // snapthread-sweep: offline quasi-static sweep of a scene along a straight control path,
 // one CSV row per step.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -38,7 +39,8 @@ int main(int argc, char** argv) {
   app.add_option("--set", sets, "override a scene key, e.g. --set params.n=20 (repeatable)");
   app.add_option("--out", out_file, "CSV output file (default: standard output)");
   std::string shape_file;
-  app.add_option("--shape-out", shape_file, "also write every row's node positions (step,node,x,y,z) to this CSV");
+  app.add_option("--shape-out,--shapes-out", shape_file,
+                 "also write every row's node positions (step,node,x,y,z) to this CSV");
   // The models a scene may name, with their parameters (--set params.<name>=...).
   app.footer("Models (scene key `model:`):\n" + ModelHelp());
   const auto run = [&]() -> int {
@@ -87,11 +89,11 @@ int main(int argc, char** argv) {
       WriteShapeCsv(rows, tracker->model(), shapes);
     }
     if (out_file.empty()) {
-      WriteSweepCsv(rows, scene.solver.method, std::cout, scene.grasp_layout);
+      WriteSweepCsv(rows, scene.solver.method, std::cout, scene.grasp_layout, std::max<int>(1, static_cast<int>(scene.grasps.size())));
     } else {
       std::ofstream out(out_file);
       if (!out) throw std::runtime_error("--out: cannot write '" + out_file + "'");
-      WriteSweepCsv(rows, scene.solver.method, out, scene.grasp_layout);
+      WriteSweepCsv(rows, scene.solver.method, out, scene.grasp_layout, std::max<int>(1, static_cast<int>(scene.grasps.size())));
     }
     return 0;
   };

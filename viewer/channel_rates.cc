@@ -1,12 +1,14 @@
 #include "channel_rates.h"
 
+#include "messages/subscribe.h"
+
 #include <cstdio>
 
 namespace snapthread::viewer {
 
 ChannelRateMonitor::ChannelRateMonitor(lcm::LCM* lcm, const std::string& channel_regex)
     : lcm_(lcm) {
-  subscription_ = lcm_->subscribe(channel_regex, &ChannelRateMonitor::OnMessage, this);
+  subscription_ = messages::Subscribe<&ChannelRateMonitor::OnMessage>(lcm_, channel_regex, this);
 }
 
 ChannelRateMonitor::~ChannelRateMonitor() {

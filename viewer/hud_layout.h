@@ -21,7 +21,7 @@ struct HudLayout {
 
 inline HudLayout MakeHudLayout(int width, int height) {
   HudLayout l;
-  l.text = {8, 8, 300, 190};
+  l.text = {8, 8, 300, 215};  // up to 11 lines of 1.5x stb_easy_font (18 px each)
   const int cw = width * 3 / 10 > 160 ? width * 3 / 10 : 160;
   const int ch = height / 5 > 70 ? height / 5 : 70;
   l.chart = {width - cw - 10, height - ch - 10, cw, ch};

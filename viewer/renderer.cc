@@ -8,6 +8,7 @@
 #include <stb_easy_font.h>
 
 #include "hud_layout.h"
+#include "marker_colors.h"
 #include "spline.h"
 #include "models/registry.h"
 
@@ -214,6 +215,35 @@ void Renderer::BuildChart(const SessionSnapshot& s, int width, int height) {
   }
 }
 
+void Renderer::AppendForceArrow(const Eigen::Vector3d& at, const Eigen::Vector3d& f,
+                                double extent, double radius) {
+  const double fn = f.norm();
+  force_scale_n_ = std::max(force_scale_n_, fn);
+  if (fn > 1e-12 && force_scale_n_ > 0) {
+    const double len = 0.3 * extent * std::clamp(fn / force_scale_n_, 0.05, 1.0);
+    scene_.AppendArrow(at, at + len * f / fn, 0.6 * radius, kForceArrowColor);
+  }
+}
+
+void Renderer::AppendGraspsAndContacts(const thread_shape_t& shape, double extent,
+                                       double radius) {
+  for (int g = 0; g < shape.num_grasps; ++g) {
+    const auto& row = shape.grasps[g];
+    const Eigen::Vector3d at(row[0], row[1], row[2]);
+    scene_.AppendSphere(at, 2.0 * radius, GraspColor(g));
+    AppendForceArrow(at, Eigen::Vector3d(row[3], row[4], row[5]), extent, radius);
+  }
+  // Contacts: a bead on each of the two closest points and the segment joining them, drawn
+  // over the thread (their own depth only): the closest points lie inside the tube.
+  for (int c = 0; c < shape.num_contacts; ++c) {
+    const auto& row = shape.contacts[c];
+    const Eigen::Vector3d a(row[0], row[1], row[2]), b(row[3], row[4], row[5]);
+    highlights_.AppendSphere(a, 1.2 * radius, kContactColor);
+    highlights_.AppendSphere(b, 1.2 * radius, kContactColor);
+    if ((b - a).norm() > 1e-12) highlights_.AppendTube({a, b}, 0.5 * radius, 8, kContactColor);
+  }
+}
+
 void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int width, int height,
                     const FrameInfo& info) {
   glViewport(0, 0, width, height);
@@ -221,6 +251,7 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glUseProgram(program_);
   scene_.Clear();
+  highlights_.Clear();
   overlay_triangles_.clear();
   overlay_lines_.clear();
 
@@ -244,23 +275,25 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
                       kTubeSides, StatusColor(shape.status));
     scene_.AppendSphere(nodes.front(), 2.2 * radius, {0.6f, 0.6f, 0.62f});  // clamp
     const Eigen::Vector3d grasp(shape.grasp[0], shape.grasp[1], shape.grasp[2]);
-    scene_.AppendSphere(grasp, 2.0 * radius,
-                        info.dragging ? Rgb(1.0f, 1.0f, 0.5f) : Rgb(1.0f, 0.85f, 0.2f));
+    // With named grasps every row is drawn (the first is the legacy grasp); otherwise the
+    // single grasp, which the mouse may be dragging.
+    if (shape.num_grasps == 0) {
+      scene_.AppendSphere(grasp, 2.0 * radius,
+                          info.dragging ? Rgb(1.0f, 1.0f, 0.5f) : GraspColor(0));
+    }
     const Eigen::Vector3d d(shape.grip_direction[0], shape.grip_direction[1],
                             shape.grip_direction[2]);
     if (d.norm() > 1e-9) {
       scene_.AppendArrow(grasp, grasp + 0.12 * extent * d.normalized(), 0.5 * radius,
                          {0.8f, 0.4f, 0.9f});
     }
-    // Force arrow: direction of the model force, length relative to the largest |F| seen,
-    // so the arrow stays readable for any scene's force scale.
-    const Eigen::Vector3d f(shape.force[0], shape.force[1], shape.force[2]);
-    const double fn = f.norm();
-    force_scale_n_ = std::max(force_scale_n_, fn);
-    if (fn > 1e-12 && force_scale_n_ > 0) {
-      const double len = 0.3 * extent * std::clamp(fn / force_scale_n_, 0.05, 1.0);
-      scene_.AppendArrow(grasp, grasp + len * f / fn, 0.6 * radius, {1.0f, 0.35f, 0.25f});
+    // Force arrows: direction of the model force, length relative to the largest |F| seen,
+    // so the arrows stay readable for any scene's force scale.
+    if (shape.num_grasps == 0) {
+      AppendForceArrow(grasp, Eigen::Vector3d(shape.force[0], shape.force[1], shape.force[2]),
+                       extent, radius);
     }
+    AppendGraspsAndContacts(shape, extent, radius);
   }
 
   const double aspect = double(width) / height;
@@ -270,6 +303,10 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
   const float light[3] = {float(l.x()), float(l.y()), float(l.z())};
   glEnable(GL_DEPTH_TEST);
   DrawVertices(scene_.vertices(), GL_TRIANGLES, mvp, light);
+  if (!highlights_.vertices().empty()) {
+    glClear(GL_DEPTH_BUFFER_BIT);
+    DrawVertices(highlights_.vertices(), GL_TRIANGLES, mvp, light);
+  }
 
   // Overlay in pixel coordinates (origin top-left, y down).
   char line[256];
@@ -299,6 +336,21 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
                   s.status.method.c_str(), s.status.iterations, s.status.residual,
                   s.status.lambda_min, s.status.update_rate_hz, s.status.solve_us_p50,
                   s.status.solve_us_p99, static_cast<long long>(s.status.dropped_poses));
+    text += line;
+  }
+  if (s.has_shape || s.has_status) {
+    // The knot type (issue 15): the status's, with its determinant, else the shape's; the
+    // contacts of the shape drawn, else the status's count.
+    const bool status_knot = s.has_status && !s.status.knot.empty();
+    const std::string& knot = status_knot ? s.status.knot : s.shape.knot;
+    std::snprintf(line, sizeof line, "knot %s", knot.empty() ? "-" : knot.c_str());
+    text += line;
+    if (status_knot && s.status.knot_determinant > 0) {
+      std::snprintf(line, sizeof line, " (det %d)", s.status.knot_determinant);
+      text += line;
+    }
+    const int contacts = s.has_shape ? s.shape.num_contacts : s.status.contacts;
+    std::snprintf(line, sizeof line, "  contacts %d\n", contacts);
     text += line;
   }
   if (info.grasp_mode) text += info.dragging ? "GRASP: dragging\n" : "GRASP mode: drag the grasp\n";

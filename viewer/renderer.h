@@ -1,6 +1,6 @@
 // OpenGL 3.3 core drawing of one frame: the thread as a lit tube along the spline through
-// its nodes, clamp, grasp, grip direction, force arrow, status text and a |force| strip
-// chart. Needs a current GL context (GLFW + libepoxy); all geometry is rebuilt per frame
+// its nodes, clamp, grasps, grip direction, force arrows, active contacts, status text
+// (with the knot type) and a |force| strip chart. Needs a current GL context (GLFW + libepoxy); all geometry is rebuilt per frame
 // (a few thousand vertices) and streamed in one buffer.
 #pragma once
 
@@ -46,6 +46,10 @@ class Renderer {
   void AppendRect(float x0, float y0, float x1, float y1, const Rgb& color);
   void AppendLine(float x0, float y0, float x1, float y1, const Rgb& color);
   void BuildChart(const SessionSnapshot& s, int width, int height);
+  void AppendForceArrow(const Eigen::Vector3d& at, const Eigen::Vector3d& f, double extent,
+                        double radius);
+  // Every grasp of thread_shape_t.grasps with its force arrow, and every active contact.
+  void AppendGraspsAndContacts(const thread_shape_t& shape, double extent, double radius);
 
   GLuint program_ = 0;
   GLuint vao_ = 0;
@@ -53,6 +57,7 @@ class Renderer {
   GLint mvp_location_ = -1;
   GLint light_location_ = -1;
   MeshBuilder scene_;
+  MeshBuilder highlights_;  // drawn over scene_ (active contacts)
   std::vector<Vertex> overlay_triangles_;
   std::vector<Vertex> overlay_lines_;
   static constexpr int kMaxTextQuads = 4000;  // per AppendText call (~ 40 lines of text)

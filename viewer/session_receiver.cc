@@ -8,6 +8,7 @@
 
 #include "shape_check.h"
 #include "messages/channels.h"
+#include "messages/subscribe.h"
 
 namespace snapthread::viewer {
 
@@ -17,8 +18,10 @@ SessionReceiver::SessionReceiver(lcm::LCM* lcm, const std::string& session,
       key_(key),
       shape_channel_(transport::Channels(session).shape),
       status_channel_(transport::Channels(session).solver_status) {
-  lcm::Subscription* shapes = lcm_->subscribe(shape_channel_, &SessionReceiver::OnShape, this);
-  lcm::Subscription* statuses = lcm_->subscribe(status_channel_, &SessionReceiver::OnStatus, this);
+  lcm::Subscription* shapes =
+      messages::Subscribe<&SessionReceiver::OnShape>(lcm_, shape_channel_, this);
+  lcm::Subscription* statuses =
+      messages::Subscribe<&SessionReceiver::OnStatus>(lcm_, status_channel_, this);
   // LCM's reader thread drops what arrives while a subscription's queue is full (its
   // default is 30 messages). Statuses (10 Hz) only update the overlay; every shape counts.
   if (shapes != nullptr) shapes->setQueueCapacity(kShapeQueue);

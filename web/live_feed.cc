@@ -8,6 +8,7 @@
 #include "message_json.h"
 #include "messages/channels.h"
 #include "messages/lcm_url.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "snapthread/device_status_t.hpp"
 #include "snapthread/force_model_t.hpp"
@@ -46,10 +47,15 @@ LiveFeed::LiveFeed(const std::string& lcm_url, const std::string& session,
   const transport::Channels channels(session);
   // Shapes come at ~60 Hz and force models at the update rate; LCM's default queue of 30
   // would drop bursts while this thread is off the CPU, so give them seconds of room.
-  auto* shape = lcm_.subscribe(channels.shape, &LiveFeed::OnMessage<thread_shape_t>, this);
-  auto* model = lcm_.subscribe(channels.force_model, &LiveFeed::OnMessage<force_model_t>, this);
-  auto* solver = lcm_.subscribe(channels.solver_status, &LiveFeed::OnMessage<solver_status_t>, this);
-  auto* device = lcm_.subscribe(channels.device_status, &LiveFeed::OnMessage<device_status_t>, this);
+  // (messages::Subscribe, not lcm_.subscribe: see messages/subscribe.h.)
+  auto* shape =
+      messages::Subscribe<&LiveFeed::OnMessage<thread_shape_t>>(lcm_, channels.shape, this);
+  auto* model =
+      messages::Subscribe<&LiveFeed::OnMessage<force_model_t>>(lcm_, channels.force_model, this);
+  auto* solver = messages::Subscribe<&LiveFeed::OnMessage<solver_status_t>>(
+      lcm_, channels.solver_status, this);
+  auto* device = messages::Subscribe<&LiveFeed::OnMessage<device_status_t>>(
+      lcm_, channels.device_status, this);
   if (shape) shape->setQueueCapacity(240);
   if (model) model->setQueueCapacity(4000);
   subscriptions_ = {shape, model, solver, device};

@@ -41,18 +41,33 @@ class ChainModel : public Model {
   const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
 
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
-    const SparseMatrix& pattern = assembly_.Pattern();
-    const int nx = NumStates();
-    if (h->rows() != nx || h->cols() != nx || h->nonZeros() != pattern.nonZeros() || !h->isCompressed()) {
-      *h = pattern;
-    }
-    double* values = h->valuePtr();
-    std::fill(values, values + pattern.nonZeros(), 0.0);
+    double* values = HessianValues(h);
+    // StoreHessian: every chain slot is reached by a chain term first, so no clearing pass;
+    // slots only a contact pair reaches are cleared when the model has contact.
+    if (chain_terms_ < assembly_.NumTerms()) std::fill(values, values + h->nonZeros(), 0.0);
     for (int t = 0; t < chain_terms_; ++t) {
       Self().Local(t, x, u, /*want_h=*/true, [&](const double*, const double* lh, int ld) {
-        assembly_.AddHessian(t, lh, ld, values);
+        assembly_.StoreHessian(t, lh, ld, values);
       });
     }
+    Self().AddContactHessian(x, u, values);
+  }
+
+  // One pass over the terms for both: each term's local derivatives are computed once
+  // (Gradient() alone costs a third of Hessian()). The same operations as the two
+  // separate passes, so the same bits.
+  void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override {
+    if (g->size() != NumStates()) g->resize(NumStates());
+    g->setZero();
+    double* values = HessianValues(h);
+    if (chain_terms_ < assembly_.NumTerms()) std::fill(values, values + h->nonZeros(), 0.0);
+    for (int t = 0; t < chain_terms_; ++t) {
+      Self().Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int ld) {
+        assembly_.AddGradient(t, lg, g->data());
+        assembly_.StoreHessian(t, lh, ld, values);
+      });
+    }
+    Self().AddContactGradient(x, u, g);
     Self().AddContactHessian(x, u, values);
   }
 
@@ -89,6 +104,27 @@ class ChainModel : public Model {
         assembly_.AddControlHessian(t, lh, ld, euu);
       });
     }
+    Self().AddContactControlHessian(x, u, euu);
+  }
+
+  // One pass over the control terms for all three (the same operations, the same bits).
+  void ControlDerivatives(const Vec& x, const Vec& u, Vec* eu, Mat* exu, Mat* euu) const override {
+    const int nx = NumStates(), nu = NumControls();
+    if (eu->size() != nu) eu->resize(nu);
+    if (exu->rows() != nx || exu->cols() != nu) exu->resize(nx, nu);
+    if (euu->rows() != nu || euu->cols() != nu) euu->resize(nu, nu);
+    eu->setZero();
+    exu->setZero();
+    euu->setZero();
+    for (int t : control_terms_) {
+      Self().Local(t, x, u, true, [&](const double* lg, const double* lh, int ld) {
+        assembly_.AddControlGradient(t, lg, eu->data());
+        assembly_.AddMixedHessian(t, lh, ld, exu);
+        assembly_.AddControlHessian(t, lh, ld, euu);
+      });
+    }
+    Self().AddContactControlGradient(x, u, eu);
+    Self().AddContactMixedHessian(x, u, exu);
     Self().AddContactControlHessian(x, u, euu);
   }
 
@@ -154,6 +190,15 @@ class ChainModel : public Model {
 
  private:
   const Derived& Self() const { return static_cast<const Derived&>(*this); }
+  // h with the pattern's structure (set on first use); its values to be stored.
+  double* HessianValues(SparseMatrix* h) const {
+    const SparseMatrix& pattern = assembly_.Pattern();
+    const int nx = NumStates();
+    if (h->rows() != nx || h->cols() != nx || h->nonZeros() != pattern.nonZeros() || !h->isCompressed()) {
+      *h = pattern;
+    }
+    return h->valuePtr();
+  }
 
   std::vector<int> control_terms_;
 };

@@ -54,6 +54,7 @@ void HessianAssembly::Finalize() {
   runs_.clear();
   const int* outer = pattern_.outerIndexPtr();
   const int* inner = pattern_.innerIndexPtr();
+  std::vector<char> reached(pattern_.nonZeros(), 0);
   for (int t = 0; t < terms; ++t) {
     run_begin_[t] = static_cast<int>(runs_.size());
     const int* v = TermVars(t);
@@ -67,18 +68,35 @@ void HessianAssembly::Finalize() {
         const int* it = std::lower_bound(first, last, v[i]);
         assert(it != last && *it == v[i]);
         const int index = static_cast<int>(it - inner);
+        const bool is_first = reached[index] == 0;
+        reached[index] = 1;
         if (!runs_.empty() && static_cast<int>(runs_.size()) > run_begin_[t]) {
           Run& run = runs_.back();
-          if (run.local_col == j && run.local_row + run.len == i && run.value + run.len == index) {
+          if (run.local_col == j && run.local_row + run.len == i && run.value + run.len == index &&
+              run.first == is_first) {
             ++run.len;
             continue;
           }
         }
-        runs_.push_back({i, j, 1, index});
+        runs_.push_back({i, j, 1, index, is_first});
       }
     }
   }
   run_begin_[terms] = static_cast<int>(runs_.size());
+
+  store_begin_.assign(4 * terms + 1, 0);
+  store_runs_.clear();
+  for (int t = 0; t < terms; ++t) {
+    for (int k = 0; k < 4; ++k) {
+      store_begin_[4 * t + k] = static_cast<int>(store_runs_.size());
+      for (int r = run_begin_[t]; r < run_begin_[t + 1]; ++r) {
+        const Run& run = runs_[r];
+        const int kind = (run.len == 3 ? 0 : 2) + (run.first ? 0 : 1);
+        if (kind == k) store_runs_.push_back(run);
+      }
+    }
+  }
+  store_begin_[4 * terms] = static_cast<int>(store_runs_.size());
 }
 
 void HessianAssembly::AddGradient(int term, const double* local_g, double* g) const {
@@ -101,6 +119,32 @@ void HessianAssembly::AddHessian(int term, const double* local_h, int ld, double
   const Run* run = runs_.data() + run_begin_[term];
   const Run* end = runs_.data() + run_begin_[term + 1];
   for (; run != end; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    for (int r = 0; r < run->len; ++r) dst[r] += src[r];
+  }
+}
+
+void HessianAssembly::StoreHessian(int term, const double* local_h, int ld, double* values) const {
+  const Run* runs = store_runs_.data();
+  const int* begin = store_begin_.data() + 4 * term;
+  // A node's three coordinates make most runs 3 long: those unrolled.
+  for (const Run* run = runs + begin[0]; run != runs + begin[1]; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    dst[0] = src[0], dst[1] = src[1], dst[2] = src[2];
+  }
+  for (const Run* run = runs + begin[1]; run != runs + begin[2]; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    dst[0] += src[0], dst[1] += src[1], dst[2] += src[2];
+  }
+  for (const Run* run = runs + begin[2]; run != runs + begin[3]; ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = values + run->value;
+    for (int r = 0; r < run->len; ++r) dst[r] = src[r];
+  }
+  for (const Run* run = runs + begin[3]; run != runs + begin[4]; ++run) {
     const double* src = local_h + run->local_row + run->local_col * ld;
     double* dst = values + run->value;
     for (int r = 0; r < run->len; ++r) dst[r] += src[r];

@@ -57,6 +57,11 @@ class HessianAssembly {
   void AddControlGradient(int term, const double* local_g, double* eu) const;
   // `values` is valuePtr() of a matrix with exactly Pattern()'s structure.
   void AddHessian(int term, const double* local_h, int ld, double* values) const;
+  // The same sum without clearing `values` first: the first term (in term order) to
+  // reach a slot stores into it, later ones add. Call it for every term, in order
+  // 0 .. NumTerms() - 1. 0 + h == h exactly, so the result is AddHessian's on a zeroed
+  // matrix to the last bit, without a pass that clears the whole matrix.
+  void StoreHessian(int term, const double* local_h, int ld, double* values) const;
   // exu: num_states x num_controls, euu: num_controls x num_controls (presized).
   void AddMixedHessian(int term, const double* local_h, int ld, Mat* exu) const;
   void AddControlHessian(int term, const double* local_h, int ld, Mat* euu) const;
@@ -75,9 +80,16 @@ class HessianAssembly {
     int local_col;
     int len;
     int value;
+    bool first;  // the first term to reach these slots (StoreHessian stores, not adds)
   };
   std::vector<int> run_begin_;        // term t's runs are runs_[run_begin_[t], run_begin_[t+1])
   std::vector<Run> runs_;
+  // The same runs for StoreHessian, grouped per term into four loops without branches:
+  // first-reached runs of 3, other runs of 3, first-reached others, other others
+  // (store_begin_[4 t + k] .. store_begin_[4 t + k + 1]). A slot appears once per term,
+  // so the order of the runs within a term does not change any sum.
+  std::vector<int> store_begin_;
+  std::vector<Run> store_runs_;
   std::vector<char> touches_controls_;
   SparseMatrix pattern_;
   int bandwidth_ = 0;

@@ -55,12 +55,25 @@ class Model {
   // E_xx with the fixed pattern of HessianPattern().
   virtual const SparseMatrix& HessianPattern() const = 0;
   virtual void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const = 0;
+  // E_x and E_xx at one state, the same values as Gradient() and Hessian(); a model may
+  // fuse the two passes over its terms (the solvers call this where both are needed).
+  virtual void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
+    Gradient(x, u, g);
+    Hessian(x, u, h);
+  }
   // E_u, size NumControls(). The force on the grasp is F = -E_u (envelope theorem, §2.3.4).
   virtual void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const = 0;
   // E_xu, NumStates() x NumControls() (dense: only a few rows are non-zero).
   virtual void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const = 0;
   // E_uu, NumControls() x NumControls().
   virtual void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const = 0;
+  // E_u, E_xu and E_uu at one state, the same values as the three above; a model may
+  // fuse their passes over the terms that touch the controls (the tracker's force and K).
+  virtual void ControlDerivatives(const Vec& x, const Vec& u, Vec* eu, Mat* exu, Mat* euu) const {
+    ControlGradient(x, u, eu);
+    MixedHessian(x, u, exu);
+    ControlHessian(x, u, euu);
+  }
   // A grasp that holds its orientation (GraspLayout::grip_rotation): the torque of the
   // model on the hand about the grasp point, world frame, -dE/dδ for a small world
   // rotation exp([δ]×) of the grasp (the rotation part of -E_u is that torque only while

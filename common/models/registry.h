@@ -30,6 +30,10 @@ struct ChainSpec {
 struct ModelCapabilities {
   // The model's controls as a device sees them, for valid parameters.
   std::function<GraspLayout(const ModelParams&)> grasp_layout{};
+  // What each grasp holds, in the order of the controls ("edge 0", "node 20"), when the
+  // model has several grasps (a scene's `grasps:` names them in this order; each takes
+  // grasp_layout's controls). Unset: one grasp, whatever the model's controls hold.
+  std::function<std::vector<std::string>(const ModelParams&)> grasp_sites{};
   // Set for chains (see ChainSpec); their snap length scale is the segment length.
   std::optional<ChainSpec> chain{};
 };

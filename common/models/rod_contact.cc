@@ -19,13 +19,14 @@ void RodModel::RegisterContact() {
                     &assembly_);
 }
 
-const Eigen::Matrix3Xd& RodModel::ContactNodes(const Vec& x, const GraspMap& gm) const {
+const Eigen::Matrix3Xd& RodModel::ContactNodes(const Vec& x, const GraspMaps& gm) const {
   if (contact_nodes_.cols() != n_ + 1) contact_nodes_.resize(3, n_ + 1);
   for (int k = 0; k <= n_; ++k) contact_nodes_.col(k) = Node(k, x, gm);
   return contact_nodes_;
 }
 
-internal::ControlMap RodModel::ContactControls(const GraspMap& gm) {
+internal::ControlMap RodModel::ContactControls(const GraspMaps& gms) {
+  const GraspMap& gm = gms.end;  // a clamped rod: the one grasp, of edge n-1
   internal::ControlMap m;
   m.jac = gm.jac.topRows<6>();
   for (int r = 0; r < 6; ++r) {
@@ -43,7 +44,7 @@ double RodModel::MaxStepFraction(const Vec& x, const Vec& dx, const Vec& u) cons
 
 double RodModel::MaxMotionFraction(const Vec& x0, const Vec& u0, const Vec& x1, const Vec& u1) const {
   if (!contact_.enabled()) return 1.0;
-  const GraspMap g0 = Grasp(u0, false), g1 = Grasp(u1, false);
+  const GraspMaps g0 = Grasp(u0, false), g1 = Grasp(u1, false);
   Eigen::Matrix3Xd& from = contact_nodes_;
   ContactNodes(x0, g0);
   Eigen::Matrix3Xd& to = contact_to_;

@@ -17,12 +17,20 @@ using V3 = Eigen::Vector3d;
 using M3 = Eigen::Matrix3d;
 constexpr int kMaxVars = internal::HessianAssembly::kMaxTermVars;
 
+// The grasp coordinate g of a local code (RodModel::Term): -2 - g, or -9 - g for the grasp
+// of edge 0.
+int GraspCoordinate(int code) { return code <= -9 ? -9 - code : -2 - code; }
+
 bool RodParams::IsValid(std::string* error) const {
   auto fail = [&](const std::string& why) {
     if (error != nullptr) *error = "rod: " + why;
     return false;
   };
   if (n < 3) return fail("n must be at least 3 (the clamp and the grasp hold one edge each)");
+  if (free_start && n < 5) return fail("n must be at least 5 without a clamp (two grasps)");
+  // Self-contact maps the grasped nodes through one grasp's controls (rod_contact.cc).
+  if (free_start && contact.enabled)
+    return fail("self-contact (params.contact) is not yet supported with clamp: false");
   if (!(length > 0.0) || !std::isfinite(length)) return fail("length must be positive");
   const double stiffnesses[] = {stretch_stiffness, bend_stiffness, bend_stiffness_2,
                                 twist_stiffness};
@@ -47,6 +55,7 @@ RodModel::RodModel(const RodParams& params) : p_(params) {
   if (!p_.IsValid(&error)) throw std::invalid_argument(error);
   n_ = p_.n;
   nx_ = 4 * n_ - 11;
+  nu_ = p_.free_start ? 12 : 6;
   rest_ = p_.length / n_;
   // Uniform rest edges: the Voronoi length ℓ̄ = ℓ at every interior vertex.
   stiffness_.c1 = p_.bend_stiffness / rest_;
@@ -54,7 +63,7 @@ RodModel::RodModel(const RodParams& params) : p_(params) {
   stiffness_.ct = p_.twist_stiffness / rest_;
   stiffness_.kappa1_bar = p_.natural_curvature * rest_;
   stiffness_.kappa2_bar = p_.natural_curvature_2 * rest_;
-  assembly_ = internal::HessianAssembly(nx_, 6);
+  assembly_ = internal::HessianAssembly(nx_, nu_);
   BuildTerms();
   ResetHistory();
 }
@@ -64,7 +73,10 @@ void RodModel::ResetHistory() {
   sources_.assign(n_, FrameSource{p_.clamp_rotation.col(0), p_.clamp_rotation.col(1)});
   twist_near_.assign(n_, 0.0);
   grasp_theta_near_ = 0.0;
-  grasp_theta_near_ = Grasp(Vec::Zero(6), false).theta;
+  start_theta_near_ = 0.0;
+  const GraspMaps gm = Grasp(Vec::Zero(nu_), false);
+  grasp_theta_near_ = gm.end.theta;
+  if (p_.free_start) start_theta_near_ = gm.start.theta;
 }
 
 int RodModel::NodeIndex(int k) const {
@@ -76,21 +88,26 @@ int RodModel::ThetaIndex(int j) const {
 }
 
 void RodModel::BuildTerms() {
+  const bool free = p_.free_start;
   auto node_code = [&](int k, int c) {
-    if (k <= 1) return -1;
+    if (k == 0) return free ? -12 - c : -1;
+    if (k == 1) return free ? -9 - c : -1;
     if (k == n_ - 1) return -2 - c;
     if (k == n_) return -5 - c;
     return NodeIndex(k) + c;
   };
   auto theta_code = [&](int j) {
-    if (j == 0) return -1;
+    if (j == 0) return free ? -15 : -1;
     if (j == n_ - 1) return -8;
     return ThetaIndex(j);
   };
   auto add = [&](Term term) {
     int vars[kMaxVars];
     int count = 0;
-    for (int r = 0; r < term.nloc; ++r) term.grasp = term.grasp || term.code[r] <= -2;
+    for (int r = 0; r < term.nloc; ++r) {
+      term.grasp = term.grasp || term.code[r] <= -2;
+      term.at_start = term.at_start || term.code[r] <= -9;
+    }
     if (!term.grasp) {
       for (int r = 0; r < term.nloc; ++r) vars[count++] = term.code[r];
     } else {
@@ -101,7 +118,9 @@ void RodModel::BuildTerms() {
           vars[count++] = term.code[r];
         }
       }
-      for (int c = 0; c < 6; ++c) vars[count++] = nx_ + c;
+      // Controls: u = (grasp of edge 0, grasp of edge n-1) without a clamp.
+      const int offset = free && !term.at_start ? 6 : 0;
+      for (int c = 0; c < 6; ++c) vars[count++] = nx_ + offset + c;
     }
     assembly_.AddTerm(vars, count);
     terms_.push_back(term);
@@ -136,44 +155,59 @@ void RodModel::BuildTerms() {
   }
 }
 
-RodModel::GraspMap RodModel::Grasp(const Vec& u, bool derivatives, bool world_rotation) const {
+RodModel::GraspMaps RodModel::Grasp(const Vec& u, bool derivatives, bool world_rotation) const {
+  GraspMaps gm;
+  gm.end = OneGrasp(u, false, derivatives, world_rotation);
+  if (p_.free_start) gm.start = OneGrasp(u, true, derivatives, world_rotation);
+  return gm;
+}
+
+// The held end node is xn (x_n, or x_0 for the grasp of edge 0), the inner one xn1
+// (x_{n-1}, or x_1): the edge's tangent t = R e_x points from x_{n-1} to x_n and from x_0
+// to x_1, so the inner node is the held one ∓ ℓ t.
+RodModel::GraspMap RodModel::OneGrasp(const Vec& u, bool at_start, bool derivatives,
+                                      bool world_rotation) const {
   GraspMap gm;
-  const V3 pos = u.head<3>();
-  const V3 phi = u.segment<3>(3);
+  const int offset = p_.free_start && !at_start ? 6 : 0;
+  const V3 pos = u.segment<3>(offset);
+  const V3 phi = u.segment<3>(offset + 3);
+  const M3& r_start = at_start ? p_.clamp_rotation : p_.grasp_rotation;
+  const double side = at_start ? rest_ : -rest_;
+  const FrameSource& src = sources_[at_start ? 0 : n_ - 1];
+  const double near = at_start ? start_theta_near_ : grasp_theta_near_;
   if (!derivatives) {
     // Values only (Energy, line searches): the rotation and one angle.
-    const M3 r = rod::ExpMap(phi) * p_.grasp_rotation;
+    const M3 r = rod::ExpMap(phi) * r_start;
     const V3 t = r.col(0);
     gm.xn = pos;
-    gm.xn1 = pos - rest_ * t;
+    gm.xn1 = pos + side * t;
     V3 a, b;
-    rod::ReferenceFrame(sources_[n_ - 1], t, &a, &b);
-    gm.theta = rod::AngleAbout(t, a, r.col(1), grasp_theta_near_);
+    rod::ReferenceFrame(src, t, &a, &b);
+    gm.theta = rod::AngleAbout(t, a, r.col(1), near);
     return gm;
   }
   // Derivatives in φ, or in a world rotation δ of the current orientation
   // (exp([δ]×) R(u), δ = 0) for the torque.
-  const M3 rot = world_rotation ? M3(rod::ExpMap(phi) * p_.grasp_rotation) : p_.grasp_rotation;
+  const M3 rot = world_rotation ? M3(rod::ExpMap(phi) * r_start) : r_start;
   const V3 at = world_rotation ? V3::Zero() : phi;
   const JetVec t = rod::RotateJet(at, rot.col(0));
   const JetVec m1 = rod::RotateJet(at, rot.col(1));
   gm.xn = pos;
-  gm.xn1 = pos - rest_ * t.Value();
+  gm.xn1 = pos + side * t.Value();
   // θ_{n-1}: the angle of m1 about t from the time-parallel reference director
   // a = P_{t_s}^{t} a_s = a_s - (a_s·t)/(1 + t_s·t) (t_s + t) (a_s ⊥ t_s).
-  const FrameSource& s = sources_[n_ - 1];
+  const FrameSource& s = src;
   const Jet k = Dot(s.a, t) * rod::Inverse(Jet::Constant(1.0) + Dot(s.t, t));
   const JetVec a = JetVec::Constant(s.a) - k * (JetVec::Constant(s.t) + t);
   const JetVec b = rod::CrossJ(t, a);
   const Jet theta = rod::Atan2(Dot(b, m1), Dot(a, m1));
-  gm.theta = grasp_theta_near_ +
-             std::remainder(theta.v - grasp_theta_near_, 2.0 * std::numbers::pi);
+  gm.theta = near + std::remainder(theta.v - near, 2.0 * std::numbers::pi);
   gm.jac.setZero();
   for (int c = 0; c < 3; ++c) {
     gm.jac(c, c) = 1.0;
     gm.jac(3 + c, c) = 1.0;
-    gm.jac.block<1, 3>(c, 3) = -rest_ * t.c[c].g.transpose();
-    gm.hess_phi[c] = -rest_ * t.c[c].h;
+    gm.jac.block<1, 3>(c, 3) = side * t.c[c].g.transpose();
+    gm.hess_phi[c] = side * t.c[c].h;
     gm.hess_phi[3 + c].setZero();
   }
   gm.jac.block<1, 3>(6, 3) = theta.g.transpose();
@@ -181,23 +215,24 @@ RodModel::GraspMap RodModel::Grasp(const Vec& u, bool derivatives, bool world_ro
   return gm;
 }
 
-V3 RodModel::Node(int k, const Vec& x, const GraspMap& gm) const {
-  if (k == 0) return p_.clamp_position;
-  if (k == 1) return p_.clamp_position + rest_ * p_.clamp_rotation.col(0);
-  if (k == n_ - 1) return gm.xn1;
-  if (k == n_) return gm.xn;
+V3 RodModel::Node(int k, const Vec& x, const GraspMaps& gm) const {
+  if (k == 0) return p_.free_start ? gm.start.xn : p_.clamp_position;
+  if (k == 1) return p_.free_start ? gm.start.xn1 : V3(p_.clamp_position + rest_ * p_.clamp_rotation.col(0));
+  if (k == n_ - 1) return gm.end.xn1;
+  if (k == n_) return gm.end.xn;
   return x.segment<3>(NodeIndex(k));
 }
 
-double RodModel::Theta(int j, const Vec& x, const GraspMap& gm) const {
-  if (j == 0) return 0.0;
-  if (j == n_ - 1) return gm.theta;
+double RodModel::Theta(int j, const Vec& x, const GraspMaps& gm) const {
+  if (j == 0) return p_.free_start ? gm.start.theta : 0.0;
+  if (j == n_ - 1) return gm.end.theta;
   return x[ThetaIndex(j)];
 }
 
 template <class F>
-void RodModel::Local(int t, const Vec& x, const GraspMap& gm, bool want_h, F&& f) const {
+void RodModel::Local(int t, const Vec& x, const GraspMaps& gms, bool want_h, F&& f) const {
   const Term& term = terms_[t];
+  const GraspMap& gm = term.at_start ? gms.start : gms.end;
   Eigen::Matrix<double, kMaxLocal, 1> gy;
   Eigen::Matrix<double, kMaxLocal, kMaxLocal> hy;
   const int i = term.index;
@@ -210,16 +245,16 @@ void RodModel::Local(int t, const Vec& x, const GraspMap& gm, bool want_h, F&& f
     Eigen::Matrix<double, 6, 1> g6;
     Eigen::Matrix<double, 6, 6> h6;
     // ½ EA (|e|/ℓ - 1)² ℓ = (EA / 2ℓ) (|e| - ℓ)²  [DER (2) with the stretching of DVT §4]
-    internal::StretchTerm<3>(Node(i, x, gm), Node(i + 1, x, gm),
+    internal::StretchTerm<3>(Node(i, x, gms), Node(i + 1, x, gms),
                              0.5 * p_.stretch_stiffness / rest_, rest_, &g6,
                              want_h ? &h6 : nullptr);
     gy.head<6>() = g6;
     if (want_h) hy.topLeftCorner<6, 6>() = h6;
   } else {
-    const V3 xa = Node(i - 1, x, gm), xb = Node(i, x, gm), xc = Node(i + 1, x, gm);
+    const V3 xa = Node(i - 1, x, gms), xb = Node(i, x, gms), xc = Node(i + 1, x, gms);
     rod::Vec8 g8;
     rod::Mat8 h8;
-    rod::VertexEnergy(xb - xa, xc - xb, Theta(i - 1, x, gm), Theta(i, x, gm), sources_[i - 1],
+    rod::VertexEnergy(xb - xa, xc - xb, Theta(i - 1, x, gms), Theta(i, x, gms), sources_[i - 1],
                       sources_[i], twist_near_[i], stiffness_, &g8, want_h ? &h8 : nullptr);
     // (e0, e1) = (x_i - x_{i-1}, x_{i+1} - x_i).
     gy.segment<3>(0) = -g8.segment<3>(0);
@@ -263,7 +298,7 @@ void RodModel::Local(int t, const Vec& x, const GraspMap& gm, bool want_h, F&& f
     if (term.code[r] >= 0) {
       c(r, term.pos[r]) = 1.0;
     } else if (term.code[r] <= -2) {
-      c.block<1, 6>(r, k - 6) = gm.jac.row(-2 - term.code[r]);
+      c.block<1, 6>(r, k - 6) = gm.jac.row(GraspCoordinate(term.code[r]));
     }
   }
   Eigen::Matrix<double, kMaxVars, 1> ga;
@@ -273,14 +308,14 @@ void RodModel::Local(int t, const Vec& x, const GraspMap& gm, bool want_h, F&& f
     const Eigen::Matrix<double, kMaxLocal, kMaxVars> hc = hy * c;
     ha.noalias() = c.transpose() * hc;
     for (int r = 0; r < nloc; ++r) {
-      if (term.code[r] <= -2) ha.block<3, 3>(k - 3, k - 3) += gy[r] * gm.hess_phi[-2 - term.code[r]];
+      if (term.code[r] <= -2) ha.block<3, 3>(k - 3, k - 3) += gy[r] * gm.hess_phi[GraspCoordinate(term.code[r])];
     }
   }
   f(ga.data(), ha.data(), kMaxVars);
 }
 
 double RodModel::Energy(const Vec& x, const Vec& u) const {
-  const GraspMap gm = Grasp(u, false);
+  const GraspMaps gm = Grasp(u, false);
   double e = 0.0;
   for (const Term& term : terms_) {
     const int i = term.index;
@@ -301,7 +336,7 @@ double RodModel::Energy(const Vec& x, const Vec& u) const {
 void RodModel::Gradient(const Vec& x, const Vec& u, Vec* g) const {
   if (g->size() != nx_) g->resize(nx_);
   g->setZero();
-  const GraspMap gm = Grasp(u, true);
+  const GraspMaps gm = Grasp(u, true);
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, x, gm, false,
           [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
@@ -316,20 +351,44 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
     *h = pattern;
   }
   double* values = h->valuePtr();
-  std::fill(values, values + pattern.nonZeros(), 0.0);
-  const GraspMap gm = Grasp(u, true);
+  // StoreHessian: every elastic slot is reached by an elastic term first, so no clearing
+  // pass; slots only a contact pair reaches are cleared when contact is on.
+  if (contact_.enabled()) std::fill(values, values + pattern.nonZeros(), 0.0);
+  const GraspMaps gm = Grasp(u, true);
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
-      assembly_.AddHessian(t, lh, ld, values);
+      assembly_.StoreHessian(t, lh, ld, values);
     });
   }
-  if (contact_.enabled()) contact_.AddHessian(ContactNodes(x, gm), values);
+}
+
+void RodModel::GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
+  if (g->size() != nx_) g->resize(nx_);
+  g->setZero();
+  const SparseMatrix& pattern = assembly_.Pattern();
+  if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
+      !h->isCompressed()) {
+    *h = pattern;
+  }
+  double* values = h->valuePtr();
+  if (contact_.enabled()) std::fill(values, values + pattern.nonZeros(), 0.0);
+  const GraspMaps gm = Grasp(u, true);
+  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
+    Local(t, x, gm, true, [&](const double* lg, const double* lh, int ld) {
+      assembly_.AddGradient(t, lg, g->data());
+      assembly_.StoreHessian(t, lh, ld, values);
+    });
+  }
+  if (contact_.enabled()) {
+    contact_.AddGradient(ContactNodes(x, gm), g->data());
+    contact_.AddHessian(ContactNodes(x, gm), values);
+  }
 }
 
 void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
-  if (eu->size() != 6) eu->resize(6);
+  if (eu->size() != nu_) eu->resize(nu_);
   eu->setZero();
-  const GraspMap gm = Grasp(u, true);
+  const GraspMaps gm = Grasp(u, true);
   for (int t : control_terms_) {
     Local(t, x, gm, false, [&](const double* lg, const double*, int) {
       assembly_.AddControlGradient(t, lg, eu->data());
@@ -342,22 +401,22 @@ bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) 
   // The E_u of a grasp map differentiated in a world rotation δ instead of φ: the
   // rotation-vector gradient E_φ = J_l(φ)ᵀ E_δ loses the torque where J_l is singular
   // (|φ| = 2π, 4π: two turns of a roll).
-  const GraspMap gm = Grasp(u, true, true);
-  Eigen::Matrix<double, 6, 1> e = Eigen::Matrix<double, 6, 1>::Zero();
+  const GraspMaps gm = Grasp(u, true, true);
+  Eigen::Matrix<double, 12, 1> e = Eigen::Matrix<double, 12, 1>::Zero();
   for (int t : control_terms_) {
     Local(t, x, gm, false, [&](const double* lg, const double*, int) {
       assembly_.AddControlGradient(t, lg, e.data());
     });
   }
   if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, gm), ContactControls(gm), e.data());
-  *torque = -e.tail<3>();
+  *torque = -e.segment<3>(3);  // the first grasp's (edge 0's without a clamp)
   return true;
 }
 
 void RodModel::MixedHessian(const Vec& x, const Vec& u, Mat* exu) const {
-  if (exu->rows() != nx_ || exu->cols() != 6) exu->resize(nx_, 6);
+  if (exu->rows() != nx_ || exu->cols() != nu_) exu->resize(nx_, nu_);
   exu->setZero();
-  const GraspMap gm = Grasp(u, true);
+  const GraspMaps gm = Grasp(u, true);
   for (int t : control_terms_) {
     Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
       assembly_.AddMixedHessian(t, lh, ld, exu);
@@ -367,9 +426,9 @@ void RodModel::MixedHessian(const Vec& x, const Vec& u, Mat* exu) const {
 }
 
 void RodModel::ControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
-  if (euu->rows() != 6 || euu->cols() != 6) euu->resize(6, 6);
+  if (euu->rows() != nu_ || euu->cols() != nu_) euu->resize(nu_, nu_);
   euu->setZero();
-  const GraspMap gm = Grasp(u, true);
+  const GraspMaps gm = Grasp(u, true);
   for (int t : control_terms_) {
     Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
       assembly_.AddControlHessian(t, lh, ld, euu);
@@ -379,14 +438,14 @@ void RodModel::ControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
 }
 
 Vec RodModel::InitialState(const Vec& u) const {
-  const GraspMap gm = Grasp(u, false);
+  const GraspMaps gm = Grasp(u, false);
   Vec x = Vec::Zero(nx_);
   const V3 x1 = Node(1, x, gm);
   // A slack rod starts bowed out towards the clamp's m1 (a compressed straight rod is a
   // saddle whose bending modes the start solve cannot pick between): the free span
   // x_1 .. x_{n-1} of chord D and rest length L' follows y = A/2 (1 - cos 2πs) with
   // A = (2/π) sqrt(D (L' - D)), the arc of length ≈ L'.
-  const V3 chord = gm.xn1 - x1;
+  const V3 chord = gm.end.xn1 - x1;
   const double d = chord.norm(), free = (n_ - 2) * rest_;
   V3 side = V3::Zero();
   if (d > 0.0 && free - d > 1e-9 * p_.length) {
@@ -400,20 +459,21 @@ Vec RodModel::InitialState(const Vec& u) const {
     const double s = static_cast<double>(k - 1) / (n_ - 2);
     x.segment<3>(NodeIndex(k)) = x1 + s * chord + 0.5 * (1.0 - std::cos(2.0 * std::numbers::pi * s)) * side;
   }
-  for (int j = 1; j <= n_ - 2; ++j) x[ThetaIndex(j)] = gm.theta * j / (n_ - 1);
+  const double theta0 = Theta(0, x, gm);
+  for (int j = 1; j <= n_ - 2; ++j) x[ThetaIndex(j)] = theta0 + (gm.end.theta - theta0) * j / (n_ - 1);
   return x;
 }
 
 void RodModel::NodePositions(const Vec& x, const Vec& u, Eigen::Matrix3Xd* nodes) const {
   if (nodes->cols() != n_ + 1) nodes->resize(3, n_ + 1);
-  const GraspMap gm = Grasp(u, false);
+  const GraspMaps gm = Grasp(u, false);
   for (int k = 0; k <= n_; ++k) nodes->col(k) = Node(k, x, gm);
 }
 
 double RodModel::Probe(const Vec& x, const Vec& u) const {
-  const GraspMap gm = Grasp(u, false);
-  const V3 c = p_.clamp_position;
-  V3 d = gm.xn - c;
+  const GraspMaps gm = Grasp(u, false);
+  const V3 c = Node(0, Vec(), gm);
+  V3 d = gm.end.xn - c;
   const double len = d.norm();
   d = len > 1e-12 * p_.length ? V3(d / len) : V3::Zero();
   double probe = 0.0;
@@ -429,14 +489,14 @@ double RodModel::ForceScale() const {
 }
 
 Vec RodModel::MaterialAngles(const Vec& x, const Vec& u) const {
-  const GraspMap gm = Grasp(u, false);
+  const GraspMaps gm = Grasp(u, false);
   Vec theta(n_);
   for (int j = 0; j < n_; ++j) theta[j] = Theta(j, x, gm);
   return theta;
 }
 
 V3 RodModel::MaterialDirector(const Vec& x, const Vec& u, int j) const {
-  const GraspMap gm = Grasp(u, false);
+  const GraspMaps gm = Grasp(u, false);
   const V3 t = (Node(j + 1, x, gm) - Node(j, x, gm)).normalized();
   V3 a, b;
   rod::ReferenceFrame(sources_[j], t, &a, &b);
@@ -445,7 +505,7 @@ V3 RodModel::MaterialDirector(const Vec& x, const Vec& u, int j) const {
 }
 
 void RodModel::AcceptState(const Vec& x, const Vec& u) {
-  const GraspMap gm = Grasp(u, false);
+  const GraspMaps gm = Grasp(u, false);
   // Continued values first, against the old sources (at the accepted state the new
   // frames equal the old ones carried there, so E(x, u) does not change).
   for (int i = 1; i <= n_ - 1; ++i) {
@@ -453,7 +513,8 @@ void RodModel::AcceptState(const Vec& x, const Vec& u) {
                                          Node(i + 1, x, gm) - Node(i, x, gm), sources_[i - 1],
                                          sources_[i], twist_near_[i]);
   }
-  grasp_theta_near_ = gm.theta;
+  grasp_theta_near_ = gm.end.theta;
+  if (p_.free_start) start_theta_near_ = gm.start.theta;
   for (int j = 0; j < n_; ++j) {
     const V3 t = (Node(j + 1, x, gm) - Node(j, x, gm)).normalized();
     V3 a, b;
@@ -492,6 +553,8 @@ ModelRegistration RodRegistration() {
        .doc = "natural material curvature kappa1-bar (bending towards m1)"},
       {.name = "natural_curvature_2", .default_value = 0.0, .units = "1/m",
        .doc = "natural material curvature kappa2-bar (bending towards m2)"},
+      {.name = "clamp", .kind = ParamKind::kBool, .default_value = 1.0,
+       .doc = "false: no clamp, a first grasp holds edge 0 (u = (its pose, the last edge's pose))"},
       {.name = "radius", .default_value = 0.01, .min = 0.0, .units = "m",
        .doc = "tube radius (drawing; the capsule radius of self-contact)"},
   };
@@ -508,8 +571,18 @@ ModelRegistration RodRegistration() {
     p.natural_curvature = mp.Number("natural_curvature");
     p.natural_curvature_2 = mp.Number("natural_curvature_2");
     p.radius = mp.Number("radius");
+    p.free_start = !mp.Bool("clamp");
     p.contact = internal::ReadContactParams(mp);
     return std::make_unique<RodModel>(p);
+  };
+  r.check = [](const ModelParams& mp, std::string* error) {
+    if (mp.Bool("clamp") || mp.Integer("n") >= 5) return true;
+    if (error != nullptr) *error = "params.n: expected an integer >= 5 with clamp: false (two grasps)";
+    return false;
+  };
+  r.capabilities.grasp_sites = [](const ModelParams& mp) {
+    const std::string last = "edge " + std::to_string(mp.Integer("n") - 1);
+    return mp.Bool("clamp") ? std::vector<std::string>{last} : std::vector<std::string>{"edge 0", last};
   };
   r.capabilities.grasp_layout = [](const ModelParams&) {
     return GraspLayout{.spatial_dimension = 3, .grip_rotation = true};

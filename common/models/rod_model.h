@@ -48,6 +48,10 @@ struct RodParams {
   Eigen::Vector3d clamp_position = Eigen::Vector3d::Zero();
   Eigen::Matrix3d clamp_rotation = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d grasp_rotation = Eigen::Matrix3d::Identity();  // R_start (φ = 0)
+  // No clamp (issue 15): edge 0 is held by a first grasp u[0..5] = (p, φ) with
+  // x_0 = p, x_1 = p + ℓ R e_x, R = exp([φ]×) clamp_rotation, m1_0 = R e_y, and the
+  // grasp above takes u[6..11]. Both ends held by full poses leave no rigid-body motion.
+  bool free_start = false;
 
   bool IsValid(std::string* error) const;
 };
@@ -59,17 +63,20 @@ class RodModel final : public Model {
 
   std::string_view Name() const override { return "rod"; }
   int NumStates() const override { return nx_; }
-  int NumControls() const override { return 6; }
+  int NumControls() const override { return nu_; }
   int SpatialDimension() const override { return 3; }
 
   double Energy(const Vec& x, const Vec& u) const override;
   void Gradient(const Vec& x, const Vec& u, Vec* g) const override;
   const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override;
+  // One pass over the terms for both (the same operations as the two, the same bits).
+  void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override;
   void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override;
   void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override;
   void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override;
-  // -dE/dδ for a world rotation exp([δ]×) of the grasp: the torque about x_n (N m).
+  // -dE/dδ for a world rotation exp([δ]×) of the grasp: the torque about x_n (N m)
+  // (free_start: of the first grasp, about x_0).
   bool GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const override;
 
   // Nodes evenly spaced on the segment x_1 .. x_{n-1}, twist spread evenly.
@@ -111,34 +118,46 @@ class RodModel final : public Model {
     Eigen::Matrix<double, 7, 6> jac;
     std::array<Eigen::Matrix3d, 7> hess_phi;
   };
+
+  // The grasp of edge n-1 and, without a clamp, the one of edge 0 (unused otherwise).
+  struct GraspMaps {
+    GraspMap end;
+    GraspMap start;
+  };
   // One energy term (stretching of an edge, or bending and twist at a vertex). Local
   // coordinate codes: >= 0 a state index, -1 fixed by the clamp, -2 - g grasp
-  // coordinate g (0..2 x_{n-1}, 3..5 x_n, 6 θ_{n-1}).
+  // coordinate g (0..2 x_{n-1}, 3..5 x_n, 6 θ_{n-1}); free_start: -9 - g coordinate g of
+  // the grasp of edge 0 (0..2 x_1, 3..5 x_0, 6 θ_0). No term touches both grasps (n ≥ 5).
   struct Term {
     bool vertex = false;
     int index = 0;  // edge (stretch) or vertex
     int nloc = 0;
     bool grasp = false;
+    bool at_start = false;  // the grasp it touches holds edge 0
     std::array<int, kMaxLocal> code{};
     std::array<int, kMaxLocal> pos{};  // grasp terms: assembly position of state coordinates
   };
   void BuildTerms();
   // Self-contact (rod_contact.cc): pair terms registered after the elastic ones, node
-  // positions into contact_nodes_, and the grasped nodes' map for E_u, E_xu, E_uu.
+  // positions into contact_nodes_, and the grasped nodes' map for E_u, E_xu, E_uu
+  // (a clamped rod only: with clamp false the model refuses contact).
   void RegisterContact();
-  const Eigen::Matrix3Xd& ContactNodes(const Vec& x, const GraspMap& gm) const;
-  static internal::ControlMap ContactControls(const GraspMap& gm);
-  GraspMap Grasp(const Vec& u, bool derivatives, bool world_rotation = false) const;
-  Eigen::Vector3d Node(int k, const Vec& x, const GraspMap& gm) const;
-  double Theta(int j, const Vec& x, const GraspMap& gm) const;
+  const Eigen::Matrix3Xd& ContactNodes(const Vec& x, const GraspMaps& gm) const;
+  static internal::ControlMap ContactControls(const GraspMaps& gm);
+  GraspMaps Grasp(const Vec& u, bool derivatives, bool world_rotation = false) const;
+  // The map of one grasp: the one of edge n-1 (at_start false) or of edge 0.
+  GraspMap OneGrasp(const Vec& u, bool at_start, bool derivatives, bool world_rotation) const;
+  Eigen::Vector3d Node(int k, const Vec& x, const GraspMaps& gm) const;
+  double Theta(int j, const Vec& x, const GraspMaps& gm) const;
   // Calls f(local gradient, local Hessian, leading dimension) for term t in its
   // assembly variables.
   template <class F>
-  void Local(int t, const Vec& x, const GraspMap& gm, bool want_h, F&& f) const;
+  void Local(int t, const Vec& x, const GraspMaps& gm, bool want_h, F&& f) const;
 
   RodParams p_;
   int n_;
   int nx_;
+  int nu_ = 6;  // 12 with free_start
   double rest_;  // ℓ
   rod::VertexStiffness stiffness_;
   internal::HessianAssembly assembly_;
@@ -152,6 +171,7 @@ class RodModel final : public Model {
   std::vector<rod::FrameSource> sources_;
   std::vector<double> twist_near_;
   double grasp_theta_near_ = 0.0;
+  double start_theta_near_ = 0.0;  // free_start: the same for the grasp of edge 0
 };
 
 }  // namespace snapthread

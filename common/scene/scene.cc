@@ -158,8 +158,10 @@ void ReadParams(const YAML::Node& p, const ModelRegistration& model, const Reade
 // A waypoint of a grasp that holds its full orientation (GraspLayout::grip_rotation):
 // [X, Y, Z] (start orientation), or {position: [X, Y, Z], roll_deg: r}, a roll by r
 // degrees about the grasp's x axis, the rod's tangent at the start (u = (X, Y, Z, r, 0, 0)
-// in radians). Legs between waypoints interpolate the rotation vector linearly, so a
-// leg from roll 0 to roll 720 turns the grasp twice.
+// in radians), or {position: [X, Y, Z], rotation_deg: [a, b, c]}, the rotation vector φ
+// in degrees (a hand that turns the rod's end about any axis). Legs between waypoints
+// interpolate the rotation vector linearly, so a leg from roll 0 to roll 720 turns the
+// grasp twice.
 Vec RotationWaypoint(const YAML::Node& point, const std::string& key, const Reader& rd) {
   Vec p = Vec::Zero(6);
   if (point.IsSequence()) {
@@ -167,11 +169,129 @@ Vec RotationWaypoint(const YAML::Node& point, const std::string& key, const Read
     return p;
   }
   if (!point.IsMap()) rd.Fail(key, "expected [X, Y, Z] or {position: [X, Y, Z], roll_deg: r}, got '" + Reader::Dump(point) + "'");
-  rd.CheckKeys(point, key, {"position", "roll_deg"});
+  rd.CheckKeys(point, key, {"position", "roll_deg", "rotation_deg"});
   if (!point["position"]) rd.Fail(key + ".position", "missing (expected a list of 3 numbers)");
+  if (point["roll_deg"] && point["rotation_deg"]) rd.Fail(key + ".rotation_deg", "also given as roll_deg; keep one");
   p.head(3) = rd.Vector(point["position"], key + ".position", 3);
-  p[3] = rd.Number(point, "roll_deg", key + ".roll_deg", 0.0) * std::numbers::pi / 180.0;
+  constexpr double kRad = std::numbers::pi / 180.0;
+  p[3] = rd.Number(point, "roll_deg", key + ".roll_deg", 0.0) * kRad;
+  if (point["rotation_deg"]) p.tail(3) = rd.Vector(point["rotation_deg"], key + ".rotation_deg", 3) * kRad;
   return p;
+}
+
+struct GraspRead {
+  Vec start;
+  std::vector<Vec> path;
+};
+
+// One grasp's start and path: the position (2 or 3 numbers), then a unit grip direction
+// if the model holds one, or a rotation vector (start: 0) if it holds the full
+// orientation (see GraspLayout). `extra` are further keys the caller reads.
+GraspRead ReadGrasp(const YAML::Node& g, const std::string& key, const GraspLayout& layout,
+                    const Reader& rd, std::set<std::string> extra = {}) {
+  const int pos_dim = layout.spatial_dimension;
+  const bool grip = layout.grip_direction;
+  const int m = layout.NumControls();
+  extra.insert({"start", "direction", "path"});
+  rd.CheckKeys(g, key, extra);
+  if (!g["start"]) rd.Fail(key + ".start", "missing (expected a list of " + std::to_string(pos_dim) + " numbers)");
+  Vec start = rd.Vector(g["start"], key + ".start", pos_dim);
+  Vec dir;
+  if (grip) {
+    if (!g["direction"]) rd.Fail(key + ".direction", "missing: params.grip_direction needs a list of 3 numbers");
+    dir = rd.Vector(g["direction"], key + ".direction", 3);
+    if (!(dir.norm() > 1e-9)) rd.Fail(key + ".direction", "expected a non-zero vector");
+    dir.normalize();
+  } else if (g["direction"]) {
+    rd.Fail(key + ".direction", "only allowed with params.grip_direction: true");
+  }
+  GraspRead out;
+  out.start = Vec::Zero(m);
+  out.start.head(pos_dim) = start;
+  if (grip) out.start.tail(3) = dir;
+  if (g["path"]) {
+    const YAML::Node path = g["path"];
+    if (!path.IsSequence() || path.size() < 1) rd.Fail(key + ".path", "expected a list of points");
+    for (size_t i = 0; i < path.size(); ++i) {
+      const std::string pkey = key + ".path[" + std::to_string(i) + "]";
+      Vec p(m);
+      // With a grip direction a waypoint may also turn the grip: X,Y,Z,dx,dy,dz.
+      if (layout.grip_rotation) {
+        p = RotationWaypoint(path[i], pkey, rd);
+      } else if (grip && path[i].IsSequence() && path[i].size() == 6) {
+        p = rd.Vector(path[i], pkey, 6);
+        if (!(p.tail(3).norm() > 1e-9)) rd.Fail(pkey, "expected a non-zero grip direction");
+        p.tail(3).normalize();
+      } else {
+        p.head(pos_dim) = rd.Vector(path[i], pkey, pos_dim);
+        if (grip) p.tail(3) = dir;
+      }
+      out.path.push_back(p);
+    }
+  }
+  return out;
+}
+
+// `grasps:`: a list of {name, edge | node, start, path, ...}, one per grasp site of the
+// model, in the model's order. Paths: every grasp with a path gives the same number of
+// points; a grasp without one holds its start. u and the path points concatenate them.
+void ReadGrasps(const YAML::Node& list, const ModelRegistration& model, const Reader& rd, Scene* sc) {
+  const std::vector<std::string> sites =
+      model.capabilities.grasp_sites ? model.capabilities.grasp_sites(sc->params) : std::vector<std::string>{};
+  if (!list.IsSequence() || list.size() < 1) rd.Fail("grasps", "expected a list of grasps");
+  if (sites.empty() && list.size() != 1) rd.Fail("grasps", sc->params.model + " has one grasp");
+  if (!sites.empty() && list.size() != sites.size())
+    rd.Fail("grasps", "expected " + std::to_string(sites.size()) + " grasps (holding " + [&] {
+      std::string all;
+      for (const auto& s : sites) all += (all.empty() ? "" : ", ") + s;
+      return all;
+    }() + ")");
+  const int m = sc->grasp_layout.NumControls();
+  std::vector<GraspRead> reads;
+  size_t path_points = 0;
+  for (size_t i = 0; i < list.size(); ++i) {
+    const std::string key = "grasps[" + std::to_string(i) + "]";
+    const YAML::Node g = list[i];
+    if (!g.IsMap()) rd.Fail(key, "expected a mapping with name, edge or node, start, path");
+    GraspRead r = ReadGrasp(g, key, sc->grasp_layout, rd, {"name", "edge", "node", "model_origin"});
+    SceneGrasp sg;
+    if (!g["name"]) rd.Fail(key + ".name", "missing (expected a name, e.g. left)");
+    sg.name = rd.Get<std::string>(g["name"], key + ".name", "a name");
+    if (sg.name.empty() || sg.name.find_first_of(" ,\t\n") != std::string::npos)
+      rd.Fail(key + ".name", "expected a name without spaces or commas");
+    for (const SceneGrasp& other : sc->grasps)
+      if (other.name == sg.name) rd.Fail(key + ".name", "duplicated grasp name '" + sg.name + "'");
+    if (g["edge"] && g["node"]) rd.Fail(key, "give edge or node, not both");
+    if (!g["edge"] && !g["node"]) rd.Fail(key + ".edge", "missing (expected the edge or node the grasp holds)");
+    const char* kind = g["edge"] ? "edge" : "node";
+    const int index = rd.Get<int>(g[kind], key + "." + kind, "an integer");
+    sg.holds = std::string(kind) + " " + std::to_string(index);
+    const std::string expected = sites.empty() ? sg.holds : sites[i];
+    if (sg.holds != expected)
+      rd.Fail(key + "." + kind, "expected the " + expected + " (the model's grasps in order), got " + sg.holds);
+    sg.offset = static_cast<int>(i) * m;
+    if (g["model_origin"]) {
+      const Vec o = rd.Vector(g["model_origin"], key + ".model_origin", 3);
+      sg.has_model_origin = true;
+      sg.model_origin = {o[0], o[1], o[2]};
+    }
+    if (!r.path.empty()) {
+      if (path_points != 0 && r.path.size() != path_points)
+        rd.Fail(key + ".path", "expected " + std::to_string(path_points) + " points as the other grasps' paths");
+      path_points = r.path.size();
+    }
+    sc->grasps.push_back(sg);
+    reads.push_back(std::move(r));
+  }
+  const int total = m * static_cast<int>(reads.size());
+  sc->grasp_start.resize(total);
+  for (size_t i = 0; i < reads.size(); ++i) sc->grasp_start.segment(i * m, m) = reads[i].start;
+  for (size_t k = 0; k < path_points; ++k) {
+    Vec p(total);
+    for (size_t i = 0; i < reads.size(); ++i)
+      p.segment(i * m, m) = reads[i].path.empty() ? reads[i].start : reads[i].path[k];
+    sc->path.push_back(p);
+  }
 }
 
 void ApplyOverrides(YAML::Node root, const std::vector<SceneOverride>& overrides, const Reader& rd) {
@@ -233,7 +353,7 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
   }
   if (!root || !root.IsMap()) throw SceneError(file_label + ": expected a YAML mapping at the top level");
   ApplyOverrides(root, overrides, rd);
-  rd.CheckKeys(root, "", {"name", "description", "model", "params", "grasp", "solver", "device", "targets"});
+  rd.CheckKeys(root, "", {"name", "description", "model", "params", "grasp", "grasps", "solver", "device", "targets"});
 
   Scene sc;
   sc.file = file_label;
@@ -255,55 +375,29 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
   std::string error;
   if (!sc.params.IsValid(&error)) throw SceneError(file_label + ": " + error);
 
-  // Controls: the grasp position (2 or 3 numbers), then a unit grip direction if the
-  // model holds one, or a rotation vector (start: 0) if it holds the full orientation
-  // (see GraspLayout).
   sc.grasp_layout = model->capabilities.grasp_layout(sc.params);
-  const int pos_dim = sc.grasp_layout.spatial_dimension;
-  const bool grip = sc.grasp_layout.grip_direction;
-  const int m = sc.grasp_layout.NumControls();
-  if (!root["grasp"]) rd.Fail("grasp", "missing (expected start and path)");
-  const YAML::Node g = root["grasp"];
-  rd.CheckKeys(g, "grasp", {"start", "direction", "path"});
-  if (!g["start"]) rd.Fail("grasp.start", "missing (expected a list of " + std::to_string(pos_dim) + " numbers)");
-  Vec start = rd.Vector(g["start"], "grasp.start", pos_dim);
-  Vec dir;
-  if (grip) {
-    if (!g["direction"]) rd.Fail("grasp.direction", "missing: params.grip_direction needs a list of 3 numbers");
-    dir = rd.Vector(g["direction"], "grasp.direction", 3);
-    if (!(dir.norm() > 1e-9)) rd.Fail("grasp.direction", "expected a non-zero vector");
-    dir.normalize();
-  } else if (g["direction"]) {
-    rd.Fail("grasp.direction", "only allowed with params.grip_direction: true");
-  }
-  sc.grasp_start = Vec::Zero(m);
-  sc.grasp_start.head(pos_dim) = start;
-  if (grip) sc.grasp_start.tail(3) = dir;
-  if (g["path"]) {
-    const YAML::Node path = g["path"];
-    if (!path.IsSequence() || path.size() < 1) rd.Fail("grasp.path", "expected a list of points");
-    for (size_t i = 0; i < path.size(); ++i) {
-      const std::string key = "grasp.path[" + std::to_string(i) + "]";
-      Vec p(m);
-      // With a grip direction a waypoint may also turn the grip: X,Y,Z,dx,dy,dz.
-      if (sc.grasp_layout.grip_rotation) {
-        p = RotationWaypoint(path[i], key, rd);
-      } else if (grip && path[i].IsSequence() && path[i].size() == 6) {
-        p = rd.Vector(path[i], key, 6);
-        if (!(p.tail(3).norm() > 1e-9)) rd.Fail(key, "expected a non-zero grip direction");
-        p.tail(3).normalize();
-      } else {
-        p.head(pos_dim) = rd.Vector(path[i], key, pos_dim);
-        if (grip) p.tail(3) = dir;
-      }
-      sc.path.push_back(p);
-    }
+  if (root["grasp"] && root["grasps"]) rd.Fail("grasps", "also given as grasp; keep one");
+  if (root["grasps"]) {
+    ReadGrasps(root["grasps"], *model, rd, &sc);
+  } else {
+    if (!root["grasp"]) rd.Fail("grasp", "missing (expected start and path)");
+    if (model->capabilities.grasp_sites && model->capabilities.grasp_sites(sc.params).size() != 1)
+      rd.Fail("grasp", "this model has several grasps: name them under grasps:");
+    GraspRead g = ReadGrasp(root["grasp"], "grasp", sc.grasp_layout, rd);
+    sc.grasps = {SceneGrasp{}};
+    sc.grasp_start = std::move(g.start);
+    sc.path = std::move(g.path);
   }
 
   if (root["solver"]) {
     const YAML::Node s = root["solver"];
     rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "time_budget_us", "max_time_us",
-                               "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor"});
+                               "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor",
+                               "max_update_hz"});
+    sc.max_update_hz = rd.Number(s, "max_update_hz", "solver.max_update_hz", 0.0);
+    if (!(sc.max_update_hz >= 0.0 && sc.max_update_hz <= 100000.0))
+      throw SceneError(file_label + ": solver.max_update_hz: expected a rate in [0, 100000] Hz (0 = no cap), got " +
+                       std::to_string(sc.max_update_hz));
     if (s["method"]) {
       // A registered solver's name: checked where the solver is made (MakeSolver), since
       // a scene links no solver code (the device client reads scenes).
@@ -352,6 +446,20 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
     sc.target_rate_hz = rd.Positive(t, "rate_hz", "targets.rate_hz", 1000.0);
   }
   return sc;
+}
+
+int FindGrasp(const Scene& scene, const std::string& name) {
+  if (name.empty()) return 0;
+  for (size_t i = 0; i < scene.grasps.size(); ++i)
+    if (scene.grasps[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+DeviceMapping GraspDeviceMapping(const Scene& scene, int grasp) {
+  DeviceMapping m = scene.device;
+  if (grasp >= 0 && grasp < static_cast<int>(scene.grasps.size()) && scene.grasps[grasp].has_model_origin)
+    m.model_origin = scene.grasps[grasp].model_origin;
+  return m;
 }
 
 Scene LoadScene(const std::string& path, const std::vector<SceneOverride>& overrides) {

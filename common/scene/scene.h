@@ -25,22 +25,48 @@ struct DeviceMapping {
   std::array<double, 3> model_origin = {0.0, 0.0, 0.0};
 };
 
+// One grasp of a scene (issue 15): a scene with `grasps:` names several, each holding a
+// part of the model (the model's grasp sites, models/registry.h) and taking
+// grasp_layout.NumControls() controls of u, in the order listed. A scene with the single
+// `grasp:` has one, named "" (the only grasp, as devices and messages call it).
+struct SceneGrasp {
+  std::string name;
+  std::string holds;  // "edge 0", "edge 59"; "" for the single grasp
+  int offset = 0;     // its first control in u
+  // The model point this grasp's device origin maps to (`model_origin:` of the grasp):
+  // each hand works about its own end. Unset: the scene's device.model_origin.
+  bool has_model_origin = false;
+  std::array<double, 3> model_origin = {0.0, 0.0, 0.0};
+};
+
 struct Scene {
   std::string file;         // where it was loaded from ("<string>" for text)
   std::string name;
   std::string description;
   ModelParams params;
-  GraspLayout grasp_layout;  // the model's controls as a device sees them
-  Vec grasp_start;          // initial controls u (size = model controls)
-  // Scripted path of the grasp through the scene's snaps (waypoints in control space),
-  // used by the demo, the device client's scripted backends and the tests.
+  GraspLayout grasp_layout;  // the controls of one grasp as a device sees them
+  std::vector<SceneGrasp> grasps;  // at least one
+  Vec grasp_start;          // initial controls u (size = model controls: every grasp's, in order)
+  // Scripted path of the grasp through the scene's snaps (waypoints in control space,
+  // every grasp's controls at each point), used by the demo, the device client's scripted
+  // backends and the tests.
   std::vector<Vec> path;
   SolverOptions solver;
+  // solver.max_update_hz: the server's cap on equilibrium updates per second (issue 17;
+  // 0 = none). The server's --max-update-hz overrides it.
+  double max_update_hz = 0.0;
   DeviceMapping device;
   // Optional targets for "model no more than a scene needs".
   double target_force_error = 0.0;  // relative to the model's force scale; 0 = none
   double target_rate_hz = 0.0;
 };
+
+// The index in scene.grasps of the grasp called `name`, -1 when there is none ("" names
+// the first grasp of any scene, so a client without --grasp binds as before).
+int FindGrasp(const Scene& scene, const std::string& name);
+// The device mapping of grasp `grasp` (an index into scene.grasps; the scene's mapping
+// for a scene without grasps): the scene's, about the grasp's own model origin.
+DeviceMapping GraspDeviceMapping(const Scene& scene, int grasp);
 
 class SceneError : public std::runtime_error {
  public:

@@ -221,7 +221,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   SolverSummary s;
   if (!BeginSolve(u, *x, &s) || ContinueSnap(u, x, &s)) return s;
   Vec& xr = *x;
-  double r = EvalGradient(xr, u, &s);
+  double r = EvalGradientAtStart(xr, u, &s);
   s.termination = Termination::kBudgetSpent;
   bool newton_stalled = false;
   int reduction_stalls = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -33,7 +34,7 @@ SolverBase::SolverBase(const Model& model, const SolverOptions& options)
   }
   w.eig.Resize(n_);
   w.orbits = std::make_unique<SymmetryOrbits>(model_);
-  for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch}) v->resize(n_);
+  for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch, &w.h_state}) v->resize(n_);
 }
 
 void SolverBase::Reset() {
@@ -56,6 +57,8 @@ bool SolverBase::BeginSolve(const Vec& u, const Vec& x, SolverSummary* s) {
   start_ = Clock::now();
   factor_valid_ = false;
   factor_before_tiny_step_ = false;
+  // Lagged model data (AcceptState) may have changed E since the last solve.
+  hessian_ready_ = false;
   // Eigen checks sizes only with assertions on: a Release build must check here.
   const char* why = nullptr;
   if (x.size() != n_) why = "the state has the wrong size";
@@ -180,8 +183,21 @@ double SolverBase::EvalGradient(const Vec& x, const Vec& u, SolverSummary* s) {
   return EvalGradient(x, u, &ws_.g, s);
 }
 
+double SolverBase::EvalGradientAtStart(const Vec& x, const Vec& u, SolverSummary* s) {
+  model_.GradientAndHessian(x, u, &ws_.g, &ws_.h);
+  ++s->gradient_evaluations;
+  ws_.h_state = x;
+  hessian_ready_ = true;
+  return ws_.g.norm();
+}
+
 LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummary* s) {
-  model_.Hessian(x, u, &ws_.h);
+  // E_xx from EvalGradientAtStart at this very state (bit for bit) is not evaluated again;
+  // it counts as this factorisation's evaluation.
+  const bool have_h = hessian_ready_ && x.size() == ws_.h_state.size() &&
+                      std::memcmp(x.data(), ws_.h_state.data(), sizeof(double) * x.size()) == 0;
+  hessian_ready_ = false;
+  if (!have_h) model_.Hessian(x, u, &ws_.h);
   ++s->hessian_evaluations;
   ++s->factorizations;
   const LinearSolverStatus st = ws_.factor->Factorize(ws_.h);
@@ -367,7 +383,7 @@ NewtonSolver::NewtonSolver(const Model& model, const SolverOptions& options, boo
 SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
   SolverSummary s;
   if (!BeginSolve(u, *x, &s) || ContinueSnap(u, x, &s)) return s;
-  double r = EvalGradient(*x, u, &s);
+  double r = EvalGradientAtStart(*x, u, &s);
   s.termination = Termination::kBudgetSpent;
   while (NextIteration(r, x, &s)) {
     if (line_search_) {

@@ -55,6 +55,10 @@ class SolverBase : public EquilibriumSolver {
   double EvalGradient(const Vec& x, const Vec& u, SolverSummary* s);
   // E_x(x, u) into *g (a method's own vector); returns its norm.
   double EvalGradient(const Vec& x, const Vec& u, Vec* g, SolverSummary* s) const;
+  // EvalGradient(x, u, s) at the warm start of a solve, where E_xx is always needed next
+  // (by the first iteration, or by Finish() when the warm start has converged): the model
+  // evaluates both in one pass, and the next FactorAt() at this x uses that E_xx.
+  double EvalGradientAtStart(const Vec& x, const Vec& u, SolverSummary* s);
   const Vec& Gradient() const { return ws_.g; }
 
   // --- Hessian and its factorisations ------------------------------------------------
@@ -103,6 +107,7 @@ class SolverBase : public EquilibriumSolver {
     SmallestEigenpair eig;
     std::unique_ptr<SymmetryOrbits> orbits;
     Vec g, dx, trial, last_good, dx_scratch;
+    Vec h_state;  // the state h was evaluated at by EvalGradientAtStart (hessian_ready_)
   };
 
   bool BudgetLeft(const SolverSummary& s) const;
@@ -131,6 +136,8 @@ class SolverBase : public EquilibriumSolver {
   // The factorisation holds E_xx at the state before the last, tiny, plain Newton step:
   // Finish() may use it instead of factorising again (kReuseStep).
   bool factor_before_tiny_step_ = false;
+  // ws_.h holds E_xx at ws_.h_state from EvalGradientAtStart, not yet factorised.
+  bool hessian_ready_ = false;
   double lambda_ref_ = -1.0;     // lambda_0 at the last regular converged state
   // MinimizeFully stopped at the time budget: the snap goes on at the next update.
   bool snap_in_progress_ = false;

@@ -157,14 +157,12 @@ void EquilibriumTracker::ComputeForces() {
   const Model& m = *model_;
   // F = -E_u at the equilibrium (envelope theorem, §2.3.4); at a degenerate point this
   // is still the finite, continuous force of (2.16-2.17).
-  m.ControlGradient(x_, u_, &eu_);
+  m.ControlDerivatives(x_, u_, &eu_, &exu_, &euu_);
   result_.force = -eu_;
   result_.energy = result_.summary.energy;
   result_.probe = m.Probe(x_, u_);
 
   // K = dF/du = -(E_uu - E_ux E_xx^-1 E_xu) (implicit differentiation, (2.14-2.15)).
-  m.ControlHessian(x_, u_, &euu_);
-  m.MixedHessian(x_, u_, &exu_);
   result_.stiffness_regularized = false;
   if (result_.summary.status == EquilibriumStatus::kSnapping) {
     // Mid-snap (time budget): the state is an accepted, energy-decreasing one but no
@@ -199,8 +197,11 @@ void EquilibriumTracker::ComputeForces() {
   Mat& k = result_.stiffness;
   if (ok) {
     // -(E_uu - E_ux sol), written without temporaries (no allocation per update).
-    k.noalias() = exu_.transpose() * sol_;
-    k -= euu_;
+    // (A column dot per entry: a general matrix product packs its operands first, a
+    // tenth of an update at n = 1000.)
+    for (int j = 0; j < k.cols(); ++j) {
+      for (int i = 0; i < k.rows(); ++i) k(i, j) = exu_.col(i).dot(sol_.col(j)) - euu_(i, j);
+    }
   }
   if (!ok || !k.allFinite()) {
     // No usable factorisation: the stiffness with the state held (no response), finite.

@@ -15,6 +15,7 @@
 #include "auth/message_mac.h"
 #include "auth/pose_echo_window.h"
 #include "auth/session_epoch.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "sample_messages.h"
 
@@ -36,8 +37,8 @@ Bytes Copy(const lcm::ReceiveBuffer* rbuf) {
 class Device {
  public:
   Device(lcm::LCM* lcm, const SessionKey* key) : lcm_(lcm), key_(key) {
-    lcm->subscribe(kStatus, &Device::OnStatus, this);
-    lcm->subscribe(kModel, &Device::OnModel, this);
+    messages::Subscribe<&Device::OnStatus>(lcm, kStatus, this);
+    messages::Subscribe<&Device::OnModel>(lcm, kModel, this);
   }
 
   void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
@@ -90,7 +91,9 @@ class Device {
 class Server {
  public:
   Server(lcm::LCM* lcm, const SessionKey* key)
-      : lcm_(lcm), key_(key), subscription_(lcm->subscribe(kPose, &Server::OnPose, this)) {}
+      : lcm_(lcm),
+        key_(key),
+        subscription_(messages::Subscribe<&Server::OnPose>(lcm, kPose, this)) {}
   ~Server() { lcm_->unsubscribe(subscription_); }
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
@@ -144,8 +147,8 @@ TEST(AuthOverMemqTest, ForgedReplayedAndRekeyedMessagesAreRefusedAndCounted) {
   ASSERT_TRUE(lcm.good());
   const SessionKey key = SessionKey::Generate();
   Recorder log;
-  lcm.subscribe(kModel, &Recorder::OnAny, &log);
-  lcm.subscribe(kStatus, &Recorder::OnAny, &log);
+  messages::Subscribe<&Recorder::OnAny>(lcm, kModel, &log);
+  messages::Subscribe<&Recorder::OnAny>(lcm, kStatus, &log);
   Device device(&lcm, &key);
   auto server = std::make_unique<Server>(&lcm, &key);
 

@@ -27,6 +27,7 @@
 #include "auth/session_epoch.h"
 #include "command_message.h"
 #include "messages/channels.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "test_support.h"
 
@@ -95,7 +96,7 @@ class LiveProcess {
  public:
   LiveProcess(const std::vector<std::string>& argv, const std::string& log, const std::string& status_channel)
       : log_(log), child_(argv, test_support::OneLog(log, true)), lcm_(test_support::kLoopbackLcmUrl) {
-    lcm_.subscribe(status_channel, &LiveProcess::OnStatus, this);
+    messages::Subscribe<&LiveProcess::OnStatus>(lcm_, status_channel, this);
     thread_ = std::thread([this] {
       while (!stop_.load()) lcm_.handleTimeout(20);
     });
@@ -279,7 +280,7 @@ class FakeServer {
  public:
   FakeServer(const transport::Channels& ch, lcm::LCM* lcm, const auth::SessionKey* key)
       : ch_(ch), lcm_(lcm), key_(key), epoch_(auth::NewEpoch()) {
-    lcm_->subscribe(ch_.device_state, &FakeServer::OnPose, this);
+    messages::Subscribe<&FakeServer::OnPose>(lcm_, ch_.device_state, this);
   }
   void Tick() {
     if (Clock::now() < next_status_) return;

@@ -29,6 +29,7 @@
 #include "auth/session_epoch.h"
 #include "messages/channels.h"
 #include "messages/pose_mapping.h"
+#include "messages/subscribe.h"
 #include "scene/scene.h"
 #include "snapthread/device_state_t.hpp"
 #include "snapthread/force_model_t.hpp"
@@ -60,9 +61,9 @@ std::string Hex(int64_t v) {
 class SessionListener {
  public:
   explicit SessionListener(const std::string& session) : lcm_(kUrl), channels_(session) {
-    lcm_.subscribe(channels_.solver_status, &SessionListener::OnStatus, this);
-    lcm_.subscribe(channels_.shape, &SessionListener::OnShape, this);
-    lcm_.subscribe(channels_.force_model, &SessionListener::OnModel, this);
+    messages::Subscribe<&SessionListener::OnStatus>(lcm_, channels_.solver_status, this);
+    messages::Subscribe<&SessionListener::OnShape>(lcm_, channels_.shape, this);
+    messages::Subscribe<&SessionListener::OnModel>(lcm_, channels_.force_model, this);
     thread_ = std::thread([this] {
       while (!stop_) lcm_.handleTimeout(20);
     });

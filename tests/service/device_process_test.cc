@@ -32,6 +32,7 @@
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "messages/channels.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "test_support.h"
 
@@ -97,7 +98,7 @@ class FakeServer {
   FakeServer(const std::string& session, const auth::SessionKey* key)
       : channels_(session), lcm_(kUrl), key_(key), epoch_(auth::NewEpoch()) {
     if (!lcm_.good()) return;
-    lcm_.subscribe(channels_.device_state, &FakeServer::OnPose, this);
+    messages::Subscribe<&FakeServer::OnPose>(lcm_, channels_.device_state, this);
     thread_ = std::thread([this] {
       auto next_status = std::chrono::steady_clock::now();
       while (!stop_.load()) {
@@ -367,8 +368,8 @@ class Listener {
  public:
   explicit Listener(const std::string& session) : channels_(session), lcm_(kUrl) {
     if (!lcm_.good()) return;
-    lcm_.subscribe(channels_.device_state, &Listener::OnPose, this);
-    lcm_.subscribe(channels_.device_status, &Listener::OnStatus, this);
+    messages::Subscribe<&Listener::OnPose>(lcm_, channels_.device_state, this);
+    messages::Subscribe<&Listener::OnStatus>(lcm_, channels_.device_status, this);
     thread_ = std::thread([this] {
       while (!stop_.load()) lcm_.handleTimeout(10);
     });

@@ -66,28 +66,7 @@ std::vector<TraceRow> ReadTrace(const std::string& path) {
   return rows;
 }
 
-// The numbers of a flat JSON object ({"key": number, ...}).
-std::map<std::string, double> ReadJsonNumbers(const std::string& path) {
-  std::map<std::string, double> out;
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
-  size_t pos = 0;
-  while ((pos = text.find('"', pos)) != std::string::npos) {
-    const size_t end = text.find('"', pos + 1);
-    if (end == std::string::npos) break;
-    const std::string key = text.substr(pos + 1, end - pos - 1);
-    size_t colon = text.find_first_not_of(" \t", end + 1);
-    pos = end + 1;
-    if (colon == std::string::npos || text[colon] != ':') continue;
-    const char* start = text.c_str() + colon + 1;
-    char* stop = nullptr;
-    const double v = std::strtod(start, &stop);
-    if (stop != start) out[key] = v;
-  }
-  return out;
-}
+using test_support::ReadJsonNumbers;
 
 double Percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;

@@ -19,6 +19,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "messages/channels.h"
+#include "messages/subscribe.h"
 #include "snapthread/command_t.hpp"
 #include "snapthread/device_state_t.hpp"
 #include "snapthread/force_model_t.hpp"
@@ -41,7 +42,7 @@ class Rogue {
   bool good() { return lcm_.good(); }
 
   void Run(double duration_s, const std::vector<LoggedEvent>& replay) {
-    lcm_.subscribe(channels_.device_state, &Rogue::OnPose, this);
+    snapthread::messages::Subscribe<&Rogue::OnPose>(lcm_, channels_.device_state, this);
     const auto start = Clock::now();
     auto next_noise = start;
     size_t replay_at = 0;

@@ -22,6 +22,7 @@
 #include "auth/message_gate.h"
 #include "auth/message_mac.h"
 #include "messages/channels.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "snapthread/force_model_t.hpp"
 #include "snapthread/solver_status_t.hpp"
@@ -48,8 +49,8 @@ class Watcher {
  public:
   Watcher(const std::string& session, const auth::SessionKey* key)
       : channels_(session), key_(key) {
-    lcm_.subscribe(channels_.solver_status, &Watcher::OnStatus, this);
-    lcm_.subscribe(channels_.force_model, &Watcher::OnModel, this);
+    messages::Subscribe<&Watcher::OnStatus>(lcm_, channels_.solver_status, this);
+    messages::Subscribe<&Watcher::OnModel>(lcm_, channels_.force_model, this);
     thread_ = std::thread([this] {
       while (!stop_) lcm_.handleTimeout(10);
     });

@@ -29,6 +29,7 @@
 #include "command_message.h"
 #include "environment.h"
 #include "messages/pose_mapping.h"
+#include "messages/subscribe.h"
 #include "scene/scene.h"
 #include "server.h"
 #include "session_key_file.h"
@@ -92,7 +93,8 @@ class ServerCheckpointTest : public ::testing::Test {
       };
     }
     server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
-    shape_sub_ = lcm_.subscribe(server_->channels().shape, &ServerCheckpointTest::OnShape, this);
+    shape_sub_ = messages::Subscribe<&ServerCheckpointTest::OnShape>(lcm_, server_->channels().shape,
+                                                                 this);
     server_->Start();
   }
   void StartServer() { StartServer(Params()); }

@@ -26,6 +26,7 @@
 #include "arrival_log.h"
 #include "environment.h"
 #include "messages/pose_mapping.h"
+#include "messages/subscribe.h"
 #include "scene/scene.h"
 #include "scene_dir.h"
 #include "server.h"
@@ -70,7 +71,7 @@ class CommandsTest : public ::testing::Test {
     params.log_level = "off";
     params.key_path = key_file_.path();
     server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
-    sub_ = lcm_.subscribe(server_->channels().force_model, &CommandsTest::OnModel, this);
+    sub_ = messages::Subscribe<&CommandsTest::OnModel>(lcm_, server_->channels().force_model, this);
     server_->Start();
     const Scene scene = LoadScene(params.scene_path);
     pose_ = messages::ControlsToPosition(scene.device, scene.grasp_layout, scene.grasp_start);

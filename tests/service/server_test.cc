@@ -26,6 +26,7 @@
 #include "models/models.h"
 #include "scene/scene.h"
 #include "tracking/tracker.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
@@ -47,9 +48,9 @@ using test_support::SourceDir;
 class Probe {
  public:
   Probe(lcm::LCM* lcm, const transport::Channels& ch) : lcm_(lcm) {
-    subs_.push_back(lcm->subscribe(ch.force_model, &Probe::OnModel, this));
-    subs_.push_back(lcm->subscribe(ch.shape, &Probe::OnShape, this));
-    subs_.push_back(lcm->subscribe(ch.solver_status, &Probe::OnStatus, this));
+    subs_.push_back(messages::Subscribe<&Probe::OnModel>(lcm, ch.force_model, this));
+    subs_.push_back(messages::Subscribe<&Probe::OnShape>(lcm, ch.shape, this));
+    subs_.push_back(messages::Subscribe<&Probe::OnStatus>(lcm, ch.solver_status, this));
   }
   ~Probe() {
     for (auto* s : subs_) lcm_->unsubscribe(s);
@@ -339,6 +340,13 @@ TEST_F(ServerTest, ThreadGripDirectionFromOrientation) {
     for (int a = 0; a < 3; ++a) EXPECT_NEAR(m.torque0[a], tau[a], 1e-9 * (1.0 + tau.norm()));
   }
   EXPECT_EQ(server_->Stats().snaps, direct_snaps);
+  // The knot type (server/knot_watch.h) reaches the status and the shape: a bent thread
+  // with free ends, closed far away, is the unknot.
+  EXPECT_TRUE(probe_->WaitStatus(0, [](const solver_status_t& st) {
+    return st.knot == "unknot" && st.knot_determinant == 1;
+  }));
+  EXPECT_TRUE(probe_->WaitShape(0, [](const thread_shape_t& sh) { return sh.knot == "unknot"; },
+                                nullptr));
   EXPECT_EQ(probe_->invalid(), 0);
 }
 

@@ -21,6 +21,7 @@
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "messages/channels.h"
+#include "messages/subscribe.h"
 #include "snapthread/command_t.hpp"
 #include "snapthread/solver_status_t.hpp"
 #include "test_support.h"
@@ -131,7 +132,7 @@ TEST_F(SignalTest, ViewerStopsWithinOneSecond) {
 class StatusListener {
  public:
   explicit StatusListener(const std::string& session) : lcm_(kUrl), channels_(session) {
-    lcm_.subscribe(channels_.solver_status, &StatusListener::On, this);
+    messages::Subscribe<&StatusListener::On>(lcm_, channels_.solver_status, this);
     thread_ = std::thread([this] {
       while (!stop_) lcm_.handleTimeout(20);
     });

@@ -21,6 +21,7 @@
 #include "messages/lcm_url.h"
 #include "realtime/percentiles.h"
 #include "realtime/spsc_ring.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "sample_messages.h"
 
@@ -136,7 +137,7 @@ void RoundTrip(const T& sent) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
   Catcher<T> catcher;
-  lcm.subscribe("RT_TEST", &Catcher<T>::Handle, &catcher);
+  messages::Subscribe<&Catcher<T>::Handle>(lcm, "RT_TEST", &catcher);
   ASSERT_EQ(lcm.publish("RT_TEST", &sent), 0);
   for (int i = 0; i < 10 && catcher.got.empty() && catcher.rejected.empty(); ++i) {
     lcm.handleTimeout(100);
@@ -410,7 +411,7 @@ TEST(TransportDecodeTest, GarbageOverMemqIsCountedNotFatal) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
   Catcher<force_model_t> catcher;
-  lcm.subscribe("FUZZ", &Catcher<force_model_t>::Handle, &catcher);
+  messages::Subscribe<&Catcher<force_model_t>::Handle>(lcm, "FUZZ", &catcher);
   std::mt19937 rng(99);
   std::uniform_int_distribution<int> byte(0, 255);
   for (int i = 0; i < 200; ++i) {

@@ -2,8 +2,9 @@
 // promise "no allocation after warm-up" (the servo tick, signing, the LDL^T backends, the
 // model derivatives) count what the calling thread allocates between two points.
 //
-// allocation_counter.cc replaces glibc's malloc family and the global operator new/delete
-// with counting versions; it is linked (snapthread::test_allocation_counter) only into the
+// allocation_counter.cc replaces glibc's malloc family (under AddressSanitizer it counts
+// in the sanitizer's malloc hook instead) and the global operator new/delete with
+// counting versions; it is linked (snapthread::test_allocation_counter) only into the
 // test binaries that count, since a program may replace them once. The malloc count sees
 // every heap allocation: operator new (the replacements call malloc), Eigen's
 // aligned_malloc (std::malloc, which operator new alone would miss) and CHOLMOD's
@@ -15,10 +16,10 @@
 
 namespace snapthread::test_support {
 
-// Under AddressSanitizer the sanitizer owns malloc: no interposition there, the counts
-// stay zero, and the allocation-counting tests run in the Release build only
-// (deploy/test.sh). Outside glibc there are no __libc_* functions to forward to.
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
+// Under AddressSanitizer the sanitizer owns malloc: there its malloc hook counts
+// (__sanitizer_install_malloc_and_free_hooks), so the same tests assert the same counts
+// in the sanitizer build. Outside glibc there are no __libc_* functions to forward to.
+#if defined(__GLIBC__)
 inline constexpr bool kCountsAllocations = true;
 #else
 inline constexpr bool kCountsAllocations = false;

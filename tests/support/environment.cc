@@ -24,6 +24,14 @@ std::string SourceDir() { return EnvOr("SNAPTHREAD_SOURCE_DIR", SNAPTHREAD_TEST_
 std::string BinDir() { return EnvOr("SNAPTHREAD_BIN_DIR", SNAPTHREAD_TEST_BIN_DIR); }
 std::string ScenePath(const std::string& file) { return SourceDir() + "/scenes/" + file; }
 
+double SpeedScale() {
+  const char* v = std::getenv("SNAPTHREAD_SPEED_SCALE");
+  if (v == nullptr || *v == '\0') return 1.0;
+  char* end = nullptr;
+  const double scale = std::strtod(v, &end);
+  return (end != v && *end == '\0' && scale >= 1.0 && scale <= 100.0) ? scale : 1.0;
+}
+
 std::string UniqueSession(const std::string& prefix) {
   static std::atomic<int> counter{0};
   std::random_device rd;
@@ -36,6 +44,25 @@ std::string ReadFile(const std::string& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+std::map<std::string, double> ReadJsonNumbers(const std::string& path) {
+  std::map<std::string, double> out;
+  const std::string text = ReadFile(path);
+  size_t pos = 0;
+  while ((pos = text.find('"', pos)) != std::string::npos) {
+    const size_t end = text.find('"', pos + 1);
+    if (end == std::string::npos) break;
+    const std::string key = text.substr(pos + 1, end - pos - 1);
+    size_t colon = text.find_first_not_of(" \t", end + 1);
+    pos = end + 1;
+    if (colon == std::string::npos || text[colon] != ':') continue;
+    const char* start = text.c_str() + colon + 1;
+    char* stop = nullptr;
+    const double v = std::strtod(start, &stop);
+    if (stop != start) out[key] = v;
+  }
+  return out;
 }
 
 bool WaitUntil(const std::function<bool()>& condition, double timeout_s, double poll_s) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 
 namespace snapthread::test_support {
@@ -19,8 +20,16 @@ std::string ScenePath(const std::string& file);  // SourceDir()/scenes/file
 // are at most 63 bytes with the channel suffix).
 std::string UniqueSession(const std::string& prefix);
 
+// $SNAPTHREAD_SPEED_SCALE (default 1, at least 1): how many times slower than the Release
+// build this build runs; deploy/test.sh sets it for the sanitizer run. Only wall-clock
+// thresholds that are about speed (a time budget) are multiplied by it, never a safety
+// property (|F| limits, finiteness, ordering, rejection counts).
+double SpeedScale();
+
 // The whole file ("" when it cannot be read).
 std::string ReadFile(const std::string& path);
+// The numbers of a flat JSON object ({"key": number, ...}) in a file, e.g. a --summary.
+std::map<std::string, double> ReadJsonNumbers(const std::string& path);
 
 // Polls `condition` every poll_s until it holds (true) or timeout_s has passed (false;
 // the condition is asked once more at the deadline).

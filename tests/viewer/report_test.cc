@@ -117,6 +117,10 @@ std::string WriteReferenceLog(const std::string& dir) {
       st.solve_us_p50 = 200;
       st.solve_us_p99 = 300;
       st.updates = k;
+      // Issue 15: the knot is tied at k = 150, with contacts from k = 100.
+      st.knot = k < 150 ? "unknot" : "trefoil";
+      st.knot_determinant = k < 150 ? 1 : 3;
+      st.contacts = k < 100 ? 0 : k < 150 ? 2 : 4;
       log.Write("RPT_SOLVER_STATUS", t + 20, st);
     }
     if (k % 40 == 0) {
@@ -211,6 +215,11 @@ TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
   EXPECT_NE(summary.find("shapes count 1"), std::string::npos) << summary;
   EXPECT_NE(summary.find("clamps: force 4 "), std::string::npos) << summary;
   EXPECT_NE(summary.find("methods: newton, higher-order"), std::string::npos) << summary;
+  // The knot over time (statuses at log time (k * 1000 + 20 - 1000) us, k = 10, 20, ...).
+  EXPECT_NE(summary.find("knot_changes: 0.009 unknot (det 1) 0.149 trefoil (det 3)\n"),
+            std::string::npos) << summary;
+  EXPECT_NE(summary.find("knot_last: trefoil; contacts max 4 last 4"), std::string::npos)
+      << summary;
   EXPECT_NE(summary.find("duration_s: 0.200"), std::string::npos) << summary;
   // Round trip as logged: every answered pose took 700 us (the repeat answers pose 10 late).
   EXPECT_NE(summary.find("round_trip_us (pose logged -> model logged) p50 700"), std::string::npos)
@@ -220,7 +229,13 @@ TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
   int rows = -1;
   for (std::string line; std::getline(csv, line);) rows++;
   EXPECT_EQ(rows, 197);
-  for (const char* png : {"force.png", "solver.png", "device.png", "latency_hist.png"}) {
+  std::ifstream knot_csv(dir + "/out/knot.csv");
+  std::vector<std::string> knot_rows;
+  for (std::string line; std::getline(knot_csv, line);) knot_rows.push_back(line);
+  ASSERT_EQ(knot_rows.size(), 21u);
+  EXPECT_EQ(knot_rows[0], "t_s,knot,knot_determinant,contacts");
+  EXPECT_EQ(knot_rows[20], "0.19902,trefoil,3,4");
+  for (const char* png : {"force.png", "solver.png", "device.png", "latency_hist.png", "knot.png"}) {
     SCOPED_TRACE(png);
     ExpectNonTrivialPng(dir + "/out/" + png);
   }
@@ -259,7 +274,9 @@ TEST(ReportTest, DamagedMiddleIsSkippedAndTheRestStillRead) {
   {
     std::fstream f(log, std::ios::in | std::ios::out | std::ios::binary);
     f.seekp(std::streamoff(size / 2));
-    const std::string junk(300, '\xAB');
+    // Longer than any one event (a force model with its 6x6 wrench block is ~0.8 kB), so
+    // the damage reaches an event header wherever it lands.
+    const std::string junk(2000, '\xAB');
     f.write(junk.data(), std::streamsize(junk.size()));
   }
   std::string summary;

@@ -5,6 +5,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "messages/pose_mapping.h"
+#include "messages/subscribe.h"
 #include "snapthread/device_state_t.hpp"
 
 #include "grasp_publisher.h"
@@ -79,7 +80,7 @@ TEST(GraspMappingTest, PublisherSendsDeviceMetresOnTheSessionChannel) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
   PoseSink sink;
-  lcm.subscribe("GRASPTEST_DEVICE_STATE", &PoseSink::On, &sink);
+  messages::Subscribe<&PoseSink::On>(lcm, "GRASPTEST_DEVICE_STATE", &sink);
   DeviceMapping m;
   m.model_units_per_metre = 100.0;
   m.model_origin = {0.5, 0.0, 0.0};

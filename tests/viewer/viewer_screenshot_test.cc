@@ -5,6 +5,7 @@
 #include <mutex>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <random>
 #include <thread>
 
@@ -14,6 +15,7 @@
 #include "messages/pose_mapping.h"
 #include "grasp_publisher.h"
 #include "hud_layout.h"
+#include "marker_colors.h"
 #include "snapthread/device_state_t.hpp"
 #include "scene/scene.h"
 #include "orbit_camera.h"
@@ -22,6 +24,7 @@
 #include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
 #include "messages/channels.h"
+#include "messages/subscribe.h"
 #include "spline.h"
 #include "png_image.h"
 #include "test_support.h"
@@ -76,11 +79,14 @@ thread_shape_t ArcShape(int64_t seq, int8_t status = 0) {
 // announced in a signed solver status before each shape).
 class ShapePublisher {
  public:
-  ShapePublisher(const std::string& session, bool with_garbage, int8_t status = 0)
+  // `decorate` adds to each shape (grasps, contacts) before it is signed.
+  ShapePublisher(const std::string& session, bool with_garbage, int8_t status = 0,
+                 std::function<void(thread_shape_t*)> decorate = {})
       : channel_(transport::Channels(session).shape),
         status_channel_(transport::Channels(session).solver_status),
         garbage_(with_garbage),
-        status_(status) {}
+        status_(status),
+        decorate_(std::move(decorate)) {}
   ~ShapePublisher() { Stop(); }
   bool Start() {
     if (!lcm_.good()) return false;
@@ -109,6 +115,7 @@ class ShapePublisher {
         lcm_.publish(status_channel_, &st);
       }
       thread_shape_t s = ArcShape(++seq, status_);
+      if (decorate_) decorate_(&s);
       if (auth::Sign(&s, channel_, epoch_, auth_seq_.Next(), key_file_.key())) {
         lcm_.publish(channel_, &s);
       }
@@ -162,6 +169,7 @@ class ShapePublisher {
   std::string status_channel_;
   bool garbage_;
   int8_t status_;
+  std::function<void(thread_shape_t*)> decorate_;
   std::atomic<bool> running_{true};
   std::atomic<int64_t> garbage_sent_{0};
   std::thread thread_;
@@ -347,6 +355,69 @@ TEST(ViewerScreenshotTest, SolverStateIsColourCoded) {
   EXPECT_GT(colour[1].x(), colour[1].z() + 80) << "snapped: " << colour[1].transpose();
 }
 
+// Issue 15: two grasps (the arc's end and its apex, each with its force) and one active
+// contact between two points of the arc at 40 and 50 degrees.
+const Point3 kGraspA(-1.0, 0.0, 0.0), kGraspB(0.0, 1.0, 0.0);
+const Point3 kContactA(std::cos(0.7), std::sin(0.7), 0.0), kContactB(std::cos(0.87), std::sin(0.87), 0.0);
+
+void AddGraspsAndContact(thread_shape_t* s) {
+  s->grasp_names = "left,right";
+  s->num_grasps = 2;
+  // The apex's force points down into the arc, the larger one: its arrow has full length.
+  s->grasps = {{kGraspA.x(), kGraspA.y(), kGraspA.z(), 0.0, -0.5, 0.0},
+               {kGraspB.x(), kGraspB.y(), kGraspB.z(), 0.0, -1.0, 0.0}};
+  s->num_contacts = 1;
+  s->contacts = {{kContactA.x(), kContactA.y(), kContactA.z(), kContactB.x(), kContactB.y(),
+                  kContactB.z()}};
+  s->knot = "unknot";
+}
+
+// The pixel's colour is `want` (a marker's flat colour, lit face-on) within `tol` levels.
+::testing::AssertionResult HasColour(const Image& img, const Eigen::Vector2d& at,
+                                     const viewer::Rgb& want, int tol) {
+  const uint8_t* c = img.At(int(std::lround(at.x())), int(std::lround(at.y())));
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(c[i] - int(std::lround(255 * want[i]))) > tol) {
+      return ::testing::AssertionFailure()
+             << "pixel (" << at.transpose() << ") is " << int(c[0]) << "," << int(c[1]) << ","
+             << int(c[2]) << ", want " << (255 * want).transpose();
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+TEST(ViewerScreenshotTest, DrawsEveryGraspAndTheActiveContacts) {
+  const std::string session = UniqueSession("VIEWGRASPS");
+  const std::string dir = FreshTempDir("viewer-grasps");
+  ShapePublisher publisher(session, false, 0, AddGraspsAndContact);
+  ASSERT_TRUE(publisher.Start());
+  const ViewerRun run = RunViewerScreenshot(session, dir, 5, 30.0);
+  publisher.Stop();
+  ASSERT_EQ(run.result.exit_code, 0) << run.result.out << run.result.err;
+  Image img;
+  std::string error;
+  ASSERT_TRUE(ReadPng(run.png, &img, &error)) << error;
+  const OrbitCamera camera = ArcCamera();
+  auto px = [&](const Point3& p) { return camera.ProjectToPixel(p, kWidth, kHeight); };
+  // Each grasp in its own colour (the marker's centre faces the camera: fully lit), where
+  // the tube alone is pale blue.
+  EXPECT_TRUE(HasColour(img, px(kGraspA), viewer::GraspColor(0), 40));
+  EXPECT_TRUE(HasColour(img, px(kGraspB), viewer::GraspColor(1), 40));
+  // Both contact points and the middle of the segment joining them are highlighted.
+  EXPECT_TRUE(HasColour(img, px(kContactA), viewer::kContactColor, 40));
+  EXPECT_TRUE(HasColour(img, px(kContactB), viewer::kContactColor, 40));
+  EXPECT_TRUE(HasColour(img, px(0.5 * (kContactA + kContactB)), viewer::kContactColor, 40));
+  // The second grasp's force arrow runs from the apex down into the arc (the first one's,
+  // half as long, along the x axis below the arc's end).
+  EXPECT_TRUE(HasColour(img, px(Point3(0.0, 0.6, 0.0)), viewer::kForceArrowColor, 60));
+  EXPECT_TRUE(IsBackground(img.At(int(px(Point3(0.0, 0.2, 0.0)).x()),
+                                  int(px(Point3(0.0, 0.2, 0.0)).y()))));
+  // A tube pixel away from every marker is the tube's colour, not a marker's.
+  const Eigen::Vector2d tube = px(Point3(std::cos(2.2), std::sin(2.2), 0.0));
+  EXPECT_FALSE(HasColour(img, tube, viewer::kContactColor, 40));
+  EXPECT_FALSE(HasColour(img, tube, viewer::GraspColor(1), 40));
+}
+
 // Review path of docs/lab-setup.md: a logged session played back with lcm-logplayer into a
 // viewer shows the logged thread.
 TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
@@ -419,7 +490,7 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
 class PoseCollector {
  public:
   explicit PoseCollector(const std::string& session) {
-    lcm_.subscribe(transport::Channels(session).device_state, &PoseCollector::On, this);
+    messages::Subscribe<&PoseCollector::On>(lcm_, transport::Channels(session).device_state, this);
     thread_ = std::thread([this] {
       while (running_) lcm_.handleTimeout(20);
     });

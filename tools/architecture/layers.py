@@ -37,6 +37,8 @@ FORBIDDEN = [
     ("messages", {"solvers", "linalg", "tracking", "CHOLMOD"}),
     ("snapthread-device", {"solvers", "linalg", "tracking", "CHOLMOD"}),
     ("device_client", {"solvers", "linalg", "tracking", "CHOLMOD"}),
+    # Knot identification is geometry only: no physics, no messages.
+    ("topology", {"models", "solvers", "linalg", "tracking", "scene", "messages", "LCM"}),
     # The browser bridge only observes: it never solves.
     ("snapthread-web", {"solvers", "linalg", "tracking", "CHOLMOD"}),
     ("web_core", {"solvers", "linalg", "tracking", "CHOLMOD", "Boost.Beast (asio)"}),

@@ -66,6 +66,21 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
     out.notes.push_back("force.png not drawn: no " + ch + "_FORCE_MODEL messages");
   }
 
+  if (r.HasKnot()) {
+    RunGnuplot(dir, "knot",
+               "set multiplot layout 2,1 title 'Knot type and self-contacts (" + ch +
+                   "_SOLVER_STATUS)'\nset xlabel 'time [s]'\n"
+                   "set ylabel 'knot determinant'\nset yrange [0:*]\n"
+                   "set ytics add ('unknot 1' 1, 'trefoil 3' 3, 'figure-eight 5' 5)\n"
+                   "plot " + Csv(dir, "knot.csv") + " skip 1 using 1:3 with steps lw 2 "
+                   "title '|Delta(-1)|'\nset ylabel 'active contacts'\n"
+                   "set ytics autofreq\nplot '' skip 1 using 1:4 with steps lw 2 lc rgb 'red' "
+                   "title 'contacts'\nunset multiplot\n",
+               &out);
+  } else {
+    out.notes.push_back("knot.png not drawn: no knot type or contacts in the solver status");
+  }
+
   if (r.HasSolve() || r.HasSolverStatus()) {
     std::string body = "set multiplot layout 3,1 title 'Solver (" + ch + ")'\nset xlabel 'time [s]'\n";
     if (r.HasSolve()) {

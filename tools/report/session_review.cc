@@ -134,6 +134,7 @@ void SessionReview::Add(const lcm::LogEvent& e) {
     c.seq.Add(m.seq);
     status_.push_back({t, m.method, m.iterations, m.residual, m.lambda_min, m.negative_pivots,
                        m.update_rate_hz, m.solve_us_p50, m.solve_us_p99, m.dropped_poses});
+    knot_.push_back({t, m.knot, m.knot_determinant, m.contacts});
   } else if (c.type == "device_status_t") {
     device_status_t m;
     if (!Decode(e, &m, &c)) return;
@@ -147,6 +148,13 @@ void SessionReview::Add(const lcm::LogEvent& e) {
     command_t m;
     Decode(e, &m, &c);
   }
+}
+
+bool SessionReview::HasKnot() const {
+  for (const auto& r : knot_) {
+    if (!r.knot.empty() || r.contacts > 0) return true;
+  }
+  return false;
 }
 
 std::vector<std::string> SessionReview::WriteCsv(const std::string& dir) const {
@@ -189,6 +197,14 @@ std::vector<std::string> SessionReview::WriteCsv(const std::string& dir) const {
       f << r.t_s << ',' << r.method << ',' << mi << ',' << r.iterations << ',' << r.residual << ','
         << r.lambda_min << ',' << r.negative_pivots << ',' << r.update_rate_hz << ','
         << r.solve_us_p50 << ',' << r.solve_us_p99 << ',' << r.dropped_poses << '\n';
+    }
+  }
+  {
+    auto f = open("knot.csv");
+    f << "t_s,knot,knot_determinant,contacts\n";
+    for (const auto& r : knot_) {
+      f << r.t_s << ',' << (r.knot.empty() ? "-" : r.knot) << ',' << r.determinant << ','
+        << r.contacts << '\n';
     }
   }
   {
@@ -300,6 +316,30 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
       << "\n";
   }
   if (solve_.empty() && status_.empty()) s << "no solver messages in the log\n";
+
+  s << "\nknot:\n";
+  if (!HasKnot()) {
+    s << "no knot type or contacts in the solver status\n";
+  } else {
+    // The knot type over time: each change, with its determinant (first 20).
+    s << "knot_changes:";
+    std::string last = "\x01";
+    int listed = 0;
+    for (const auto& r : knot_) {
+      if (r.knot == last) continue;
+      last = r.knot;
+      if (++listed > 20) {
+        s << " ...";
+        break;
+      }
+      s << " " << Fmt("%.3f", r.t_s) << " " << (r.knot.empty() ? "-" : r.knot) << " (det "
+        << r.determinant << ")";
+    }
+    int max_contacts = 0;
+    for (const auto& r : knot_) max_contacts = std::max(max_contacts, r.contacts);
+    s << "\nknot_last: " << (knot_.back().knot.empty() ? "-" : knot_.back().knot)
+      << "; contacts max " << max_contacts << " last " << knot_.back().contacts << "\n";
+  }
 
   s << "\ndevice:\n";
   if (device_.empty()) {

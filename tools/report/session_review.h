@@ -39,6 +39,8 @@ struct DeviceRow {
   double force_norm_n; int64_t force_clamps; int64_t stiffness_clamps; int64_t slew_limits;
   int64_t fades; int64_t snaps_felt;
 };
+// solver_status_t's knot type and active contacts (issue 15).
+struct KnotRow { double t_s; std::string knot; int determinant; int contacts; };
 struct RoundTripRow { double t_s; double loop_us; double server_us; };
 
 // Picks the session with the most messages among channels named <SESSION>_<KNOWN SUFFIX>;
@@ -63,6 +65,8 @@ class SessionReview {
   bool HasDevice() const { return !device_.empty(); }
   bool HasRoundTrip() const { return !round_trip_.empty(); }
   bool HasSolve() const { return !solve_.empty(); }
+  // Some status carried a knot type or a contact (older servers send neither).
+  bool HasKnot() const;
   const std::string& session() const { return session_; }
 
  private:
@@ -77,6 +81,7 @@ class SessionReview {
   std::vector<SolveRow> solve_;
   std::vector<StatusRow> status_;
   std::vector<DeviceRow> device_;
+  std::vector<KnotRow> knot_;
   std::vector<RoundTripRow> round_trip_;
   std::map<int64_t, int64_t> pose_log_time_us_;  // device seq -> log time (recent poses)
   int64_t shape_snaps_first_ = -1, shape_snaps_last_ = -1;

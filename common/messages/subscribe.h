@@ -1,0 +1,70 @@
+// Subscribe an object's member function to an LCM channel, without the member-function
+// overloads of lcm::LCM::subscribe.
+//
+// Why: those overloads (lcm::LCMMHSubscription and LCMMHUntypedSubscription in
+// lcm-cpp-impl.hpp) call the handler through a pointer-to-member-function stored at run
+// time. GCC 12 with -fsanitize=undefined (the vptr check) instruments that call wrongly:
+// on the non-virtual branch of the call it checks the object against a register it never
+// set, so UBSan reports "member access within misaligned address 0x5" or "wrong dynamic
+// type" depending on what the caller (liblcm, uninstrumented) left in that register. It
+// is a false report, it is deterministic per call path, clang does not do it, and it made
+// every LCM-dispatching test fail under the sanitizer build (see the README's Tests
+// section; also dotnet/runtime#73927, "ubsan failure when calling through pointer to
+// member function", GCC 10-12). Here the member function is a template argument, so the
+// call is direct, and liblcm calls a plain function with a context (subscribeFunction).
+// Usage: sub = messages::Subscribe<&Server::HandleDeviceState>(lcm, channel, this);
+// the handler is (const lcm::ReceiveBuffer*, const std::string& channel) or, typed,
+// (const lcm::ReceiveBuffer*, const std::string& channel, const Msg*). Unsubscribe with
+// lcm.unsubscribe(sub) as before.
+#pragma once
+
+#include <string>
+
+#include <lcm/lcm-cpp.hpp>
+
+namespace snapthread::messages {
+
+namespace subscribe_detail {
+
+template <auto Method>
+struct MemberHandler;
+
+template <class Class, void (Class::*Method)(const lcm::ReceiveBuffer*, const std::string&)>
+struct MemberHandler<Method> {
+  static lcm::Subscription* Subscribe(lcm::LCM* lcm, const std::string& channel,
+                                      Class* self) {
+    return lcm->subscribeFunction(channel, &Call, self);
+  }
+  static void Call(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Class* self) {
+    (self->*Method)(rbuf, channel);
+  }
+};
+
+template <class Class, class Msg,
+          void (Class::*Method)(const lcm::ReceiveBuffer*, const std::string&, const Msg*)>
+struct MemberHandler<Method> {
+  static lcm::Subscription* Subscribe(lcm::LCM* lcm, const std::string& channel,
+                                      Class* self) {
+    return lcm->subscribeFunction(channel, &Call, self);
+  }
+  static void Call(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                   const Msg* msg, Class* self) {
+    (self->*Method)(rbuf, channel, msg);
+  }
+};
+
+}  // namespace subscribe_detail
+
+// Subscribes self->Method to channel (an LCM channel regex); returns the subscription
+// (nullptr if lcm is not good), which lcm->unsubscribe() takes.
+template <auto Method, class Class>
+lcm::Subscription* Subscribe(lcm::LCM* lcm, const std::string& channel, Class* self) {
+  return subscribe_detail::MemberHandler<Method>::Subscribe(lcm, channel, self);
+}
+
+template <auto Method, class Class>
+lcm::Subscription* Subscribe(lcm::LCM& lcm, const std::string& channel, Class* self) {
+  return Subscribe<Method>(&lcm, channel, self);
+}
+
+}  // namespace snapthread::messages

@@ -1,0 +1,86 @@
+#include "snap_ahead.h"
+
+#include <cmath>
+
+namespace snapthread::device {
+
+bool PrepareFold(const force_model_t& msg, const SafetyLimits& limits, LocalModel* out,
+                 bool* clamped, std::string* why) {
+  out->has_fold = false;
+  if (msg.has_fold == 0) return true;
+  auto bad = [&](const char* what) {
+    if (why) *why = std::string("fold: ") + what;
+    return false;
+  };
+  if (msg.has_fold != 1 || msg.fold_id <= 0) return bad("has_fold must be 0 or 1 and fold_id > 0");
+  double n2 = 0.0;
+  bool finite = std::isfinite(msg.fold_curvature);
+  for (int i = 0; i < 3; ++i) {
+    n2 += msg.fold_normal[i] * msg.fold_normal[i];
+    finite = finite && std::isfinite(msg.fold_point[i]) && std::isfinite(msg.fold_normal[i]) &&
+             std::isfinite(msg.post_u0[i]) && std::isfinite(msg.post_f0[i]);
+    for (int j = 0; j < 3; ++j) finite = finite && std::isfinite(msg.post_K[i][j]);
+  }
+  if (!finite) return bad("not finite");
+  if (std::abs(std::sqrt(n2) - 1.0) > 1e-6) return bad("fold_normal is not a unit vector");
+  bool post_clamped = false;
+  if (!ClampStiffness(msg.post_K, limits, out->post_K_n_per_m, &post_clamped, why)) return false;
+  *clamped = *clamped || post_clamped;
+  out->has_fold = true;
+  out->fold_id = msg.fold_id;
+  out->fold_curvature_per_m = msg.fold_curvature;
+  for (int i = 0; i < 3; ++i) {
+    out->fold_point_m[i] = msg.fold_point[i];
+    out->fold_normal[i] = msg.fold_normal[i];
+    out->post_u0_m[i] = msg.post_u0[i];
+    out->post_f0_n[i] = msg.post_f0[i];
+  }
+  return true;
+}
+
+bool PastFold(const LocalModel& model, const double position_m[3]) {
+  double w[3], a = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    w[i] = position_m[i] - model.fold_point_m[i];
+    a += model.fold_normal[i] * w[i];
+  }
+  double perp2 = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double p = w[i] - a * model.fold_normal[i];
+    perp2 += p * p;
+  }
+  return a >= 0.5 * model.fold_curvature_per_m * perp2;
+}
+
+const LocalModel* SnapAhead::Select(const LocalModel* latest, const double position_m[3],
+                                    int64_t next_pose_seq) {
+  if (latest == nullptr) return latest;
+  if (active_) {
+    // A model for a pose sent after the switch comes from the new branch: render it.
+    if (latest->device_seq >= switch_pose_seq_) {
+      active_ = false;
+    } else {
+      post_.receive_us = latest->receive_us;  // the watchdog follows the server's models
+      return &post_;
+    }
+  }
+  if (!latest->has_fold || latest->fold_id == switched_fold_id_ ||
+      latest->status == force_model_t::STATUS_INVALID || !PastFold(*latest, position_m)) {
+    return latest;
+  }
+  post_ = *latest;
+  post_.has_fold = false;
+  post_.status = force_model_t::STATUS_SNAPPED;
+  for (int i = 0; i < 3; ++i) {
+    post_.u0_m[i] = latest->post_u0_m[i];
+    post_.f0_n[i] = latest->post_f0_n[i];
+    for (int j = 0; j < 3; ++j) post_.K_n_per_m[i][j] = latest->post_K_n_per_m[i][j];
+  }
+  active_ = true;
+  switched_fold_id_ = latest->fold_id;
+  switch_pose_seq_ = next_pose_seq;
+  switches_.fetch_add(1, std::memory_order_relaxed);
+  return &post_;
+}
+
+}  // namespace snapthread::device

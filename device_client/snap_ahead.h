@@ -1,0 +1,59 @@
+// Snap-ahead on the device (issue 17): the server sends, with a force model near a fold,
+// the fold boundary (point, unit normal, curvature; device metres) and the local model of
+// the equilibrium past it. Each servo tick SnapAhead checks which side of the boundary
+// the hand is on; at the tick it crosses, it renders the post-snap model (the safety
+// layer's slew limit still bounds the step) and every later pose carries the fold's id
+// (device_state_t.snap_fold_id), so the server's next solve starts on the new branch.
+//
+// The boundary: w = p - point, a = n . w, w_perp = w - a n; the hand is past the fold when
+//   a >= (curvature / 2) |w_perp|^2      (curvature > 0: the fold bends away from the hand).
+// Hysteresis: a fold switches once (its id is remembered); crossing back does not switch
+// back, the other branch's fold governs. The post-snap model is rendered until a model
+// arrives that answers a pose sent after the switch (the server had the switch then);
+// models answering earlier poses are from the old branch and are not rendered.
+//
+// Servo thread only (Select); no allocation, no locks, no logging.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+
+#include "safety.h"
+#include "snapthread/force_model_t.hpp"
+
+namespace snapthread::device {
+
+// Off the servo thread, from PrepareModel: copies and checks a force model's fold
+// (finite, unit normal, positive id; transport::Validate checked the message already)
+// and clamps the post-snap K's stiffness like K. A message without a fold leaves
+// out->has_fold false. False (with *why) when the fold is not usable: the whole model
+// is refused, so a bad fold never reaches the servo.
+bool PrepareFold(const force_model_t& msg, const SafetyLimits& limits, LocalModel* out,
+                 bool* clamped, std::string* why);
+
+// True when position_m is on the far side of model's fold boundary.
+bool PastFold(const LocalModel& model, const double position_m[3]);
+
+class SnapAhead {
+ public:
+  // The model to render this tick: `latest` (the newest received), or the post-snap model
+  // after the hand crossed latest's fold. next_pose_seq: the seq the next published pose
+  // will carry. Allocation-free.
+  const LocalModel* Select(const LocalModel* latest, const double position_m[3],
+                           int64_t next_pose_seq);
+
+  // The fold id of the last switch (0: none), for the poses.
+  int64_t snap_fold_id() const { return switched_fold_id_; }
+  // Switches so far (any thread).
+  uint64_t switches() const { return switches_.load(std::memory_order_relaxed); }
+
+ private:
+  LocalModel post_;
+  bool active_ = false;            // rendering post_
+  int64_t switched_fold_id_ = 0;
+  int64_t switch_pose_seq_ = 0;    // first pose sent after the switch
+  std::atomic<uint64_t> switches_{0};
+};
+
+}  // namespace snapthread::device

@@ -1,0 +1,78 @@
+// Snap-ahead on the solve thread (issue 17): decides when a fold is within reach of the
+// hand, runs the FoldSearch in the background (BackgroundJob), keeps the current fold
+// prediction for the branch the tracker follows, writes it into each force model in
+// device units (force_model_t.has_fold ... post_K) and, when a pose says the device
+// switched to a fold's post-snap model (device_state_t.snap_fold_id), hands the solve
+// the post-snap state so the next update starts on the new branch.
+//
+// Reach: near a fold lambda_min ~ sqrt(distance) along the motion (the normal form's
+// square-root law, fold_search.h), so lambda^2 falls linearly; from two updates the
+// distance is lambda^2 / (secant slope of lambda^2). A search starts when that estimate
+// (or the tracker's near-fold status) puts a fold within `reach` of the hand.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "background_job.h"
+#include "fold_search.h"
+#include "scene/scene.h"
+#include "snapthread/force_model_t.hpp"
+#include "tracking/tracker.h"
+
+namespace snapthread::server {
+
+class FoldBoundary {
+ public:
+  explicit FoldBoundary(const Scene& scene);
+  ~FoldBoundary();
+  FoldBoundary(const FoldBoundary&) = delete;
+  FoldBoundary& operator=(const FoldBoundary&) = delete;
+
+  // Before an update for a pose that carries snap_fold_id: true (with the state and
+  // controls to resume at) the first time the device reports the current fold's switch.
+  bool TakeSwitch(int64_t snap_fold_id, Vec* x_after, Vec* u_after);
+  // After each update at controls u: notes branch changes, collects a finished search
+  // and starts one when a fold is within reach.
+  void AfterUpdate(const EquilibriumTracker& tracker, const Vec& u);
+  // Writes the current prediction into msg (device units; has_fold = 0 when there is
+  // none or msg is not a usable model). The post-snap fields come from BuildForceModel.
+  void Fill(force_model_t* msg) const;
+
+  // Blocks until a running search ends and collects it (deterministic runs: tests and
+  // the chart tool; the server never waits).
+  void WaitForSearch();
+
+  int64_t searches() const { return searches_; }
+  bool has_prediction() const { return prediction_ != nullptr; }
+
+ private:
+  // The prediction in device units, as force_model_t carries it.
+  struct DeviceFold {
+    double point[3], normal[3], curvature, post_u0[3], post_f0[3], post_K[3][3];
+  };
+  struct Job {
+    int64_t branch = 0;
+    FoldPrediction prediction;
+  };
+  void NewBranch();
+  // Takes a finished search's prediction (when it is for the current branch).
+  void Collect();
+
+  Scene scene_;
+  FoldSearch search_;  // used only by the running job
+  BackgroundJob<Job> job_;
+  std::unique_ptr<FoldPrediction> prediction_;
+  DeviceFold device_fold_{};
+  int64_t branch_ = 1;         // changes at every snap, reset or switch
+  int64_t fold_id_ = 0;        // of the current branch's prediction (0: none yet)
+  int64_t next_fold_id_ = 1;
+  int64_t switched_fold_id_ = 0;
+  int64_t searches_ = 0;
+  double jump_threshold_ = 0.1;
+  Vec x_last_, u_last_;
+  double lambda_last_ = -1.0;
+  bool have_last_ = false;
+};
+
+}  // namespace snapthread::server
