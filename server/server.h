@@ -210,6 +210,7 @@ class Server {
   std::string load_name_;         // its argument
   int64_t model_seq_ = 0, shape_seq_ = 0, status_seq_ = 0;
   int64_t snaps_since_reset_ = 0;
+  bool switched_ = false;  // this update started on the branch a snap-ahead switch chose
   int8_t last_status_ = 0;
   double last_force_n_[3] = {0.0, 0.0, 0.0};
   transport::SampleWindow status_window_{4096};  // solve µs since the last status

@@ -360,6 +360,7 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
       assembly_.StoreHessian(t, lh, ld, values);
     });
   }
+  if (contact_.enabled()) contact_.AddHessian(ContactNodes(x, gm), values);
 }
 
 void RodModel::GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
