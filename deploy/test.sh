@@ -21,20 +21,22 @@ if [ "${1:-}" != "--quick" ]; then
     -DSNAPTHREAD_WERROR=OFF -DSNAPTHREAD_BUILD_WEB=OFF >/dev/null
   cmake --build "$here/build-asan" -j"$(nproc)"
   cd "$here/build-asan"
-  # Under the sanitizers: every in-process test (labels unit, report, service, viewer: the
-  # models, linear algebra, solvers, scenes, sweep, stability, auth, messages, report, the
-  # in-process server and device over memq://, the viewer core and screenshot, and the
+  # Under the sanitizers: every in-process test of the labels unit, report and service (the
+  # models, linear algebra, solvers, contact, knots, scenes, sweep, stability, auth,
+  # messages, report, the in-process server and device over memq:// and udpm, and the
   # allocation counters, which count through ASan's malloc hook there). LCM subscriptions
   # go through messages::Subscribe (common/messages/subscribe.h): liblcm's own
   # member-function subscriptions trip a GCC 12 UBSan false report (see that header).
   # SNAPTHREAD_SPEED_SCALE: this build is slower, so wall-clock budgets that are about
   # speed (time_budget_test's 300 us) are multiplied by it; no safety bound is.
-  # Left out, and why: the multi-process, soak and namespace tests (labels process, soak,
-  # netns): not yet run under the sanitizers (they start the sanitized binaries as
-  # processes over udpm; their timing under the slowdown is not measured). OPEN.
+  # Left out, and why (OPEN, issue 12 item 7): the multi-process, soak and namespace tests
+  # (labels process, soak, netns: they start the sanitized binaries over udpm; their timing
+  # under the slowdown is not measured), the viewer tests (label viewer: Mesa and X11 under
+  # LeakSanitizer not yet run) and DeviceServoLoopTest (it asserts a 1 kHz tick rate, a
+  # speed figure the sanitized build is not meant to meet).
   SNAPTHREAD_SPEED_SCALE=4 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --output-on-failure -j2 --timeout 900 -LE 'process|soak|netns'
+    ctest --output-on-failure -j2 --timeout 900 -LE 'process|soak|netns|viewer' -E 'DeviceServoLoopTest'
 fi
 
 if [ "${1:-}" != "--quick" ]; then
