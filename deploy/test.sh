@@ -10,7 +10,8 @@ set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$here/deploy/setup.sh"
 cd "$here/build"
-ctest --output-on-failure -j2 --timeout 600
+# Labels containing `open`: tests of work in progress not yet reliable (named in the README).
+ctest --output-on-failure -j2 --timeout 600 -LE open
 
 if [ "${1:-}" != "--quick" ]; then
   echo "test: sanitizer build (ASan + UBSan) in build-asan/"
