@@ -41,10 +41,9 @@ class ChainModel : public Model {
   const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
 
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
-    double* values = HessianValues(h);
     // StoreHessian: every chain slot is reached by a chain term first, so no clearing pass;
     // slots only a contact pair reaches are cleared when the model has contact.
-    if (chain_terms_ < assembly_.NumTerms()) std::fill(values, values + h->nonZeros(), 0.0);
+    double* values = assembly_.Values(h, chain_terms_ < assembly_.NumTerms());
     for (int t = 0; t < chain_terms_; ++t) {
       Self().Local(t, x, u, /*want_h=*/true, [&](const double*, const double* lh, int ld) {
         assembly_.StoreHessian(t, lh, ld, values);
@@ -59,8 +58,7 @@ class ChainModel : public Model {
   void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override {
     if (g->size() != NumStates()) g->resize(NumStates());
     g->setZero();
-    double* values = HessianValues(h);
-    if (chain_terms_ < assembly_.NumTerms()) std::fill(values, values + h->nonZeros(), 0.0);
+    double* values = assembly_.Values(h, chain_terms_ < assembly_.NumTerms());
     for (int t = 0; t < chain_terms_; ++t) {
       Self().Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int ld) {
         assembly_.AddGradient(t, lg, g->data());
@@ -190,15 +188,6 @@ class ChainModel : public Model {
 
  private:
   const Derived& Self() const { return static_cast<const Derived&>(*this); }
-  // h with the pattern's structure (set on first use); its values to be stored.
-  double* HessianValues(SparseMatrix* h) const {
-    const SparseMatrix& pattern = assembly_.Pattern();
-    const int nx = NumStates();
-    if (h->rows() != nx || h->cols() != nx || h->nonZeros() != pattern.nonZeros() || !h->isCompressed()) {
-      *h = pattern;
-    }
-    return h->valuePtr();
-  }
 
   std::vector<int> control_terms_;
 };

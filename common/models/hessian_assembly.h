@@ -14,6 +14,8 @@
 // adding a term's Hessian is a table look-up without search or allocation.
 #pragma once
 
+#include <algorithm>
+
 #include <cmath>
 #include <vector>
 
@@ -48,6 +50,17 @@ class HessianAssembly {
 
   // Full symmetric E_xx pattern (both triangles, compressed, values 0).
   const SparseMatrix& Pattern() const { return pattern_; }
+  // h with the pattern's structure (set on first use, then reused); its values to be
+  // stored, zeroed first when `clear` (slots no StoreHessian term reaches, e.g. contact).
+  double* Values(SparseMatrix* h, bool clear) const {
+    const Eigen::Index n = pattern_.rows();
+    if (h->rows() != n || h->cols() != n || h->nonZeros() != pattern_.nonZeros() || !h->isCompressed()) {
+      *h = pattern_;
+    }
+    double* values = h->valuePtr();
+    if (clear) std::fill(values, values + pattern_.nonZeros(), 0.0);
+    return values;
+  }
   // max |i - j| over the pattern: the half-bandwidth of E_xx.
   int Bandwidth() const { return bandwidth_; }
 

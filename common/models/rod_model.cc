@@ -345,15 +345,9 @@ void RodModel::Gradient(const Vec& x, const Vec& u, Vec* g) const {
 }
 
 void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
-  const SparseMatrix& pattern = assembly_.Pattern();
-  if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
-      !h->isCompressed()) {
-    *h = pattern;
-  }
-  double* values = h->valuePtr();
   // StoreHessian: every elastic slot is reached by an elastic term first, so no clearing
   // pass; slots only a contact pair reaches are cleared when contact is on.
-  if (contact_.enabled()) std::fill(values, values + pattern.nonZeros(), 0.0);
+  double* values = assembly_.Values(h, contact_.enabled());
   const GraspMaps gm = Grasp(u, true);
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
@@ -366,13 +360,7 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
 void RodModel::GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
   if (g->size() != nx_) g->resize(nx_);
   g->setZero();
-  const SparseMatrix& pattern = assembly_.Pattern();
-  if (h->rows() != nx_ || h->cols() != nx_ || h->nonZeros() != pattern.nonZeros() ||
-      !h->isCompressed()) {
-    *h = pattern;
-  }
-  double* values = h->valuePtr();
-  if (contact_.enabled()) std::fill(values, values + pattern.nonZeros(), 0.0);
+  double* values = assembly_.Values(h, contact_.enabled());
   const GraspMaps gm = Grasp(u, true);
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, x, gm, true, [&](const double* lg, const double* lh, int ld) {
