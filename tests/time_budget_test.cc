@@ -31,13 +31,29 @@ std::vector<int> SnapRows(const std::vector<SweepRow>& rows) {
   return snaps;
 }
 
+// Rows of `with` after row `from` and before row `to` whose update the budget cut (a snap
+// spread over updates, or a regular update stopped early): each may delay a snap by one row.
+int CutRows(const std::vector<SweepRow>& with, int from, int to) {
+  int cut = 0;
+  for (const SweepRow& r : with)
+    if (r.step > from && r.step < to &&
+        (r.termination == Termination::kSnapping || r.termination == Termination::kBudgetSpent))
+      ++cut;
+  return cut;
+}
+
+// Each snap under the budget lands no earlier than without it and no later than `rows`
+// plus the rows the budget cut since the previous snap: on a slow machine (the sanitizer
+// build on a shared CI runner) a snap may outlast several budgets, and the claim is that it
+// then lands later by the updates it was spread over, not elsewhere.
 void ExpectSameSnapsAndEnd(const std::vector<SweepRow>& with, const std::vector<SweepRow>& without, int rows) {
   const auto a = SnapRows(with), b = SnapRows(without);
   ASSERT_EQ(a.size(), b.size());
   ASSERT_FALSE(b.empty());
   for (size_t i = 0; i < a.size(); ++i) {
     EXPECT_GE(a[i], b[i]) << "snap " << i << ": a budget never makes it early";
-    EXPECT_LE(a[i], b[i] + rows) << "snap " << i;
+    const int cut = CutRows(with, i == 0 ? -1 : a[i - 1], a[i]);
+    EXPECT_LE(a[i], b[i] + rows + cut) << "snap " << i << " (" << cut << " rows cut by the budget before it)";
   }
   EXPECT_LT((with.back().force - without.back().force).lpNorm<Eigen::Infinity>(), 1e-6);
 }
