@@ -7,6 +7,7 @@
 
 #include "messages/pose_mapping.h"
 #include "messages/validate.h"
+#include "shape_frames.h"
 
 namespace snapthread::server {
 namespace {
@@ -148,6 +149,8 @@ thread_shape_t BuildShape(const ShapeInputs& in) {
   for (Eigen::Index k = 0; k < nodes.cols(); ++k) {
     for (int i = 0; i < 3; ++i) msg.positions[k][i] = Finite(nodes(i, k)) ? nodes(i, k) : 0.0;
   }
+  // The rod's material frames and twist (shape_frames.h); none for other models.
+  if (nodes.cols() > 0) FillShapeFrames(model, in.x, in.u, &msg);
   for (int i = 0; i < dim && i < in.u.size(); ++i) msg.grasp[i] = in.u[i];
   if (dim == 3 && in.u.size() >= 6) {
     const Eigen::Vector3d d = in.u.segment<3>(3).normalized();

@@ -17,6 +17,7 @@ struct PixelRect {
 struct HudLayout {
   PixelRect text;   // status text, top-left
   PixelRect chart;  // |force| strip chart, bottom-right
+  PixelRect legend; // twist colour bar, bottom-left (rods only)
 };
 
 inline HudLayout MakeHudLayout(int width, int height) {
@@ -25,6 +26,7 @@ inline HudLayout MakeHudLayout(int width, int height) {
   const int cw = width * 3 / 10 > 160 ? width * 3 / 10 : 160;
   const int ch = height / 5 > 70 ? height / 5 : 70;
   l.chart = {width - cw - 10, height - ch - 10, cw, ch};
+  l.legend = {10, height - 74 - 10, 290, 74};  // four lines of stb_easy_font and a bar
   return l;
 }
 

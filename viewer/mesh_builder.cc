@@ -28,39 +28,60 @@ void MeshBuilder::Push(const Eigen::Vector3d& p, const Eigen::Vector3d& n, const
   vertices_.push_back(v);
 }
 
-void MeshBuilder::AppendTube(const std::vector<Eigen::Vector3d>& path, double radius, int sides,
-                             const Rgb& color) {
+std::vector<CurveFrame> RotationMinimisingFrames(const std::vector<Eigen::Vector3d>& path) {
   const int m = static_cast<int>(path.size());
-  if (m < 2 || sides < 3) return;
-  std::vector<Eigen::Vector3d> tangents(m);
+  std::vector<CurveFrame> frames(m);
   for (int i = 0; i < m; ++i) {
     const Eigen::Vector3d d = path[std::min(i + 1, m - 1)] - path[std::max(i - 1, 0)];
-    tangents[i] = d.norm() > 0 ? d.normalized() : Eigen::Vector3d::UnitX();
+    frames[i].tangent = d.norm() > 0 ? d.normalized() : Eigen::Vector3d::UnitX();
   }
+  if (m == 0) return frames;
   // Parallel transport of the normal: rotate it by the rotation taking t_{i-1} to t_i.
-  std::vector<Eigen::Vector3d> normals(m);
-  normals[0] = AnyPerpendicular(tangents[0]);
+  frames[0].normal = AnyPerpendicular(frames[0].tangent);
   for (int i = 1; i < m; ++i) {
-    const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(tangents[i - 1], tangents[i]);
-    Eigen::Vector3d n = q * normals[i - 1];
-    n -= n.dot(tangents[i]) * tangents[i];
-    normals[i] = n.norm() > 1e-9 ? n.normalized() : AnyPerpendicular(tangents[i]);
+    const Eigen::Vector3d& t = frames[i].tangent;
+    const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(frames[i - 1].tangent, t);
+    Eigen::Vector3d n = q * frames[i - 1].normal;
+    n -= n.dot(t) * t;
+    frames[i].normal = n.norm() > 1e-9 ? n.normalized() : AnyPerpendicular(t);
+  }
+  return frames;
+}
+
+void MeshBuilder::AppendTube(const std::vector<Eigen::Vector3d>& path, double radius, int sides,
+                             const Rgb& color) {
+  TubePaint paint;
+  paint.color.assign(path.size(), color);
+  AppendPaintedTube(path, RotationMinimisingFrames(path), radius, sides, paint);
+}
+
+void MeshBuilder::AppendPaintedTube(const std::vector<Eigen::Vector3d>& path,
+                                    const std::vector<CurveFrame>& frames, double radius,
+                                    int sides, const TubePaint& paint) {
+  const int m = static_cast<int>(path.size());
+  if (m < 2 || sides < 3 || frames.size() != path.size() || paint.color.size() != path.size() ||
+      (!paint.angle.empty() && paint.angle.size() != path.size())) {
+    return;
   }
   auto ring = [&](int i, int k) {
-    const double a = 2.0 * kPi * k / sides;
-    const Eigen::Vector3d b = tangents[i].cross(normals[i]);
-    return Eigen::Vector3d(std::cos(a) * normals[i] + std::sin(a) * b);
+    const double a = 2.0 * kPi * k / sides + (paint.angle.empty() ? 0.0 : paint.angle[i]);
+    return Eigen::Vector3d(std::cos(a) * frames[i].normal + std::sin(a) * frames[i].Binormal());
   };
+  const int band = std::clamp(paint.stripe_half_columns, 0, sides / 2);
   for (int i = 0; i + 1 < m; ++i) {
     for (int k = 0; k < sides; ++k) {
+      // Column k spans vertices k .. k+1: within the band when k < band or k >= sides - band.
+      const bool stripe = k < band || k >= sides - band;
+      const Rgb& c0 = stripe ? paint.stripe_color : paint.color[i];
+      const Rgb& c1 = stripe ? paint.stripe_color : paint.color[i + 1];
       const Eigen::Vector3d n00 = ring(i, k), n01 = ring(i, k + 1);
       const Eigen::Vector3d n10 = ring(i + 1, k), n11 = ring(i + 1, k + 1);
-      Push(path[i] + radius * n00, n00, color);
-      Push(path[i + 1] + radius * n10, n10, color);
-      Push(path[i + 1] + radius * n11, n11, color);
-      Push(path[i] + radius * n00, n00, color);
-      Push(path[i + 1] + radius * n11, n11, color);
-      Push(path[i] + radius * n01, n01, color);
+      Push(path[i] + radius * n00, n00, c0);
+      Push(path[i + 1] + radius * n10, n10, c1);
+      Push(path[i + 1] + radius * n11, n11, c1);
+      Push(path[i] + radius * n00, n00, c0);
+      Push(path[i + 1] + radius * n11, n11, c1);
+      Push(path[i] + radius * n01, n01, c0);
     }
   }
 }

@@ -9,6 +9,7 @@
 
 #include "hud_layout.h"
 #include "marker_colors.h"
+#include "material_frames.h"
 #include "spline.h"
 #include "models/registry.h"
 
@@ -90,16 +91,6 @@ const char* StatusName(int status) {
 double Norm3(const double v[3]) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
 }  // namespace
-
-Rgb StatusColor(int status) {
-  switch (status) {
-    case 0: return {0.55f, 0.80f, 0.95f};  // regular: pale blue
-    case 1: return {1.00f, 0.62f, 0.10f};  // near fold: orange
-    case 2: return {0.95f, 0.20f, 0.20f};  // snapped: red
-    case 4: return {0.85f, 0.35f, 0.75f};  // snapping (time budget): magenta
-    default: return {0.55f, 0.55f, 0.55f};  // invalid: grey
-  }
-}
 
 Renderer::~Renderer() {
   if (vbo_ != 0) glDeleteBuffers(1, &vbo_);
@@ -244,6 +235,57 @@ void Renderer::AppendGraspsAndContacts(const thread_shape_t& shape, double exten
   }
 }
 
+void Renderer::AppendMaterialTube(const thread_shape_t& shape, const std::vector<Point3>& nodes,
+                                  const std::vector<Point3>& path, double radius) {
+  const std::vector<CurveFrame> curve = RotationMinimisingFrames(path);
+  const MaterialRings rings =
+      InterpolateMaterialFrames(shape.frames, kSplineSamplesPerSegment, curve);
+  const Rgb base = StatusColor(shape.status);
+  if (rings.angle.empty()) {  // counts that do not fit: the plain tube
+    scene_.AppendTube(path, radius, kTubeSides, base);
+    return;
+  }
+  twist_legend_.shown = true;
+  twist_legend_.full_scale = TwistFullScale(nodes);
+  for (const auto& row : shape.frames) {
+    twist_legend_.max_abs = std::max(twist_legend_.max_abs, std::abs(row[3]));
+  }
+  TubePaint paint;
+  paint.angle = rings.angle;
+  paint.color.reserve(path.size());
+  for (double t : rings.twist) paint.color.push_back(TwistColor(base, t, twist_legend_.full_scale));
+  paint.stripe_half_columns = kStripeHalfColumns;
+  paint.stripe_color = kStripeColor;
+  scene_.AppendPaintedTube(path, curve, radius, kStripedTubeSides, paint);
+}
+
+void Renderer::BuildTwistLegend(const Rgb& base, int width, int height) {
+  const PixelRect r = MakeHudLayout(width, height).legend;
+  const float x0 = float(r.x), y0 = float(r.y), x1 = float(r.x + r.width),
+              y1 = float(r.y + r.height);
+  AppendRect(x0, y0, x1, y1, {0.05f, 0.05f, 0.07f});
+  const Rgb text(0.8f, 0.8f, 0.8f);
+  char line[160];
+  std::snprintf(line, sizeof line, "twist: full colour at 1 turn/L = %.3g rad/unit",
+                twist_legend_.full_scale);
+  AppendText(line, x0 + 4, y0 + 3, 1.0f, text);
+  // The colour bar, -1 .. +1 turn per length, on this tube's state colour.
+  const float bx0 = x0 + 4, bx1 = x0 + 204, by0 = y0 + 16, by1 = y0 + 26;
+  constexpr int kSteps = 40;
+  for (int k = 0; k < kSteps; ++k) {
+    const double v = -1.0 + 2.0 * (k + 0.5) / kSteps;
+    AppendRect(bx0 + (bx1 - bx0) * k / kSteps, by0, bx0 + (bx1 - bx0) * (k + 1) / kSteps, by1,
+               TwistColor(base, v, 1.0));
+  }
+  AppendText("-1 left", bx0, by1 + 2, 1.0f, text);
+  AppendText("0", 0.5f * (bx0 + bx1) - 2, by1 + 2, 1.0f, text);
+  AppendText("+1 right", bx1 - 40, by1 + 2, 1.0f, text);
+  std::snprintf(line, sizeof line, "max |twist| %.3g rad/unit (%.2f turns/L)\ndark stripe: director d1",
+                twist_legend_.max_abs,
+                twist_legend_.full_scale > 0 ? twist_legend_.max_abs / twist_legend_.full_scale : 0.0);
+  AppendText(line, x0 + 4, by1 + 15, 1.0f, text);
+}
+
 void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int width, int height,
                     const FrameInfo& info) {
   glViewport(0, 0, width, height);
@@ -252,6 +294,7 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
   glUseProgram(program_);
   scene_.Clear();
   highlights_.Clear();
+  twist_legend_ = {};
   overlay_triangles_.clear();
   overlay_lines_.clear();
 
@@ -267,12 +310,18 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
     }
     const double extent = std::max((hi - lo).norm(), 1e-3);
     const double radius = 0.012 * extent;
-    // Threads (the registry's chains) are smooth curves through their nodes; the Zeeman
-    // and cusp "shapes" are linkages (rods between joints), drawn straight.
+    // Threads (the registry's chains) and rods (shapes with material frames) are smooth
+    // curves through their nodes; the Zeeman and cusp "shapes" are linkages (rods between
+    // joints), drawn straight.
     const ModelRegistration* model = FindModel(shape.model);
-    const bool smooth = model != nullptr && model->capabilities.chain.has_value();
-    scene_.AppendTube(CatmullRomCurve(nodes, smooth ? kSplineSamplesPerSegment : 1), radius,
-                      kTubeSides, StatusColor(shape.status));
+    const bool framed = shape.num_frames > 0 && shape.num_frames + 1 == shape.num_nodes;
+    const bool smooth = framed || (model != nullptr && model->capabilities.chain.has_value());
+    const std::vector<Point3> path = CatmullRomCurve(nodes, smooth ? kSplineSamplesPerSegment : 1);
+    if (framed) {
+      AppendMaterialTube(shape, nodes, path, radius);
+    } else {
+      scene_.AppendTube(path, radius, kTubeSides, StatusColor(shape.status));
+    }
     scene_.AppendSphere(nodes.front(), 2.2 * radius, {0.6f, 0.6f, 0.62f});  // clamp
     const Eigen::Vector3d grasp(shape.grasp[0], shape.grasp[1], shape.grasp[2]);
     // With named grasps every row is drawn (the first is the legacy grasp); otherwise the
@@ -357,6 +406,7 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
   const Rgb text_color = s.has_shape ? StatusColor(s.shape.status) : Rgb(0.8f, 0.8f, 0.8f);
   AppendText(text, 10.f, 10.f, 1.5f, text_color);
   BuildChart(s, width, height);
+  if (twist_legend_.shown) BuildTwistLegend(StatusColor(s.shape.status), width, height);
 
   Eigen::Matrix4d ortho = Eigen::Matrix4d::Identity();
   ortho(0, 0) = 2.0 / width;

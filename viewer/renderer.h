@@ -1,7 +1,8 @@
 // OpenGL 3.3 core drawing of one frame: the thread as a lit tube along the spline through
-// its nodes, clamp, grasps, grip direction, force arrows, active contacts, status text
-// (with the knot type) and a |force| strip chart. Needs a current GL context (GLFW + libepoxy); all geometry is rebuilt per frame
-// (a few thousand vertices) and streamed in one buffer.
+// its nodes (a rod's with its material stripe and twist colours and their legend), clamp,
+// grasps, grip direction, force arrows, active contacts, status text (with the knot type)
+// and a |force| strip chart. Needs a current GL context (GLFW + libepoxy); all geometry is
+// rebuilt per frame (a few thousand vertices) and streamed in one buffer.
 #pragma once
 
 #include <string>
@@ -9,15 +10,14 @@
 
 #include <epoxy/gl.h>
 
+#include "marker_colors.h"
 #include "mesh_builder.h"
 #include "orbit_camera.h"
 #include "session_receiver.h"
+#include "spline.h"
 
 namespace snapthread::viewer {
 
-// Colour coding of the solver state (force_model_t.STATUS_*), also used by the tests.
-Rgb StatusColor(int status);
-inline const Rgb kBackground(0.11f, 0.12f, 0.15f);
 
 struct FrameInfo {
   std::string session;
@@ -51,6 +51,19 @@ class Renderer {
   // Every grasp of thread_shape_t.grasps with its force arrow, and every active contact.
   void AppendGraspsAndContacts(const thread_shape_t& shape, double extent, double radius);
 
+  // The rod (a shape with one frame row per edge): the tube turned so its dark stripe
+  // follows d1 and coloured by twist density (material_frames.h).
+  void AppendMaterialTube(const thread_shape_t& shape, const std::vector<Point3>& nodes,
+                          const std::vector<Point3>& path, double radius);
+  // The twist colour bar and its scale (HudLayout::legend), when a rod is drawn.
+  void BuildTwistLegend(const Rgb& base, int width, int height);
+
+  struct TwistLegend {
+    bool shown = false;
+    double full_scale = 0.0;  // rad per model length at full colour (one turn per length)
+    double max_abs = 0.0;     // largest |twist density| of the shape
+  };
+  TwistLegend twist_legend_;
   GLuint program_ = 0;
   GLuint vao_ = 0;
   GLuint vbo_ = 0;

@@ -1,6 +1,7 @@
 // Vetting of the messages the viewer draws: the transport library's DecodeAndValidate
 // (length fields checked before lcm-gen's decoders, counts and finiteness after), plus what
-// drawing needs on top (at least one node). Never throws: called inside LCM handlers.
+// drawing needs on top (at least one node; material frames, if any, one per edge with a
+// unit director). Never throws: called inside LCM handlers.
 #pragma once
 
 #include <string>

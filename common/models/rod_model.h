@@ -106,6 +106,13 @@ class RodModel final : public Model {
   Vec MaterialAngles(const Vec& x, const Vec& u) const;
   // Material director m1 of edge j.
   Eigen::Vector3d MaterialDirector(const Vec& x, const Vec& u, int j) const;
+  // For drawing (rod_shape.cc): m1 of every edge (3 x n) and the twist density of every
+  // edge (rad per unit length): the total twist θ_i − θ_{i−1} + m_i of its end vertices
+  // [DVT (2)] averaged (edges 0 and n−1 have one interior vertex) over ℓ̄ = ℓ. A straight
+  // rod whose held edges are turned by Φ against each other has Φ / ((n − 1) ℓ) on every
+  // edge (the twist acts between the held edges' midpoints).
+  void MaterialFrames(const Vec& x, const Vec& u, Eigen::Matrix3Xd* d1, Vec* twist_density) const;
+  Vec TwistDensity(const Vec& x, const Vec& u) const;
   const RodParams& params() const { return p_; }
 
  private:

@@ -255,8 +255,52 @@ TEST(ServerMessagesTest, ShapeCountsMatchAndValidate) {
   EXPECT_DOUBLE_EQ(s.force[0], 1.5);
   EXPECT_DOUBLE_EQ(s.force_newtons[1], -4.0);
   EXPECT_EQ(s.snaps, 3);
+  EXPECT_EQ(s.num_frames, 0);  // material frames are the rod's alone
+  EXPECT_TRUE(s.frames.empty());
   std::string why;
   EXPECT_TRUE(transport::Validate(s, &why)) << why;
+}
+
+// Issue 14 item 3: the rod's shape carries one frame row per edge, m1 and the twist
+// density. A straight rod (n = 8, L = 1) with the grasp rolled by 2 rad about it: m1 of
+// edge j is turned by 2 j / 7 about +x from the clamp's +y, and every edge has the twist
+// density 2 / (7 ℓ) rad per model length (the twist acts between the held edges' midpoints).
+TEST(ServerMessagesTest, RodShapeCarriesMaterialFramesAndTwistDensity) {
+  const DeviceMapping map = TestMapping();
+  ModelParams p;
+  p.model = "rod";
+  p.Set("n", 8);
+  auto model = MakeModel(p);
+  const double roll = 2.0;
+  const Vec u = (Vec(6) << 1.0, 0.0, 0.0, roll, 0.0, 0.0).finished();
+  ShapeInputs in;
+  in.scene = "rod";
+  in.mapping = &map;
+  in.model = model.get();
+  in.u = u;
+  in.x = model->InitialState(u);
+  const thread_shape_t s = BuildShape(in);
+  ASSERT_EQ(s.num_nodes, 9);
+  ASSERT_EQ(s.num_frames, 8);
+  ASSERT_EQ(s.frames.size(), 8u);
+  const double ell = 1.0 / 8;
+  for (int j = 0; j < 8; ++j) {
+    const auto& f = s.frames[j];
+    const double a = roll * j / 7;
+    EXPECT_NEAR(f[0], 0.0, 1e-12) << "edge " << j;
+    EXPECT_NEAR(f[1], std::cos(a), 1e-12) << "edge " << j;
+    EXPECT_NEAR(f[2], std::sin(a), 1e-12) << "edge " << j;
+    EXPECT_NEAR(f[3], roll / (7 * ell), 1e-9) << "edge " << j;
+    // m1 is normal to its edge (nodes j, j + 1).
+    double along = 0.0;
+    for (int i = 0; i < 3; ++i) along += f[i] * (s.positions[j + 1][i] - s.positions[j][i]);
+    EXPECT_NEAR(along, 0.0, 1e-12);
+  }
+  std::string why;
+  EXPECT_TRUE(transport::Validate(s, &why)) << why;
+  // A state that does not fit the model gets no frames (and no nodes).
+  in.x = Vec::Zero(3);
+  EXPECT_EQ(BuildShape(in).num_frames, 0);
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ namespace {
 using test_support::ChildProcess;
 using test_support::OneLog;
 
-// The native viewer's tube colours by status (viewer/renderer.cc StatusColor).
+// The native viewer's tube colours by status (viewer/marker_colors.h StatusColor).
 const double kStatusColours[5][3] = {
     {0.55, 0.80, 0.95}, {1.00, 0.62, 0.10}, {0.95, 0.20, 0.20}, {0.55, 0.55, 0.55}, {0.85, 0.35, 0.75}};
 

@@ -1,9 +1,9 @@
-// The native viewer's colours (viewer/renderer.cc, renderer.h), linear RGB 0..1, so the
+// The native viewer's colours (viewer/marker_colors.h), linear RGB 0..1, so the
 // page and snapthread-viewer look alike. Shading is the viewer's headlight too
 // (scene_view.js: 0.35 + 0.65 |n . eye|).
 export const BACKGROUND = [0.11, 0.12, 0.15];
 
-// force_model_t.STATUS_*: renderer.cc StatusColor.
+// force_model_t.STATUS_*: marker_colors.h StatusColor.
 export function statusColour(status) {
   switch (status) {
     case 0: return [0.55, 0.80, 0.95]; // regular: pale blue
