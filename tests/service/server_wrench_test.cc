@@ -3,7 +3,9 @@
 // (ApplyGraspPoses -> tracker -> BuildForceModel) on scenes/rod_greenhill.yaml: K6
 // against central differences of the wrench over device pose perturbations, each one a
 // re-solved equilibrium, and the torque before the buckle against GJ Φ / L.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <numbers>
 #include <vector>
@@ -203,16 +205,20 @@ void ExpectK6MatchesFiniteDifferences(RodWrench* rod, const V3& position, const 
     return Vec6((plus - minus) / (2.0 * h));
   };
   const double hp = 2e-5, hr = 2e-4;
+  double worst = 0.0;
   for (int j = 0; j < 6; ++j) {
     const double h = j < 3 ? hp : hr;
     const Vec6 fd = (4.0 * central(j, 0.5 * h) - central(j, h)) / 3.0;
     Vec6 k;
     for (int i = 0; i < 6; ++i) k[i] = base.K6[i][j];
     const double scale = std::max(k.lpNorm<Eigen::Infinity>(), fd.lpNorm<Eigen::Infinity>());
+    worst = std::max(worst, (fd - k).lpNorm<Eigen::Infinity>() / scale);
     EXPECT_LT((fd - k).lpNorm<Eigen::Infinity>(), tolerance * scale)
         << "column " << j << " at rotation " << rotation.transpose() << "\nK6  " << k.transpose()
         << "\nFD  " << fd.transpose();
   }
+  std::printf("K6 vs differences at rotation (%.3f, %.3f, %.3f): worst column error %.2e of its scale\n",
+              rotation[0], rotation[1], rotation[2], worst);
   // K stays K6's top-left block (3-DoF devices are unchanged).
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) EXPECT_EQ(base.K[i][j], base.K6[i][j]);
@@ -308,6 +314,8 @@ TEST(RodWrenchTest, DeviceLocalModelReproducesTheWrenchToSecondOrder) {
   for (int c = 0; c < 2; ++c) {
     const char* what = c == 0 ? "force" : "torque";
     const double ratio = error[0][c] / error[1][c];
+    std::printf("local model %s error: %.3e at the offset, %.3e at half of it (ratio %.2f)\n", what, error[0][c],
+                error[1][c], ratio);
     EXPECT_GT(ratio, 3.5) << what << ": errors " << error[0][c] << " " << error[1][c];
     EXPECT_LT(ratio, 4.5) << what << ": errors " << error[0][c] << " " << error[1][c];
   }
