@@ -10,8 +10,8 @@
 //    (lcmtypes/device_state_t.lcm: R * (1, 0, 0)), expressed in the scene: the device's
 //    rest orientation holds the grip the way the scene starts (grasp.direction),
 //    d = R(q) d_start. This is R(q) (1, 0, 0) exactly when the scene starts along +x, and
-//    it lets devices that sense no orientation (they report the identity: sim-path,
-//    virtual-hand, 3-DOF devices) hold the scene's grip instead of turning it to +x, as
+//    it lets devices that sense no orientation (they report the identity; so do sim-path
+//    and virtual-hand outside rod scenes) hold the scene's grip instead of turning it to +x, as
 //    model_origin does for positions.
 //  * a grasp that holds its full orientation (GraspLayout::grip_rotation, the rod):
 //    u = (X, Y, Z, φ) with exp([φ]×) = R(q): the device at rest holds the scene's start
