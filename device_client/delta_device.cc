@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 #include <dhdc.h>
 
 namespace snapthread::device {
@@ -25,7 +27,12 @@ bool DeltaDevice::Open(std::string* error) {
   caps_.max_linear_damping_n_per_m_per_s = 20.0;
   caps_.workspace_radius_m = 0.075;
   caps_.max_velocity_m_per_s = 1.0;
-  caps_.has_orientation = false;  // forces only; wrist torques not driven
+  // A wrist is sensed where the device has one (omega.6, sigma.7, delta.6) and torqued
+  // where it is active (sigma.7, delta.6): dhdHasWrist / dhdHasActiveWrist. The SDK
+  // gives no continuous wrist torque; 0.1 N m is an assumed bound, not a datasheet value.
+  caps_.has_orientation = dhdHasWrist(id_);
+  caps_.has_torque_output = dhdHasActiveWrist(id_);
+  caps_.max_torque_nm = caps_.has_torque_output ? 0.1 : 0.0;
   if (dhdEnableForce(DHD_ON, id_) < 0) {
     if (error) *error = std::string("dhdEnableForce: ") + dhdErrorGetLastStr();
     Close();
@@ -45,18 +52,40 @@ bool DeltaDevice::Read(DeviceState* state) {
   }
   state->orientation[0] = 1.0;
   state->orientation[1] = state->orientation[2] = state->orientation[3] = 0.0;
+  if (caps_.has_orientation) {
+    double frame[3][3];
+    if (dhdGetOrientationFrame(frame, id_) < 0) return false;
+    Eigen::Matrix3d rot;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) rot(i, j) = frame[i][j];
+    }
+    const Eigen::Quaterniond q(rot);
+    state->orientation[0] = q.w();
+    state->orientation[1] = q.x();
+    state->orientation[2] = q.y();
+    state->orientation[3] = q.z();
+  }
   state->buttons = dhdGetButton(0, id_) == DHD_ON ? 1 : 0;
   return true;
 }
 
-bool DeltaDevice::Command(const double force_n[3], const double /*torque_nm*/[3]) {
+bool DeltaDevice::Command(const double force_n[3], const double torque_nm[3]) {
   if (id_ < 0) return false;
+  if (caps_.has_torque_output) {
+    // 0 or DHD_MOTOR_SATURATED on success, -1 on failure.
+    return dhdSetForceAndTorque(force_n[0], force_n[1], force_n[2], torque_nm[0], torque_nm[1],
+                                torque_nm[2], id_) >= 0;
+  }
   return dhdSetForce(force_n[0], force_n[1], force_n[2], id_) >= 0;
 }
 
 void DeltaDevice::Close() {
   if (id_ < 0) return;
-  dhdSetForce(0.0, 0.0, 0.0, id_);
+  if (caps_.has_torque_output) {
+    dhdSetForceAndTorque(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, id_);
+  } else {
+    dhdSetForce(0.0, 0.0, 0.0, id_);
+  }
   dhdClose(id_);
   id_ = -1;
 }

@@ -1,7 +1,9 @@
 // delta backend: Force Dimension delta / omega / sigma through the DHD SDK.
 // UNTESTED: compiled only when CMake finds dhdc.h and libdhd, and neither the SDK nor a
 // device was available where this was written. DHD calls are synchronous USB
-// transactions (~0.1-0.2 ms), made directly from the servo thread.
+// transactions (~0.1-0.2 ms), made directly from the servo thread. Devices with a wrist
+// report their orientation (dhdGetOrientationFrame); those with an active wrist (sigma.7,
+// delta.6) render the grip torque too (dhdSetForceAndTorque). Also untested.
 #pragma once
 
 #include "haptic_device.h"

@@ -18,15 +18,17 @@ namespace {
 double Seconds(int64_t us) { return 1e-6 * static_cast<double>(us); }
 
 void WriteTraceHeader(std::FILE* f) {
-  std::fputs("t_s,seq,x_m,y_m,z_m,fx_n,fy_n,fz_n,model_age_ms,model_status,clamped,fading\n", f);
+  std::fputs("t_s,seq,x_m,y_m,z_m,fx_n,fy_n,fz_n,model_age_ms,model_status,clamped,fading,"
+             "qw,qx,qy,qz,tx_nm,ty_nm,tz_nm\n", f);
 }
 
 void WriteTraceRow(std::FILE* f, const TraceRow& r, int64_t start_us) {
-  std::fprintf(f, "%.6f,%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.3f,%d,%d,%d\n",
+  std::fprintf(f, "%.6f,%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.3f,%d,%d,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
                Seconds(r.utime_us - start_us), static_cast<long long>(r.tick), r.position_m[0],
                r.position_m[1], r.position_m[2], r.force_n[0], r.force_n[1], r.force_n[2],
                r.model_age_ms, static_cast<int>(r.model_status), r.clamped ? 1 : 0,
-               r.fading ? 1 : 0);
+               r.fading ? 1 : 0, r.orientation[0], r.orientation[1], r.orientation[2],
+               r.orientation[3], r.torque_nm[0], r.torque_nm[1], r.torque_nm[2]);
 }
 
 std::FILE* OpenTrace(const std::string& path) {
@@ -46,7 +48,7 @@ DeviceClient::DeviceClient(HapticDevice* device, DeviceTransport* transport,
     : device_(device),
       transport_(transport),
       config_(std::move(config)),
-      safety_(config_.limits, config_.device_has_orientation),
+      safety_(config_.limits, config_.device_has_orientation, config_.device_torque_output),
       models_(std::make_unique<ModelSlot>()),
       poses_(std::make_unique<PoseRing>()),
       trace_ring_(std::make_unique<TraceRing>()),
@@ -263,6 +265,9 @@ DeviceClientSummary DeviceClient::Summary(int64_t now_us) const {
   s.snaps_felt = receiver_.snaps_felt();
   s.snap_ahead_switches = snap_ahead_.switches();
   s.nonfinite_outputs = sc.nonfinite_outputs.load();
+  s.torque_clamps = sc.torque_clamps.load();
+  s.torque_slew_limits = sc.torque_slew_limits.load();
+  s.wrench_models = receiver_.wrench_models();
   s.overruns = loop_.overruns();
   s.read_failures = tick_.counters().read_failures.load();
   s.pose_ring_drops = poses_->dropped();

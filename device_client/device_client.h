@@ -39,7 +39,8 @@ struct DeviceClientConfig {
   // only grasp): force models for another grasp are not for this device.
   std::string grasp;
   SafetyLimits limits;               // must be valid (SafetyLimits::IsValid)
-  bool device_has_orientation = false;
+  bool device_has_orientation = false;  // DeviceCapabilities::has_orientation
+  bool device_torque_output = false;    // DeviceCapabilities::has_torque_output
   ServoTickOptions tick;
   ServoLoopOptions loop;
   std::string trace_file;            // per-tick CSV, empty = none
@@ -68,6 +69,8 @@ struct DeviceClientSummary {
   uint64_t models_received = 0, models_rejected = 0, invalid_models = 0;
   uint64_t poses_rejected = 0, force_clamps = 0, stiffness_clamps = 0, slew_limits = 0;
   uint64_t fade_ticks = 0, snaps_felt = 0, nonfinite_outputs = 0, overruns = 0;
+  uint64_t torque_clamps = 0, torque_slew_limits = 0;  // torque-output devices only
+  uint64_t wrench_models = 0;  // accepted 6-DoF models (has_wrench)
   uint64_t snap_ahead_switches = 0;
   uint64_t read_failures = 0, pose_ring_drops = 0, trace_ring_drops = 0;
   uint64_t invalid_poses_unpublished = 0, publish_failures = 0, poses_published = 0;

@@ -75,14 +75,16 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
       "  \"snap_ahead_switches\": %llu,\n"
       "  \"max_force_n\": %.6f,\n  \"final_force_n\": %.6f,\n  \"nonfinite_outputs\": %llu,\n  \"overruns\": %llu,\n"
       "  \"read_failures\": %llu,\n  \"pose_ring_drops\": %llu,\n  \"trace_ring_drops\": %llu,\n"
-      "  \"invalid_poses_unpublished\": %llu,\n  \"realtime\": %s\n}\n",
+      "  \"invalid_poses_unpublished\": %llu,\n  \"torque_clamps\": %llu,\n"
+      "  \"torque_slew_limits\": %llu,\n  \"wrench_models\": %llu,\n  \"realtime\": %s\n}\n",
       o.backend.c_str(), o.session.c_str(), s.duration_s, u(s.ticks), s.tick_rate_hz,
       s.lateness_us.p50, s.lateness_us.p99, s.lateness_us_max, s.round_trip_us.p50,
       s.round_trip_us.p99, u(s.models_received), u(s.models_rejected), u(s.invalid_models),
       u(s.poses_rejected), u(s.force_clamps), u(s.stiffness_clamps), u(s.slew_limits),
       u(s.fade_ticks), u(s.snaps_felt), u(s.snap_ahead_switches), s.max_force_n, s.final_force_n, u(s.nonfinite_outputs), u(s.overruns),
       u(s.read_failures), u(s.pose_ring_drops), u(s.trace_ring_drops),
-      u(s.invalid_poses_unpublished), s.realtime ? "true" : "false");
+      u(s.invalid_poses_unpublished), u(s.torque_clamps), u(s.torque_slew_limits), u(s.wrench_models),
+      s.realtime ? "true" : "false");
   std::fclose(f);
   return true;
 }
@@ -117,6 +119,21 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
       ->capture_default_str();
   app.add_option("--speed-m-per-s", o->speed_m_per_s, "scripted path speed")
       ->check(CLI::Range(1e-6, 10.0))
+      ->capture_default_str();
+  app.add_option("--angular-speed-deg-per-s", o->angular_speed_deg_per_s,
+                 "scripted path turning speed (a rod scene's roll_deg)")
+      ->check(CLI::Range(1e-3, 3600.0))
+      ->capture_default_str();
+  app.add_option("--max-torque-nm", o->max_torque_nm,
+                 "torque bound for devices with torque output (never above the device's own)")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
+  app.add_option("--max-torque-rate", o->max_torque_rate_nm_per_s, "torque slew limit, N m/s")
+      ->check(CLI::Range(1e-6, 1e4))
+      ->capture_default_str();
+  app.add_option("--max-torque-stiffness", o->max_torque_stiffness_nm_per_rad,
+                 "bound on the rotational stiffness of a 6-DoF model, N m/rad")
+      ->check(CLI::Range(0.0, 1e3))
       ->capture_default_str();
   bool no_rt = false;
   app.add_flag("--no-rt", no_rt, "do not try SCHED_FIFO / mlockall");
@@ -170,6 +187,11 @@ int RunDeviceClient(const DeviceClientOptions& o) {
       {"--fade-ms", o.fade_ms > 0.0 && std::isfinite(o.fade_ms)},
       {"--speed-m-per-s", o.speed_m_per_s > 0.0 && std::isfinite(o.speed_m_per_s)},
       {"--duration", o.duration_s >= 0.0 && std::isfinite(o.duration_s)},
+      {"--angular-speed-deg-per-s", o.angular_speed_deg_per_s > 0.0 && std::isfinite(o.angular_speed_deg_per_s)},
+      {"--max-torque-nm", o.max_torque_nm >= 0.0 && std::isfinite(o.max_torque_nm)},
+      {"--max-torque-rate", o.max_torque_rate_nm_per_s > 0.0 && std::isfinite(o.max_torque_rate_nm_per_s)},
+      {"--max-torque-stiffness",
+       o.max_torque_stiffness_nm_per_rad >= 0.0 && std::isfinite(o.max_torque_stiffness_nm_per_rad)},
   };
   for (const auto& range : ranges) {
     if (!range.ok) {
@@ -218,7 +240,8 @@ int RunDeviceClient(const DeviceClientOptions& o) {
     if (!o.path_csv.empty()) {
       config.path = ScriptedPath::FromCsv(o.path_csv, o.speed_m_per_s);
     } else if (scene && BackendNeedsPath(o.backend)) {
-      config.path = ScriptedPath::FromScene(*scene, o.speed_m_per_s, grasp);
+      config.path = ScriptedPath::FromScene(*scene, o.speed_m_per_s, grasp,
+                                            o.angular_speed_deg_per_s * 3.141592653589793 / 180.0);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "snapthread-device: %s: %s\n",
@@ -249,7 +272,10 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   const DeviceCapabilities caps = device->capabilities();
   DeviceClientConfig cc;
   const DeviceMapping mapping = scene ? GraspDeviceMapping(*scene, grasp) : DeviceMapping{};
-  cc.limits = LimitsFrom(caps, scene ? &mapping : nullptr);
+  cc.limits.max_torque_nm = o.max_torque_nm;  // LimitsFrom keeps it under the device's own
+  cc.limits = LimitsFrom(caps, scene ? &mapping : nullptr, cc.limits);
+  cc.limits.max_torque_rate_nm_per_s = o.max_torque_rate_nm_per_s;
+  cc.limits.max_torque_stiffness_nm_per_rad = o.max_torque_stiffness_nm_per_rad;
   cc.limits.model_timeout_s = 1e-3 * o.model_timeout_ms;
   cc.limits.fade_time_s = 1e-3 * o.fade_ms;
   cc.limits.tick_period_s = 1.0 / o.rate_hz;
@@ -269,6 +295,7 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   if (scene && !scene->grasps.empty()) cc.grasp = scene->grasps[grasp].name;
   if (!cc.grasp.empty()) cc.device_id += "@" + cc.grasp;
   cc.device_has_orientation = caps.has_orientation;
+  cc.device_torque_output = caps.has_torque_output;
   cc.tick.publish_divisor = o.publish_divisor;
   cc.tick.trace_divisor = o.trace_divisor;
   cc.loop.rate_hz = o.rate_hz;
@@ -278,10 +305,15 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   cc.session = o.session;
   cc.snap_ahead = o.snap_ahead;
   spdlog::info("device: {} session {} on {}; limits |F| <= {} N, stiffness <= {} N/m, "
-               "slew {} N/s, timeout {} ms, fade {} ms, workspace {} m",
+               "slew {} N/s, timeout {} ms, fade {} ms, workspace {} m; orientation {}, torque {}",
                cc.device_id, o.session, url, limits.max_force_n, limits.max_stiffness_n_per_m,
                limits.max_force_rate_n_per_s, 1e3 * limits.model_timeout_s,
-               1e3 * limits.fade_time_s, limits.workspace_radius_m);
+               1e3 * limits.fade_time_s, limits.workspace_radius_m,
+               caps.has_orientation ? "sensed" : "not sensed",
+               caps.has_torque_output
+                   ? fmt::format("|τ| <= {} N m, slew {} N m/s, stiffness <= {} N m/rad", limits.max_torque_nm,
+                                 limits.max_torque_rate_nm_per_s, limits.max_torque_stiffness_nm_per_rad)
+                   : std::string("not rendered"));
 
   // ---- run until the duration elapses or a signal arrives -------------------------------
   std::unique_ptr<DeviceClient> client;

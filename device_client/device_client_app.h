@@ -20,6 +20,11 @@ struct DeviceClientOptions {
   double model_timeout_ms = 50.0;
   double fade_ms = 100.0;
   double speed_m_per_s = 0.02;           // scripted path speed
+  double angular_speed_deg_per_s = 45.0; // scripted path turning speed (a rod scene's roll)
+  // Torque output (devices with a motorised wrist, and sim-path): safety.h.
+  double max_torque_nm = 0.05;
+  double max_torque_rate_nm_per_s = 20.0;
+  double max_torque_stiffness_nm_per_rad = 0.1;
   bool realtime = true;                  // --no-rt turns off SCHED_FIFO / mlockall
   bool snap_ahead = true;                // --no-snap-ahead: never switch at a fold boundary
   std::string log_level = "info";

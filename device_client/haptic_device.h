@@ -18,7 +18,12 @@ struct DeviceCapabilities {
   double max_linear_damping_n_per_m_per_s = 0.0;  // largest stable damping, N/(m/s)
   double workspace_radius_m = 0.0;          // radius of the usable workspace about the origin
   double max_velocity_m_per_s = 0.0;        // poses faster than this are suspect
-  bool has_orientation = false;             // senses (and can be torqued about) a grip axis
+  bool has_orientation = false;             // senses its orientation (DeviceState::orientation)
+  // Renders a torque about the grip (Command's torque_nm): a wrist with motors (Force
+  // Dimension sigma.7 / delta.6). A 3-DoF device (PHANToM Omni/Touch) senses its gimbal
+  // but renders force only.
+  bool has_torque_output = false;
+  double max_torque_nm = 0.0;               // largest continuous torque, N m (torque output)
 };
 
 // One measurement, in the device frame (metres, origin at the workspace centre).

@@ -83,6 +83,7 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
     if (verdict == ModelVerdict::kStiffnessClamped) stiffness_clamps_.fetch_add(1);
     if (verdict == ModelVerdict::kInvalidStatus) invalid_models_.fetch_add(1);
     if (msg.status == force_model_t::STATUS_SNAPPED) snaps_felt_.fetch_add(1);
+    if (model.has_wrench) wrench_models_.fetch_add(1);
     slot_->Write(model);
     order_.Applied(msg.epoch, msg.seq, msg.device_seq);
     received_.fetch_add(1);

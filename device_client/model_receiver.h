@@ -66,6 +66,8 @@ class ModelReceiver {
   uint64_t stiffness_clamps() const { return stiffness_clamps_.load(); }
   uint64_t invalid_models() const { return invalid_models_.load(); }
   uint64_t snaps_felt() const { return snaps_felt_.load(); }
+  // Accepted models with a 6-DoF wrench (force_model_t.has_wrench: a rod's grasp).
+  uint64_t wrench_models() const { return wrench_models_.load(); }
 
  private:
   void Reject(const std::string& why);
@@ -80,7 +82,7 @@ class ModelReceiver {
                                        auth::FreshnessFilter::EpochPolicy::kAdopt};
   auth::FreshnessFilter model_filter_{"FORCE_MODEL"};
   std::atomic<uint64_t> received_{0}, rejected_{0}, stiffness_clamps_{0}, invalid_models_{0},
-      snaps_felt_{0}, out_of_order_{0}, other_grasp_{0};
+      snaps_felt_{0}, out_of_order_{0}, other_grasp_{0}, wrench_models_{0};
   mutable std::mutex mutex_;  // the round-trip windows (receiver and status threads)
   transport::SampleWindow round_trip_window_{2000};
   transport::SampleWindow round_trip_run_{200000};

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include <Eigen/Geometry>
+
 namespace snapthread::device {
 
 PhantomDevice::PhantomDevice() { caps_.model_name = "phantom"; }
@@ -34,7 +36,10 @@ bool PhantomDevice::Open(std::string* error) {
   for (int k = 0; k < 3; ++k) r = std::max(r, 0.5e-3 * std::abs(workspace[k + 3] - workspace[k]));
   caps_.workspace_radius_m = r;
   caps_.max_velocity_m_per_s = 1.0;
-  caps_.has_orientation = false;  // the grip is sensed but not torqued (3-DOF output)
+  // The gimbal is sensed (HD_CURRENT_TRANSFORM) but not torqued: a 3-DoF output device
+  // renders the force of a rod's 6-DoF model with its rotation coupling, never a torque.
+  caps_.has_orientation = true;
+  caps_.has_torque_output = false;
   hdEnable(HD_FORCE_OUTPUT);
   hdEnable(HD_MAX_FORCE_CLAMPING);
   callback_ = hdScheduleAsynchronous(&PhantomDevice::ServoCallback, this,
@@ -64,15 +69,17 @@ HDCallbackCode HDCALLBACK PhantomDevice::ServoCallback(void* self_ptr) {
     s.position_m[k] = 1e-3 * pos_mm[k];
     s.velocity_m_per_s[k] = 1e-3 * vel_mm_s[k];
   }
-  // Rotation (column-major 4x4) -> quaternion (w, x, y, z).
-  const double m00 = transform[0], m11 = transform[5], m22 = transform[10];
-  const double w = 0.5 * std::sqrt(std::max(0.0, 1.0 + m00 + m11 + m22));
-  s.orientation[0] = w;
-  if (w > 1e-6) {
-    s.orientation[1] = (transform[6] - transform[9]) / (4.0 * w);
-    s.orientation[2] = (transform[8] - transform[2]) / (4.0 * w);
-    s.orientation[3] = (transform[1] - transform[4]) / (4.0 * w);
+  // Rotation (column-major 4x4) -> quaternion (w, x, y, z); Eigen's conversion is exact
+  // at every angle (half a turn included).
+  Eigen::Matrix3d rot;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) rot(i, j) = transform[4 * j + i];
   }
+  const Eigen::Quaterniond q(rot);
+  s.orientation[0] = q.w();
+  s.orientation[1] = q.x();
+  s.orientation[2] = q.y();
+  s.orientation[3] = q.z();
   s.buttons = buttons;
   self->state_.Write(s);
   Force f{{0.0, 0.0, 0.0}};

@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "messages/validate.h"
+#include "numeric/so3.h"
 #include "snap_ahead.h"
 
 namespace snapthread::device {
@@ -31,15 +32,24 @@ bool SafetyLimits::IsValid(std::string* error) const {
     return bad("workspace_radius_m must be > 0");
   }
   if (!(max_torque_nm >= 0.0) || !std::isfinite(max_torque_nm)) return bad("max_torque_nm must be >= 0");
+  if (!(max_torque_rate_nm_per_s > 0.0) || !std::isfinite(max_torque_rate_nm_per_s)) {
+    return bad("max_torque_rate_nm_per_s must be > 0");
+  }
+  if (!(max_torque_stiffness_nm_per_rad >= 0.0) || !std::isfinite(max_torque_stiffness_nm_per_rad)) {
+    return bad("max_torque_stiffness_nm_per_rad must be >= 0");
+  }
   if (!(tick_period_s > 0.0) || !std::isfinite(tick_period_s)) return bad("tick_period_s must be > 0");
   return true;
 }
 
-SafetyLimits LimitsFrom(const DeviceCapabilities& caps, const DeviceMapping* mapping) {
-  SafetyLimits l;
+SafetyLimits LimitsFrom(const DeviceCapabilities& caps, const DeviceMapping* mapping,
+                        const SafetyLimits& base) {
+  SafetyLimits l = base;
   l.max_force_n = caps.max_force_n;
   l.max_stiffness_n_per_m = caps.max_stiffness_n_per_m;
   l.workspace_radius_m = caps.workspace_radius_m;
+  // A device without torque output renders none; one with it, no more than it can.
+  l.max_torque_nm = caps.has_torque_output ? std::min(l.max_torque_nm, caps.max_torque_nm) : 0.0;
   if (mapping != nullptr) {
     l.max_force_n = std::min(l.max_force_n, mapping->max_force_n);
     l.max_stiffness_n_per_m = std::min(l.max_stiffness_n_per_m, mapping->max_stiffness_n_per_m);
@@ -89,6 +99,74 @@ bool ClampStiffness(const double K_in[3][3], const SafetyLimits& limits, double 
   return true;
 }
 
+bool ClampWrenchStiffness(const double K6_in[6][6], const SafetyLimits& limits, double out[6][6],
+                          bool* clamped, std::string* why) {
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  Mat6 k;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) k(i, j) = K6_in[i][j];
+  }
+  const double k_max = limits.max_stiffness_n_per_m;
+  const double k_rot = limits.max_torque_stiffness_nm_per_rad;
+  *clamped = false;
+  Mat6 result = Mat6::Zero();
+  if (k_max > 0.0 && k_rot > 0.0) {
+    // (u, ℓ r) with ℓ² = k_rot / k_max: K6' = T K6 T, T = diag(1, 1, 1, 1/ℓ, 1/ℓ, 1/ℓ), all
+    // in N/m; -sym(K6') in [0, k_max] <=> the force block in [0, k_max] N/m and the
+    // torque block in [0, k_rot] N m/rad, with a coupling that keeps the whole PSD.
+    const double ell = std::sqrt(k_rot / k_max);
+    Eigen::Matrix<double, 6, 1> t;
+    t << 1.0, 1.0, 1.0, 1.0 / ell, 1.0 / ell, 1.0 / ell;
+    const Mat6 kp = t.asDiagonal() * k * t.asDiagonal();
+    const Mat6 sym = -(0.5 * kp + 0.5 * kp.transpose());
+    Mat6 skew = 0.5 * kp - 0.5 * kp.transpose();
+    Eigen::SelfAdjointEigenSolver<Mat6> eig(sym);
+    if (eig.info() != Eigen::Success || !eig.eigenvalues().allFinite() || !eig.eigenvectors().allFinite()) {
+      if (why) *why = "K6 stiffness eigen-decomposition failed";
+      return false;
+    }
+    Eigen::Matrix<double, 6, 1> lambda = eig.eigenvalues();
+    const double tol = 1e-9 * std::max(1.0, k_max);
+    for (int i = 0; i < 6; ++i) {
+      const double c = std::clamp(lambda[i], 0.0, k_max);
+      if (std::abs(c - lambda[i]) > tol) *clamped = true;
+      lambda[i] = c;
+    }
+    // -½[τ0]× has Frobenius norm |τ0| / √2; in K6' it is divided by ℓ².
+    const double skew_max = limits.max_torque_nm / (std::sqrt(2.0) * ell * ell);
+    const double skew_norm = skew.norm();
+    if (!std::isfinite(skew_norm)) {
+      if (why) *why = "K6 is not finite";
+      return false;
+    }
+    if (skew_norm > skew_max * (1.0 + 1e-9)) {
+      skew *= skew_max / skew_norm;
+      *clamped = true;
+    }
+    const Mat6 s = eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+    const Mat6 kc = -(0.5 * s + 0.5 * s.transpose()) + skew;
+    result = t.cwiseInverse().asDiagonal() * kc * t.cwiseInverse().asDiagonal();
+  } else {
+    double k3[3][3], c3[3][3];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) k3[i][j] = K6_in[i][j];
+    }
+    if (!ClampStiffness(k3, limits, c3, clamped, why)) return false;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) result(i, j) = c3[i][j];
+    }
+    if (!(k.bottomRows<3>().isZero(0.0) && k.topRightCorner<3, 3>().isZero(0.0))) *clamped = true;
+  }
+  if (!result.allFinite()) {
+    if (why) *why = "K6 is not finite after clamping its stiffness";
+    return false;
+  }
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) out[i][j] = result(i, j);
+  }
+  return true;
+}
+
 ModelVerdict PrepareModel(const force_model_t& msg, int64_t receive_us,
                           const SafetyLimits& limits, LocalModel* out, std::string* why) {
   if (!transport::Validate(msg, why)) return ModelVerdict::kRejected;
@@ -114,14 +192,49 @@ ModelVerdict PrepareModel(const force_model_t& msg, int64_t receive_us,
   }
   bool clamped = false;
   if (!ClampStiffness(msg.K, limits, m.K_n_per_m, &clamped, why)) return ModelVerdict::kRejected;
+  if (msg.has_wrench == 1) {
+    // Validate() checked q0 is a unit quaternion and K6 finite.
+    m.has_wrench = true;
+    const double qn = std::sqrt(msg.q0[0] * msg.q0[0] + msg.q0[1] * msg.q0[1] +
+                                msg.q0[2] * msg.q0[2] + msg.q0[3] * msg.q0[3]);
+    for (int i = 0; i < 4; ++i) m.q0[i] = msg.q0[i] / qn;
+    bool k6_clamped = false;
+    if (!ClampWrenchStiffness(msg.K6, limits, m.K6, &k6_clamped, why)) return ModelVerdict::kRejected;
+    clamped = clamped || k6_clamped;
+  }
   // A bad fold refuses the whole model: it never reaches the servo (snap_ahead.h).
   if (!PrepareFold(msg, limits, &m, &clamped, why)) return ModelVerdict::kRejected;
   *out = m;
   return clamped ? ModelVerdict::kStiffnessClamped : ModelVerdict::kAccepted;
 }
 
-ForceSafety::ForceSafety(const SafetyLimits& limits, bool device_has_orientation)
-    : limits_(limits), has_orientation_(device_has_orientation) {
+void EvaluateLocalModel(const LocalModel& model, const double position_m[3], const double orientation[4],
+                        double force_n[3], double torque_nm[3]) {
+  double d[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  for (int k = 0; k < 3; ++k) d[k] = position_m[k] - model.u0_m[k];
+  const bool six = model.has_wrench && orientation != nullptr;
+  if (six) {
+    const Eigen::Vector3d r = so3::RotationVectorBetween(orientation, model.q0);
+    for (int k = 0; k < 3; ++k) d[3 + k] = r[k];
+  }
+  for (int i = 0; i < 3; ++i) {
+    double fi = model.f0_n[i];
+    double ti = model.has_torque ? model.torque0_nm[i] : 0.0;
+    if (six) {
+      for (int j = 0; j < 6; ++j) {
+        fi += model.K6[i][j] * d[j];
+        ti += model.K6[3 + i][j] * d[j];
+      }
+    } else {
+      for (int j = 0; j < 3; ++j) fi += model.K_n_per_m[i][j] * d[j];
+    }
+    force_n[i] = fi;
+    torque_nm[i] = ti;
+  }
+}
+
+ForceSafety::ForceSafety(const SafetyLimits& limits, bool device_has_orientation, bool torque_output)
+    : limits_(limits), has_orientation_(device_has_orientation), torque_output_(torque_output) {
   std::string error;
   if (!limits_.IsValid(&error)) throw std::invalid_argument(error);
 }
@@ -130,8 +243,8 @@ namespace {
 void Bump(std::atomic<uint64_t>& c) { c.fetch_add(1, std::memory_order_relaxed); }
 }  // namespace
 
-void ForceSafety::Step(const double position_m[3], bool pose_ok, const LocalModel* model,
-                       int64_t now_us, SafetyOutput* out) {
+void ForceSafety::Step(const double position_m[3], const double orientation[4], bool pose_ok,
+                       const LocalModel* model, int64_t now_us, SafetyOutput* out) {
   *out = SafetyOutput{};
   // Elapsed time drives the fade (a stalled thread must not freeze the fade).
   double dt_s = limits_.tick_period_s;
@@ -169,6 +282,10 @@ void ForceSafety::Step(const double position_m[3], bool pose_ok, const LocalMode
     if (pose_good && r2 > limits_.workspace_radius_m * limits_.workspace_radius_m) {
       pose_good = false;
     }
+    // The orientation is part of the pose where the model uses it.
+    if (pose_good && has_orientation_ && orientation != nullptr) {
+      for (int k = 0; k < 4; ++k) pose_good = pose_good && std::isfinite(orientation[k]);
+    }
   }
   if (!pose_good) {
     out->pose_rejected = true;
@@ -185,18 +302,20 @@ void ForceSafety::Step(const double position_m[3], bool pose_ok, const LocalMode
       last_force_n_[k] *= keep;
       out->force_n[k] = last_force_n_[k];
     }
+    // The torque the same way, at its own slew limit.
+    double t[3] = {0.0, 0.0, 0.0};
+    if (torque_output_) RenderTorque(t, out);
     return;
   }
 
-  // F = f0 + K (u - u0), scaled by the fade gain.
+  // The local model, scaled by the fade gain.
   double f[3] = {0.0, 0.0, 0.0};
+  double t[3] = {0.0, 0.0, 0.0};
   if (model != nullptr && gain_ > 0.0) {
-    double du[3];
-    for (int k = 0; k < 3; ++k) du[k] = position_m[k] - model->u0_m[k];
-    for (int i = 0; i < 3; ++i) {
-      double fi = model->f0_n[i];
-      for (int j = 0; j < 3; ++j) fi += model->K_n_per_m[i][j] * du[j];
-      f[i] = gain_ * fi;
+    EvaluateLocalModel(*model, position_m, has_orientation_ ? orientation : nullptr, f, t);
+    for (int k = 0; k < 3; ++k) {
+      f[k] *= gain_;
+      t[k] *= gain_;
     }
   }
 
@@ -245,18 +364,44 @@ void ForceSafety::Step(const double position_m[3], bool pose_ok, const LocalMode
     max_force_n_.store(norm, std::memory_order_relaxed);
   }
 
-  // Grip torque: constant over the model (force_model_t has no torque stiffness), faded
-  // with the force and bounded.
-  if (has_orientation_ && model != nullptr && model->has_torque) {
-    double t[3], tn2 = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      t[k] = gain_ * model->torque0_nm[k];
-      tn2 += t[k] * t[k];
-    }
-    if (!std::isfinite(tn2)) tn2 = 0.0, t[0] = t[1] = t[2] = 0.0;
-    const double tn = std::sqrt(tn2);
-    const double s = tn > limits_.max_torque_nm ? limits_.max_torque_nm / tn : 1.0;
-    for (int k = 0; k < 3; ++k) out->torque_nm[k] = s * t[k];
+  if (torque_output_) RenderTorque(t, out);
+}
+
+void ForceSafety::RenderTorque(double t[3], SafetyOutput* out) {
+  // Non-finite (an overflow of τ0 + K6 d): aim at zero, through the slew limit.
+  double tn2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+  if (!std::isfinite(tn2)) {
+    t[0] = t[1] = t[2] = 0.0;
+    tn2 = 0.0;
+  }
+  const double tn = std::sqrt(tn2);
+  if (tn > limits_.max_torque_nm) {
+    const double s = limits_.max_torque_nm / tn;
+    for (int k = 0; k < 3; ++k) t[k] *= s;
+    out->torque_clamped = true;
+    Bump(counters_.torque_clamps);
+  }
+  const double max_step = limits_.max_torque_rate_nm_per_s * limits_.tick_period_s;
+  double d[3], dn2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    d[k] = t[k] - last_torque_nm_[k];
+    dn2 += d[k] * d[k];
+  }
+  if (dn2 > max_step * max_step) {
+    const double s = max_step / std::sqrt(dn2);
+    for (int k = 0; k < 3; ++k) t[k] = last_torque_nm_[k] + s * d[k];
+    out->torque_slew_limited = true;
+    Bump(counters_.torque_slew_limits);
+  }
+  bool finite = true;
+  for (int k = 0; k < 3; ++k) finite = finite && std::isfinite(t[k]);
+  if (!finite) {
+    Bump(counters_.nonfinite_outputs);
+    for (int k = 0; k < 3; ++k) t[k] = 0.0;
+  }
+  for (int k = 0; k < 3; ++k) {
+    out->torque_nm[k] = t[k];
+    last_torque_nm_[k] = t[k];
   }
 }
 

@@ -1,10 +1,12 @@
 #include "scripted_path.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 #include "messages/pose_mapping.h"
+#include "numeric/so3.h"
 #include "scene/input_file.h"
 
 namespace snapthread::device {
@@ -15,30 +17,50 @@ constexpr std::size_t kMaxPathCsvBytes = std::size_t{16} << 20;
 }  // namespace
 
 ScriptedPath::ScriptedPath(std::vector<std::array<double, 3>> waypoints_m, double speed_m_per_s)
-    : waypoints_(std::move(waypoints_m)), speed_m_per_s_(speed_m_per_s) {
+    : ScriptedPath(waypoints_m, std::vector<std::array<double, 3>>(waypoints_m.size(), {0.0, 0.0, 0.0}),
+                   speed_m_per_s, 1.0) {}
+
+ScriptedPath::ScriptedPath(std::vector<std::array<double, 3>> waypoints_m,
+                           std::vector<std::array<double, 3>> rotations, double speed_m_per_s,
+                           double angular_speed_rad_per_s)
+    : waypoints_(std::move(waypoints_m)),
+      rotations_(std::move(rotations)),
+      speed_m_per_s_(speed_m_per_s),
+      angular_speed_rad_per_s_(angular_speed_rad_per_s) {
   if (waypoints_.empty()) throw std::invalid_argument("scripted path: no waypoints");
+  if (rotations_.size() != waypoints_.size())
+    throw std::invalid_argument("scripted path: one rotation per waypoint");
   if (!(speed_m_per_s > 0.0) || !std::isfinite(speed_m_per_s)) {
     throw std::invalid_argument("scripted path: speed must be positive");
   }
-  cumulative_m_.push_back(0.0);
+  if (!(angular_speed_rad_per_s > 0.0) || !std::isfinite(angular_speed_rad_per_s)) {
+    throw std::invalid_argument("scripted path: angular speed must be positive");
+  }
+  for (size_t i = 0; i < waypoints_.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(waypoints_[i][k]) || !std::isfinite(rotations_[i][k]))
+        throw std::invalid_argument("scripted path: non-finite waypoint");
+    }
+  }
+  cumulative_s_.push_back(0.0);
   for (size_t i = 1; i < waypoints_.size(); ++i) {
-    double d2 = 0.0;
+    double d2 = 0.0, a2 = 0.0;
     for (int k = 0; k < 3; ++k) {
       const double d = waypoints_[i][k] - waypoints_[i - 1][k];
+      const double a = rotations_[i][k] - rotations_[i - 1][k];
       d2 += d * d;
+      a2 += a * a;
     }
-    cumulative_m_.push_back(cumulative_m_.back() + std::sqrt(d2));
+    total_length_m_ += std::sqrt(d2);
+    cumulative_s_.push_back(cumulative_s_.back() +
+                            std::max(std::sqrt(d2) / speed_m_per_s_, std::sqrt(a2) / angular_speed_rad_per_s_));
   }
-  for (const auto& w : waypoints_) {
-    for (double c : w) {
-      if (!std::isfinite(c)) throw std::invalid_argument("scripted path: non-finite waypoint");
-    }
-  }
-  total_length_m_ = cumulative_m_.back();
+  total_time_s_ = cumulative_s_.back();
 }
 
-ScriptedPath ScriptedPath::FromScene(const Scene& scene, double speed_m_per_s, int grasp) {
-  std::vector<std::array<double, 3>> pts;
+ScriptedPath ScriptedPath::FromScene(const Scene& scene, double speed_m_per_s, int grasp,
+                                     double angular_speed_rad_per_s) {
+  std::vector<std::array<double, 3>> pts, rotations;
   const DeviceMapping mapping = GraspDeviceMapping(scene, grasp);
   const int m = scene.grasp_layout.NumControls();
   const int offset = grasp > 0 && grasp < static_cast<int>(scene.grasps.size()) ? scene.grasps[grasp].offset : 0;
@@ -46,13 +68,21 @@ ScriptedPath ScriptedPath::FromScene(const Scene& scene, double speed_m_per_s, i
     const Vec control = controls.size() >= offset + m ? Vec(controls.segment(offset, m)) : controls;
     const Eigen::Vector3d p = messages::ControlsToPosition(mapping, scene.grasp_layout, control);
     pts.push_back({p[0], p[1], p[2]});
+    // The rotation vector as the pose mapping sends it back (exp of it: the device's
+    // rotation from rest); kept as the path's own value so whole turns accumulate.
+    const int dim = scene.grasp_layout.spatial_dimension;
+    std::array<double, 3> r = {0.0, 0.0, 0.0};
+    if (scene.grasp_layout.grip_rotation && control.size() >= dim + 3) {
+      for (int k = 0; k < 3; ++k) r[k] = control[dim + k];
+    }
+    rotations.push_back(r);
   };
   if (scene.path.empty()) {
     add(scene.grasp_start);
   } else {
     for (const Vec& p : scene.path) add(p);
   }
-  return ScriptedPath(std::move(pts), speed_m_per_s);
+  return ScriptedPath(std::move(pts), std::move(rotations), speed_m_per_s, angular_speed_rad_per_s);
 }
 
 ScriptedPath ScriptedPath::FromCsv(const std::string& path, double speed_m_per_s) {
@@ -96,28 +126,40 @@ ScriptedPath ScriptedPath::FromCsv(const std::string& path, double speed_m_per_s
 }
 
 void ScriptedPath::Evaluate(double t_s, double position_m[3], double velocity_m_per_s[3]) const {
+  double orientation[4];
+  Evaluate(t_s, position_m, velocity_m_per_s, orientation);
+}
+
+void ScriptedPath::Evaluate(double t_s, double position_m[3], double velocity_m_per_s[3],
+                            double orientation[4]) const {
+  double r[3];
   for (int k = 0; k < 3; ++k) {
     position_m[k] = waypoints_.front()[k];
     velocity_m_per_s[k] = 0.0;
+    r[k] = rotations_.front()[k];
   }
-  if (waypoints_.size() < 2 || total_length_m_ <= 0.0 || !(t_s >= 0.0)) return;
-  // Back and forth: the arc-length coordinate is a triangle wave of period 2L/v.
-  const double period_m = 2.0 * total_length_m_;
-  double s = std::fmod(t_s * speed_m_per_s_, period_m);
-  double direction = 1.0;
-  if (s > total_length_m_) {
-    s = period_m - s;
-    direction = -1.0;
+  if (waypoints_.size() >= 2 && total_time_s_ > 0.0 && t_s >= 0.0) {
+    // Back and forth: the time along the path is a triangle wave of period 2T.
+    const double period_s = 2.0 * total_time_s_;
+    double s = std::fmod(t_s, period_s);
+    double direction = 1.0;
+    if (s > total_time_s_) {
+      s = period_s - s;
+      direction = -1.0;
+    }
+    size_t i = 1;
+    while (i + 1 < cumulative_s_.size() && cumulative_s_[i] < s) ++i;
+    const double seg = cumulative_s_[i] - cumulative_s_[i - 1];
+    const double a = seg > 0.0 ? (s - cumulative_s_[i - 1]) / seg : 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = waypoints_[i][k] - waypoints_[i - 1][k];
+      position_m[k] = waypoints_[i - 1][k] + a * d;
+      velocity_m_per_s[k] = seg > 0.0 ? direction * d / seg : 0.0;
+      r[k] = rotations_[i - 1][k] + a * (rotations_[i][k] - rotations_[i - 1][k]);
+    }
   }
-  size_t i = 1;
-  while (i + 1 < cumulative_m_.size() && cumulative_m_[i] < s) ++i;
-  const double seg = cumulative_m_[i] - cumulative_m_[i - 1];
-  const double a = seg > 0.0 ? (s - cumulative_m_[i - 1]) / seg : 0.0;
-  for (int k = 0; k < 3; ++k) {
-    const double d = waypoints_[i][k] - waypoints_[i - 1][k];
-    position_m[k] = waypoints_[i - 1][k] + a * d;
-    velocity_m_per_s[k] = seg > 0.0 ? direction * speed_m_per_s_ * d / seg : 0.0;
-  }
+  const Eigen::Vector4d q = so3::ExpQuaternion(Eigen::Vector3d(r[0], r[1], r[2]));
+  for (int k = 0; k < 4; ++k) orientation[k] = q[k];
 }
 
 double ScriptedPath::max_radius_m() const {

@@ -34,7 +34,7 @@ void ServoTick::Tick(int64_t now_us, int64_t lateness_us) {
 
   const LocalModel* model = models_->Latest();  // wait-free
   if (snap_ahead_ != nullptr && read_ok) model = snap_ahead_->Select(model, state_.position_m, pose_seq_);
-  safety_->Step(state_.position_m, read_ok, model, now_us, &last_);
+  safety_->Step(state_.position_m, state_.orientation, read_ok, model, now_us, &last_);
   if (!device_->Command(last_.force_n, last_.torque_nm)) {
     counters_.command_failures.fetch_add(1, std::memory_order_relaxed);
   }
@@ -57,7 +57,9 @@ void ServoTick::Tick(int64_t now_us, int64_t lateness_us) {
     for (int k = 0; k < 3; ++k) {
       r.position_m[k] = state_.position_m[k];
       r.force_n[k] = last_.force_n[k];
+      r.torque_nm[k] = last_.torque_nm[k];
     }
+    for (int k = 0; k < 4; ++k) r.orientation[k] = state_.orientation[k];
     r.model_age_ms = last_.model_age_ms;
     r.model_status = last_.model_status;
     r.clamped = last_.clamped;

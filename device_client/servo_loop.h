@@ -35,6 +35,8 @@ struct TraceRow {
   int64_t tick = 0;
   double position_m[3] = {0.0, 0.0, 0.0};
   double force_n[3] = {0.0, 0.0, 0.0};
+  double orientation[4] = {1.0, 0.0, 0.0, 0.0};  // (w, x, y, z) as read
+  double torque_nm[3] = {0.0, 0.0, 0.0};         // commanded (0 without torque output)
   double model_age_ms = -1.0;
   int8_t model_status = -1;
   bool clamped = false;

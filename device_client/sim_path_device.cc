@@ -11,7 +11,11 @@ SimPathDevice::SimPathDevice(ScriptedPath path, MicrosClock clock)
   caps_.max_linear_damping_n_per_m_per_s = 20.0;
   caps_.workspace_radius_m = 0.25;
   caps_.max_velocity_m_per_s = 2.0;
-  caps_.has_orientation = false;
+  // It follows the path's orientation (a rod scene's roll) and keeps the commanded
+  // torque (last_torque_nm) as a real wrist would render it: a torque-output device.
+  caps_.has_orientation = true;
+  caps_.has_torque_output = true;
+  caps_.max_torque_nm = 1.0;
 }
 
 bool SimPathDevice::Open(std::string* error) {
@@ -29,21 +33,23 @@ bool SimPathDevice::Read(DeviceState* state) {
   const int64_t now = clock_();
   if (start_us_ < 0) start_us_ = now;
   path_.Evaluate(1e-6 * static_cast<double>(now - start_us_), state->position_m,
-                 state->velocity_m_per_s);
-  state->orientation[0] = 1.0;
-  state->orientation[1] = state->orientation[2] = state->orientation[3] = 0.0;
+                 state->velocity_m_per_s, state->orientation);
   state->buttons = 1;  // the scripted hand always holds the grasp
   return true;
 }
 
-bool SimPathDevice::Command(const double force_n[3], const double /*torque_nm*/[3]) {
+bool SimPathDevice::Command(const double force_n[3], const double torque_nm[3]) {
   if (!open_) return false;
-  for (int k = 0; k < 3; ++k) last_force_n_[k] = force_n[k];
+  for (int k = 0; k < 3; ++k) {
+    last_force_n_[k] = force_n[k];
+    last_torque_nm_[k] = torque_nm[k];
+  }
   return true;
 }
 
 void SimPathDevice::Close() {
   for (double& f : last_force_n_) f = 0.0;
+  for (double& t : last_torque_nm_) t = 0.0;
   open_ = false;
 }
 

@@ -1,5 +1,7 @@
-// sim-path backend: the grasp follows a scripted path exactly and ignores the commanded
-// force. Drives the server through a scene's snaps without hardware (demos, tests).
+// sim-path backend: the grasp follows a scripted path exactly (position and
+// orientation) and ignores the commanded force and torque, keeping the last of each.
+// Drives the server through a scene's snaps without hardware (demos, tests); it counts
+// as a torque-output device so the torque half of the servo is exercised.
 #pragma once
 
 #include <cstdint>
@@ -22,6 +24,8 @@ class SimPathDevice final : public HapticDevice {
 
   // The force of the last Command (what a real device would have rendered), newtons.
   const double* last_force_n() const { return last_force_n_; }
+  // The torque of the last Command, newton metres.
+  const double* last_torque_nm() const { return last_torque_nm_; }
 
  private:
   ScriptedPath path_;
@@ -30,6 +34,7 @@ class SimPathDevice final : public HapticDevice {
   int64_t start_us_ = -1;  // time of the first Read
   bool open_ = false;
   double last_force_n_[3] = {0.0, 0.0, 0.0};
+  double last_torque_nm_[3] = {0.0, 0.0, 0.0};
 };
 
 }  // namespace snapthread::device

@@ -17,7 +17,9 @@ VirtualHandDevice::VirtualHandDevice(ScriptedPath path, VirtualHandParams params
   caps_.max_linear_damping_n_per_m_per_s = 10.0;
   caps_.workspace_radius_m = 0.25;
   caps_.max_velocity_m_per_s = 2.0;
-  caps_.has_orientation = false;
+  // The hand turns as the path says (no rotational dynamics: it renders no torque).
+  caps_.has_orientation = true;
+  caps_.has_torque_output = false;
 }
 
 bool VirtualHandDevice::Open(std::string* error) {
@@ -68,8 +70,8 @@ bool VirtualHandDevice::Read(DeviceState* state) {
     state->position_m[k] = x_[k];
     state->velocity_m_per_s[k] = v_[k];
   }
-  state->orientation[0] = 1.0;
-  state->orientation[1] = state->orientation[2] = state->orientation[3] = 0.0;
+  double target[3], target_v[3];
+  path_.Evaluate(1e-6 * static_cast<double>(now - start_us_), target, target_v, state->orientation);
   state->buttons = 1;
   return true;
 }

@@ -2,6 +2,8 @@
 // the scripted path by a spring with near-critical damping and pushed by the rendered
 // force: it closes the haptic loop, so a force model that would be unstable on a real
 // device (negative stiffness, too stiff for the tick) shows up as oscillation here.
+// The hand's orientation is the path's (a rod scene's roll), without dynamics: it senses
+// orientation but renders no torque.
 #pragma once
 
 #include <cstdint>

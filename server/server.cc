@@ -333,7 +333,8 @@ void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
   const Scene& scene = session_->scene;
   // Each pose moves its own grasp (grasp_poses.h); the others keep their controls.
   Vec u = tracker.control();
-  const std::vector<int> grasp_of = ApplyGraspPoses(scene, session_->rest_direction, poses, &u);
+  Vec renamed;
+  const std::vector<int> grasp_of = ApplyGraspPoses(scene, session_->rest_direction, poses, &u, &renamed);
   bool any = false;
   for (size_t k = 0; k < poses.size(); ++k) {
     if (grasp_of[k] >= 0) {
@@ -358,6 +359,8 @@ void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
         break;
       }
     }
+    // A grasp's rotation vector moved to another name of its rotation (grasp_poses.h).
+    if (!switched_ && renamed != tracker.control()) tracker.RelabelControls(renamed);
     result = &tracker.Update(u);
   } catch (const std::exception& e) {
     if (ShouldLog(&last_solve_error_log_us_)) {
@@ -406,6 +409,7 @@ void Server::PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, 
     in.grasp_offset = scene.grasps[grasp].offset;
     in.grasp_controls = scene.grasp_layout.NumControls();
   }
+  in.layout = &scene.grasp_layout;
   in.device_seq = pose.state.seq;
   in.device_utime = pose.state.utime;
   in.server_receive_utime = pose.receive_utime;
@@ -424,7 +428,7 @@ void Server::PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, 
     msg = BuildForceModel(ForceModelInputs{in.mapping, in.model, in.u, Eigen::Vector3d::Zero(),
                                            nullptr, in.device_seq, in.device_utime,
                                            in.server_receive_utime, 0.0, in.seq, in.utime,
-                                           in.grasp_offset, in.grasp_controls});
+                                           in.grasp_offset, in.grasp_controls, in.layout});
   }
   if (session_->fold) session_->fold->Fill(&msg);
   msg.grasp = scene.grasps.empty() ? std::string() : scene.grasps[grasp].name;

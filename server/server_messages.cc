@@ -8,6 +8,7 @@
 #include "messages/pose_mapping.h"
 #include "messages/validate.h"
 #include "shape_frames.h"
+#include "server_wrench.h"
 
 namespace snapthread::server {
 namespace {
@@ -30,6 +31,12 @@ void ZeroForceModel(force_model_t* m) {
     for (int j = 0; j < 3; ++j) m->K[i][j] = 0.0;
   }
   m->has_torque = 0;
+  m->has_wrench = 0;
+  m->q0[0] = 1.0;
+  m->q0[1] = m->q0[2] = m->q0[3] = 0.0;
+  for (auto& row : m->K6) {
+    for (double& k : row) k = 0.0;
+  }
 }
 
 }  // namespace
@@ -101,7 +108,26 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
     m.f0[2] = -k_plane * (m.u0[2] - messages::PlanarZ0(map));
     m.K[2][2] = -k_plane;
   }
-  if (gnu >= dim + 3 && dim == 3) {
+  const bool rotation = in.layout != nullptr && in.layout->grip_rotation;
+  const bool grip = in.layout != nullptr ? in.layout->grip_direction : gnu >= dim + 3;
+  if (rotation && dim == 3 && gnu >= 6) {
+    // The rod's grasp u = (p, φ): the wrench in the pose chart (server_wrench.h). Device
+    // units: forces x N (n_per_f), torques x N/s (energy -> N m), position columns x s
+    // (per model length -> per metre), rotation columns in radians as they are.
+    GraspWrench w;
+    if (GraspWrenchFromControls(in.u.segment<6>(off), r.force.segment<6>(off),
+                                r.stiffness.block<6, 6>(off, off), &w)) {
+      const double row_scale[6] = {n_per_f, n_per_f, n_per_f, n_per_f / s, n_per_f / s, n_per_f / s};
+      const double col_scale[6] = {s, s, s, 1.0, 1.0, 1.0};
+      for (int i = 0; i < 6; ++i) {
+        for (int j = 0; j < 6; ++j) m.K6[i][j] = row_scale[i] * col_scale[j] * w.k6(i, j);
+      }
+      for (int i = 0; i < 3; ++i) m.torque0[i] = (n_per_f / s) * w.torque[i];
+      for (int i = 0; i < 4; ++i) m.q0[i] = w.q0[i];
+      m.has_torque = 1;
+      m.has_wrench = 1;
+    }
+  } else if (grip && gnu >= dim + 3 && dim == 3) {
     // Grip direction d = u[3:6] (unit): the generalised force F_d = -E_d gives the torque
     // on the grip tau = d x F_d (a rotation w moves d by w x d, dE = w . (d x E_d)).
     // F_d is in model energy units = model force x model length: N / (units per metre).
@@ -152,7 +178,16 @@ thread_shape_t BuildShape(const ShapeInputs& in) {
   // The rod's material frames and twist (shape_frames.h); none for other models.
   if (nodes.cols() > 0) FillShapeFrames(model, in.x, in.u, &msg);
   for (int i = 0; i < dim && i < in.u.size(); ++i) msg.grasp[i] = in.u[i];
-  if (dim == 3 && in.u.size() >= 6) {
+  if (msg.num_frames > 0 && nodes.cols() >= 2) {
+    // The rod: u[3:6] is a rotation vector φ, not a direction. The grip direction is
+    // R(u) e_x, the held edge's tangent: x_n - x_{n-1} for the grasp of edge n-1, or,
+    // when the first grasp holds edge 0 (12 controls; msg.grasp is that one), x_1 - x_0.
+    const Eigen::Index last = nodes.cols() - 1;
+    const Eigen::Vector3d d = (in.u.size() >= 12 ? Eigen::Vector3d(nodes.col(1) - nodes.col(0))
+                                                 : Eigen::Vector3d(nodes.col(last) - nodes.col(last - 1)))
+                                  .normalized();
+    for (int i = 0; i < 3; ++i) msg.grip_direction[i] = Finite(d[i]) ? d[i] : 0.0;
+  } else if (dim == 3 && in.u.size() >= 6) {
     const Eigen::Vector3d d = in.u.segment<3>(3).normalized();
     for (int i = 0; i < 3; ++i) msg.grip_direction[i] = Finite(d[i]) ? d[i] : 0.0;
   }

@@ -50,6 +50,11 @@ struct ForceModelInputs {
   // predictor keeps the cross terms; the device gets its own block.
   int grasp_offset = 0;
   int grasp_controls = 0;
+  // The controls of one grasp (Scene::grasp_layout). A grip direction adds the torque on
+  // the grip; a full orientation (the rod) adds the wrench: torque0, q0 and K6 in the
+  // pose chart (server_wrench.h). nullptr: a grip direction when the grasp has 3
+  // controls more than its position (the layouts before the rod).
+  const GraspLayout* layout = nullptr;
 };
 force_model_t BuildForceModel(const ForceModelInputs& in);
 

@@ -5,6 +5,8 @@
 
 #include <Eigen/Geometry>
 
+#include "numeric/so3.h"
+
 namespace snapthread::messages {
 namespace {
 
@@ -60,6 +62,12 @@ Vec PoseToControls(const DeviceMapping& mapping, const GraspLayout& layout,
   if (layout.grip_direction && u.size() >= dim + 3) {
     u.segment<3>(dim) = GripDirection(quaternion_wxyz, rest_direction);
   }
+  // A full orientation: u = (X, Y, Z, φ), exp([φ]×) = R(q) (the grasp turns from the
+  // scene's start by the device's rotation from rest), |φ| <= π.
+  if (layout.grip_rotation && u.size() >= dim + 3) {
+    u.segment<3>(dim) = so3::LogQuaternion(quaternion_wxyz[0], quaternion_wxyz[1],
+                                           quaternion_wxyz[2], quaternion_wxyz[3]);
+  }
   return u;
 }
 
@@ -70,6 +78,14 @@ Eigen::Vector3d ControlsToPosition(const DeviceMapping& mapping, const GraspLayo
   model_point[2] = 0.0;  // planar layouts: the model plane z_model = 0 (PlanarZ0)
   for (int i = 0; i < dim && i < u.size(); ++i) model_point[i] = u[i];
   return ModelPointToDevice(mapping, model_point);
+}
+
+Eigen::Vector4d ControlsToOrientation(const GraspLayout& layout, const Vec& u) {
+  const int dim = PositionalControls(layout);
+  if (!layout.grip_rotation || u.size() < dim + 3) return Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
+  const Eigen::Vector3d phi = u.segment<3>(dim);
+  if (!phi.allFinite()) return Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
+  return so3::ExpQuaternion(phi);
 }
 
 double PlanarZ0(const DeviceMapping& mapping) {

@@ -10,9 +10,14 @@
 //    (lcmtypes/device_state_t.lcm: R * (1, 0, 0)), expressed in the scene: the device's
 //    rest orientation holds the grip the way the scene starts (grasp.direction),
 //    d = R(q) d_start. This is R(q) (1, 0, 0) exactly when the scene starts along +x, and
-//    it lets devices that sense no orientation (they report the identity: sim-path,
-//    virtual-hand, 3-DOF devices) hold the scene's grip instead of turning it to +x, as
+//    it lets devices that sense no orientation (they report the identity; so do sim-path
+//    and virtual-hand outside rod scenes) hold the scene's grip instead of turning it to +x, as
 //    model_origin does for positions.
+//  * a grasp that holds its full orientation (GraspLayout::grip_rotation, the rod):
+//    u = (X, Y, Z, φ) with exp([φ]×) = R(q): the device at rest holds the scene's start
+//    orientation, and the grasp turns by the device's rotation from rest (both in the
+//    scene's frame, which the position mapping does not rotate). |φ| <= π here; the
+//    server keeps φ continuous across half turns (server/grasp_poses.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -47,6 +52,11 @@ Vec PoseToControls(const DeviceMapping& mapping, const GraspLayout& layout,
 // and the reference computations.
 Eigen::Vector3d ControlsToPosition(const DeviceMapping& mapping, const GraspLayout& layout,
                                    const Vec& u);
+
+// The device orientation (w, x, y, z) that maps to the rotation controls of u (inverse
+// of PoseToControls for grip_rotation layouts: exp([φ]×) as a quaternion; identity for
+// other layouts). Used by the scripted paths, so a rod scene's path rolls the grasp.
+Eigen::Vector4d ControlsToOrientation(const GraspLayout& layout, const Vec& u);
 
 // Device z (metres) of the model plane z_model = 0 for planar layouts:
 // z_model = origin_z + scale * z  =>  z0 = -origin_z / scale.

@@ -89,6 +89,15 @@ const TrackResult& EquilibriumTracker::Resume(const Vec& x, const Vec& u) {
   return SolveAndStartHere();
 }
 
+void EquilibriumTracker::RelabelControls(const Vec& u) {
+  if (u.size() != model_->NumControls() || !u.allFinite())
+    throw std::invalid_argument("EquilibriumTracker::RelabelControls: bad controls");
+  u_ = u;
+  u_prev_ = u;
+  have_prev_ = false;
+  have_tangent_ = false;
+}
+
 const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   if (u.size() != model_->NumControls())
     throw std::invalid_argument("EquilibriumTracker::Update: control size mismatch");

@@ -43,6 +43,14 @@ class EquilibriumTracker {
   // One control update: predictor, solve within the budget, force and stiffness.
   const TrackResult& Update(const Vec& u);
 
+  // The same controls under another name: u must give the model the same energy as
+  // control() does (a grasp's rotation vector moved to another representative of its
+  // rotation, server/grasp_poses.h). The state, the model's lagged data and the last
+  // result stay; the predictor starts again here (its tangent and secant are in the old
+  // names, so the next Update starts from the current state). Throws
+  // std::invalid_argument for a size that does not match or a non-finite u.
+  void RelabelControls(const Vec& u);
+
   // Switch method / budget / cutoff without losing the state.
   void SetOptions(const SolverOptions& options);
 

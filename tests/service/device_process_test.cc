@@ -301,7 +301,8 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
 
   std::string header;
   const auto rows = ReadTrace(dir + "/trace.csv", &header);
-  EXPECT_EQ(header, "t_s,seq,x_m,y_m,z_m,fx_n,fy_n,fz_n,model_age_ms,model_status,clamped,fading");
+  EXPECT_EQ(header, "t_s,seq,x_m,y_m,z_m,fx_n,fy_n,fz_n,model_age_ms,model_status,clamped,fading,"
+                    "qw,qx,qy,qz,tx_nm,ty_nm,tz_nm");
   ASSERT_GT(rows.size(), 1000u);
 
   // Spring law on every settled sample: a fresh model, and no stale tick (fading or no

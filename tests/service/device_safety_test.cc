@@ -366,7 +366,7 @@ TEST_F(DeviceForceSafetyTest, BadPosesFadeTheForceToZeroAtTheSlewLimit) {
 
 TEST_F(DeviceForceSafetyTest, FuzzOutputAlwaysFiniteAndBounded) {
   const SafetyLimits limits = TestLimits();
-  ForceSafety s(limits, true);
+  ForceSafety s(limits, true, true);
   std::mt19937_64 rng(12345);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::uniform_int_distribution<int> pick(0, 9);

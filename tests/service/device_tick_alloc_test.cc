@@ -7,6 +7,7 @@
 // receive and io steps run between the ticks.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -50,12 +51,28 @@ force_model_t SpringModel(int64_t seq) {
   return m;
 }
 
+// The same with a 6-DoF wrench (a rod's grasp): torque, q0 and K6.
+force_model_t WrenchModel(int64_t seq) {
+  force_model_t m = SpringModel(seq);
+  m.has_torque = 1;
+  m.has_wrench = 1;
+  m.torque0[0] = 0.001 * static_cast<double>(seq % 90);
+  m.q0[0] = std::sqrt(0.5);
+  m.q0[1] = std::sqrt(0.5);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m.K6[i][j] = m.K[i][j];
+    m.K6[3 + i][3 + i] = -0.02;
+  }
+  m.K6[1][5] = m.K6[5][1] = 0.01;
+  return m;
+}
+
 // Runs the ticks; returns the number of rejected poses.
-uint64_t RunTicks(HapticDevice* device, int ticks) {
+uint64_t RunTicks(HapticDevice* device, int ticks, bool wrench = false) {
   EXPECT_TRUE(device->Open(nullptr));
   SafetyLimits limits;
   limits.workspace_radius_m = 0.05;
-  ForceSafety safety(limits, device->capabilities().has_orientation);
+  ForceSafety safety(limits, device->capabilities().has_orientation, device->capabilities().has_torque_output);
   auto models = std::make_unique<ModelSlot>();
   auto poses = std::make_unique<PoseRing>();
   auto trace = std::make_unique<TraceRing>();
@@ -77,7 +94,8 @@ uint64_t RunTicks(HapticDevice* device, int ticks) {
     const bool silent = (i / 1000) % 3 == 2 && (i % 1000) < 300;
     if (i % 5 == 0 && !silent) {
       LocalModel m;
-      PrepareModel(SpringModel(++seq), g_now_us, limits, &m, nullptr);
+      ++seq;
+      PrepareModel(wrench ? WrenchModel(seq) : SpringModel(seq), g_now_us, limits, &m, nullptr);
       models->Write(m);
     }
     if (i % 100 == 0 && i < 1000) {
@@ -113,6 +131,14 @@ TEST(DeviceServoTickAllocationTest, SimPathTickNeverAllocatesIncludingOutOfWorks
   // The path leaves the 5 cm workspace: poses are rejected (zero force, not published).
   SimPathDevice sim(ScriptedPath({{-0.04, 0.0, 0.0}, {0.08, 0.0, 0.0}}, 0.05), &TestClock);
   EXPECT_GT(RunTicks(&sim, 10000), 1000u);
+}
+
+// A rolling hand (a rod scene's path) with 6-DoF models and the torque rendered.
+TEST(DeviceServoTickAllocationTest, SimPathWrenchTickNeverAllocates) {
+  SimPathDevice sim(ScriptedPath({{-0.02, 0.0, 0.0}, {0.02, 0.0, 0.0}}, {{0.0, 0.0, 0.0}, {9.0, 0.5, 0.0}},
+                                 0.05, 3.0),
+                    &TestClock);
+  RunTicks(&sim, 10000, true);
 }
 
 TEST(DeviceServoTickAllocationTest, DeviceClientTickNeverAllocates) {

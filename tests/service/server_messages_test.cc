@@ -296,6 +296,19 @@ TEST(ServerMessagesTest, RodShapeCarriesMaterialFramesAndTwistDensity) {
     for (int i = 0; i < 3; ++i) along += f[i] * (s.positions[j + 1][i] - s.positions[j][i]);
     EXPECT_NEAR(along, 0.0, 1e-12);
   }
+  // The grip direction is the held edge's tangent (+x here), not the rotation vector
+  // u[3:6] (which points along +x as well, so tilt the grasp to tell them apart).
+  EXPECT_NEAR(s.grip_direction[0], 1.0, 1e-12);
+  Vec tilted = u;
+  tilted.segment<3>(3) << 0.0, 0.0, 0.5;  // a yaw of 0.5 rad: tangent (cos 0.5, sin 0.5, 0)
+  in.u = tilted;
+  in.x = model->InitialState(tilted);
+  const thread_shape_t t = BuildShape(in);
+  EXPECT_NEAR(t.grip_direction[0], std::cos(0.5), 1e-9);
+  EXPECT_NEAR(t.grip_direction[1], std::sin(0.5), 1e-9);
+  EXPECT_NEAR(t.grip_direction[2], 0.0, 1e-9);
+  in.u = u;
+  in.x = model->InitialState(u);
   std::string why;
   EXPECT_TRUE(transport::Validate(s, &why)) << why;
   // A state that does not fit the model gets no frames (and no nodes).
