@@ -97,6 +97,11 @@ std::vector<Case> AllCases() {
     p.Set("contact_distance", 0.04);
     p.Set("contact_stiffness", 0.5);
     cases.push_back({std::string(model) + "_contact", p});
+    if (p.model == "rod") {
+      // No clamp: edge 0 held by a first grasp u[0..5], so pairs map through both.
+      p.Set("clamp", false);
+      cases.push_back({"rod_free_contact", p});
+    }
   }
   return cases;
 }
@@ -112,11 +117,13 @@ bool HasContact(const ModelParams& p) { return p.Has("contact") && p.Bool("conta
 // States of a contact case: the free nodes on a curling random walk of edge-length steps
 // (each direction turned by up to ~70 degrees from the last) from the clamp, kept when
 // every pair that may touch is apart by more than 2r + d̂/10 and at least two pairs are
-// active, one of them with the grasped end when `with_grasp` (E_u, E_xu, E_uu).
+// active; the first point has one with the grasped end (E_u, E_xu, E_uu), and without a
+// clamp the second one with the first grasp's edge 0 (its x_0, x_1 are controls).
 std::vector<Point> ContactPoints(const Model& m, const ModelParams& p, int count, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const bool rod = p.model == "rod";
+  const bool free = rod && p.Has("clamp") && !p.Bool("clamp");
   const int n = p.Integer("n");
   const double l = rod ? p.Number("length") / n : p.Number("segment_length");
   const double r = p.Number("radius"), dhat = p.Number("contact_distance");
@@ -137,8 +144,10 @@ std::vector<Point> ContactPoints(const Model& m, const ModelParams& p, int count
       const Eigen::Vector3d e = (nodes.col(n) - nodes.col(n - 1)).normalized();
       const Eigen::Vector3d axis = Eigen::Vector3d::UnitX().cross(e);
       const double angle = std::atan2(axis.norm(), e.x());
-      pt.u.head<3>() = nodes.col(n);
-      if (axis.norm() > 1e-12) pt.u.tail<3>() = angle * axis.normalized();
+      // Without a clamp the first grasp (u[0..5] = 0) holds edge 0 along +x at the origin.
+      const int end = free ? 6 : 0;
+      pt.u.segment<3>(end) = nodes.col(n);
+      if (axis.norm() > 1e-12) pt.u.segment<3>(end + 3) = angle * axis.normalized();
       pt.x = m.InitialState(pt.u);
       const auto& rm = dynamic_cast<const RodModel&>(m);
       for (int k = 2; k <= n - 2; ++k) pt.x.segment<3>(rm.NodeIndex(k)) = nodes.col(k);
@@ -150,14 +159,17 @@ std::vector<Point> ContactPoints(const Model& m, const ModelParams& p, int count
       for (int k = 2; k <= n - 1; ++k) pt.x.segment<3>(1 + 3 * (k - 2)) = nodes.col(k);
     }
     const std::vector<contact::ContactPoint> active = m.ActiveContacts(pt.x, pt.u);
-    int with_grasp = 0;
+    int with_grasp = 0, with_start = 0;
     bool apart = true;
     for (const auto& c : active) {
       apart = apart && c.distance > 2 * r + 0.1 * dhat;
       with_grasp += c.segment_b >= (rod ? n - 2 : n - 1) ? 1 : 0;
+      with_start += c.segment_a <= 1 ? 1 : 0;
     }
     const bool need_grasp = points.empty();
-    if (!apart || active.size() < 2 || (need_grasp && with_grasp == 0)) continue;
+    const bool need_start = free && points.size() == 1;
+    if (!apart || active.size() < 2 || (need_grasp && with_grasp == 0) || (need_start && with_start == 0))
+      continue;
     points.push_back(pt);
   }
   return points;
@@ -289,7 +301,7 @@ TEST_P(ModelDerivativeTest, SizesAndPatternAreConsistent) {
     EXPECT_EQ(m.NumControls(), GraspLayoutOf(p).grip_direction ? 6 : 3);
   } else if (p.model == "rod") {
     EXPECT_EQ(m.NumStates(), 4 * p.Integer("n") - 11);  // nodes 2..n-2 and angles 1..n-2
-    EXPECT_EQ(m.NumControls(), 6);
+    EXPECT_EQ(m.NumControls(), p.Has("clamp") && !p.Bool("clamp") ? 12 : 6);
   } else {
     EXPECT_EQ(m.NumStates(), 1);
     EXPECT_EQ(m.NumControls(), 2);
@@ -521,10 +533,12 @@ TEST_P(ModelDerivativeTest, NodesProbeAndInitialStateAreConsistent) {
     }
   } else if (p.model == "rod") {
     ASSERT_EQ(nodes.cols(), p.Integer("n") + 1);
-    EXPECT_EQ(nodes.col(0).norm(), 0.0);                                    // clamped at 0
-    EXPECT_EQ((nodes.col(p.Integer("n")) - pt.u.head<3>()).norm(), 0.0);  // held at the grasp
+    // Clamped at 0 (or, without a clamp, held there by the first grasp u[0..5] = 0).
+    EXPECT_EQ(nodes.col(0).norm(), 0.0);
+    const Eigen::Vector3d held = pt.u.segment<3>(m.NumControls() - 6);
+    EXPECT_EQ((nodes.col(p.Integer("n")) - held).norm(), 0.0);  // held at the grasp
     // Probe: the largest distance of a node from the clamp-grasp line.
-    const Eigen::Vector3d d = pt.u.head<3>().normalized();
+    const Eigen::Vector3d d = held.normalized();
     double probe = 0.0;
     for (int k = 0; k < nodes.cols(); ++k) {
       probe = std::max(probe, (nodes.col(k) - nodes.col(k).dot(d) * d).norm());

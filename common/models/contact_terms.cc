@@ -39,6 +39,7 @@ void ContactTerms::Register(const contact::ContactParams& params, int segments, 
   }
   pair_term_.assign(segments * segments, -1);
   pair_controls_.assign(segments * segments, 0);
+  pair_direct_.assign(segments * segments, 0);
   const int nx = assembly->NumStates(), nu = assembly->NumControls();
   for (int i = 0; i < segments; ++i) {
     for (int j = i + self_.MinIndexGap(); j < segments; ++j) {
@@ -52,12 +53,14 @@ void ContactTerms::Register(const contact::ContactParams& params, int segments, 
           controls = controls || nc.control >= 0;
         }
       }
+      const bool direct = count == 12;
       if (controls) {
         for (int c = 0; c < nu; ++c) vars[count++] = nx + c;
       }
       if (count > kMaxVars) throw std::logic_error("contact term with too many variables");
       pair_term_[i * segments + j] = assembly->AddTerm(vars, count);
       pair_controls_[i * segments + j] = controls ? 1 : 0;
+      pair_direct_[i * segments + j] = direct ? 1 : 0;
     }
   }
 }
@@ -73,6 +76,11 @@ void ContactTerms::ForEach(const Eigen::Matrix3Xd& nodes, const ControlMap* cmap
     const bool controls = pair_controls_[pair] != 0;
     if (controls_only && !controls) return;
     const int term = pair_term_[pair];
+    if (pair_direct_[pair] != 0) {
+      // Twelve state coordinates, in order: the pair's derivatives are the term's.
+      f(term, g12.data(), h12.data(), 12);
+      return;
+    }
     const int k = assembly_->TermSize(term);
     // y = C z: node coordinate r from term variable pos (state) or the control block.
     Eigen::Matrix<double, 12, kMaxVars> cm = Eigen::Matrix<double, 12, kMaxVars>::Zero();
@@ -105,62 +113,63 @@ void ContactTerms::ForEach(const Eigen::Matrix3Xd& nodes, const ControlMap* cmap
         }
       }
     }
-    f(term, ga, ha);
+    f(term, ga.data(), ha.data(), kMaxVars);
   });
   if (!feasible) {
     // Touching capsules: no finite derivative. Non-finite outputs make the solvers
     // restore their last good state and report it (model.h).
-    f(-1, LocalVec::Constant(std::numeric_limits<double>::quiet_NaN()), LocalMat());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    f(-1, &nan, &nan, 1);
   }
 }
 
 void ContactTerms::AddGradient(const Eigen::Matrix3Xd& nodes, double* g) const {
-  ForEach(nodes, nullptr, false, false, [&](int term, const LocalVec& lg, const LocalMat&) {
+  ForEach(nodes, nullptr, false, false, [&](int term, const double* lg, const double*, int) {
     if (term < 0) {
       g[0] = lg[0];
       return;
     }
-    assembly_->AddGradient(term, lg.data(), g);
+    assembly_->AddGradient(term, lg, g);
   });
 }
 
 void ContactTerms::AddHessian(const Eigen::Matrix3Xd& nodes, double* values) const {
-  ForEach(nodes, nullptr, true, false, [&](int term, const LocalVec& lg, const LocalMat& lh) {
+  ForEach(nodes, nullptr, true, false, [&](int term, const double* lg, const double* lh, int ld) {
     if (term < 0) {
       values[0] = lg[0];
       return;
     }
-    assembly_->AddHessian(term, lh.data(), kMaxVars, values);
+    assembly_->AddHessian(term, lh, ld, values);
   });
 }
 
 void ContactTerms::AddControlGradient(const Eigen::Matrix3Xd& nodes, const ControlMap& cmap, double* eu) const {
-  ForEach(nodes, &cmap, false, true, [&](int term, const LocalVec& lg, const LocalMat&) {
+  ForEach(nodes, &cmap, false, true, [&](int term, const double* lg, const double*, int) {
     if (term < 0) {
       eu[0] = lg[0];
       return;
     }
-    assembly_->AddControlGradient(term, lg.data(), eu);
+    assembly_->AddControlGradient(term, lg, eu);
   });
 }
 
 void ContactTerms::AddMixedHessian(const Eigen::Matrix3Xd& nodes, const ControlMap& cmap, Mat* exu) const {
-  ForEach(nodes, &cmap, true, true, [&](int term, const LocalVec& lg, const LocalMat& lh) {
+  ForEach(nodes, &cmap, true, true, [&](int term, const double* lg, const double* lh, int ld) {
     if (term < 0) {
       (*exu)(0, 0) = lg[0];
       return;
     }
-    assembly_->AddMixedHessian(term, lh.data(), kMaxVars, exu);
+    assembly_->AddMixedHessian(term, lh, ld, exu);
   });
 }
 
 void ContactTerms::AddControlHessian(const Eigen::Matrix3Xd& nodes, const ControlMap& cmap, Mat* euu) const {
-  ForEach(nodes, &cmap, true, true, [&](int term, const LocalVec& lg, const LocalMat& lh) {
+  ForEach(nodes, &cmap, true, true, [&](int term, const double* lg, const double* lh, int ld) {
     if (term < 0) {
       (*euu)(0, 0) = lg[0];
       return;
     }
-    assembly_->AddControlHessian(term, lh.data(), kMaxVars, euu);
+    assembly_->AddControlHessian(term, lh, ld, euu);
   });
 }
 

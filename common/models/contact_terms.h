@@ -28,14 +28,18 @@ contact::ContactParams ReadContactParams(const ModelParams& params);
 // Where a node coordinate comes from.
 struct NodeCoord {
   int state = -1;    // state index, or -1
-  int control = -1;  // row of ControlMap (0..5), or -1; neither: fixed
+  int control = -1;  // row of ControlMap (0..11), or -1; neither: fixed
 };
 
 // The controlled node coordinates as functions of u: rows of the Jacobian over u and,
-// per row, its Hessian over u.
+// per row, its Hessian over u. Up to 12 rows (a free rod's two grasped edges, four
+// nodes) over up to 12 controls (two full poses); a model fills the leading rows and its
+// NumControls() columns.
 struct ControlMap {
-  Eigen::Matrix<double, 6, 6> jac = Eigen::Matrix<double, 6, 6>::Zero();
-  std::array<Eigen::Matrix<double, 6, 6>, 6> hess{};
+  static constexpr int kRows = 12;
+  static constexpr int kControls = 12;
+  Eigen::Matrix<double, kRows, kControls> jac = Eigen::Matrix<double, kRows, kControls>::Zero();
+  std::array<Eigen::Matrix<double, kControls, kControls>, kRows> hess{};
 };
 
 class ContactTerms {
@@ -58,11 +62,14 @@ class ContactTerms {
   void AddControlHessian(const Eigen::Matrix3Xd& nodes, const ControlMap& cmap, Mat* euu) const;
 
  private:
-  static constexpr int kMaxVars = HessianAssembly::kMaxTermVars;
+  // A pair term: its 12 endpoint coordinates' state variables, and every control when
+  // one of them is grasped (12 + 12 at most).
+  static constexpr int kMaxVars = HessianAssembly::kMaxPairTermVars;
   using LocalVec = Eigen::Matrix<double, kMaxVars, 1>;
   using LocalMat = Eigen::Matrix<double, kMaxVars, kMaxVars>;
-  // Calls f(term, local gradient, local Hessian) for each active pair, in the term's
-  // variables; control-free pairs skipped when `controls_only`.
+  // Calls f(term, local gradient, local Hessian, leading dimension) for each active
+  // pair, in the term's variables; control-free pairs skipped when `controls_only`.
+  // After the pairs, f(-1, NaN, ...) once if some pair touches.
   template <class F>
   void ForEach(const Eigen::Matrix3Xd& nodes, const ControlMap* cmap, bool want_h, bool controls_only,
                F&& f) const;
@@ -73,6 +80,9 @@ class ContactTerms {
   std::vector<NodeCoord> coords_;  // 3 per node
   std::vector<int> pair_term_;     // i * segments + j -> term id
   std::vector<char> pair_controls_;
+  // The term's variables are the pair's 12 coordinates in order (all state variables):
+  // its local derivatives are the pair's own, no mapping.
+  std::vector<char> pair_direct_;
 };
 
 }  // namespace snapthread::internal

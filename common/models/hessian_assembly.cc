@@ -12,7 +12,7 @@ HessianAssembly::HessianAssembly(int num_states, int num_controls)
     : num_states_(num_states), num_controls_(num_controls) {}
 
 int HessianAssembly::AddTerm(const int* vars, int count) {
-  assert(count <= kMaxTermVars);
+  assert(count <= kMaxPairTermVars);
   for (int i = 0; i < count; ++i) {
     assert(vars[i] >= -1 && vars[i] < num_states_ + num_controls_);
     vars_.push_back(vars[i]);

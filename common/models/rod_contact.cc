@@ -1,6 +1,8 @@
 // Self-contact of the rod (issue 15): the barrier pairs of models/contact_terms.h on the
-// rod's nodes. Clamped nodes x_0, x_1 are fixed, x_{n-1} and x_n follow the grasp
-// u = (p, φ) (rows 0..2 and 3..5 of the grasp map), the others are state variables.
+// rod's nodes. Clamped nodes x_0, x_1 are fixed and x_{n-1}, x_n follow the grasp
+// u = (p, φ) (ControlMap rows 0..2 and 3..5); without a clamp x_0, x_1 follow the first
+// grasp u[0..5] (rows 0..2, 3..5) and x_{n-1}, x_n the second u[6..11] (rows 6..8,
+// 9..11). The other nodes are state variables.
 #include "models/rod_model.h"
 
 namespace snapthread {
@@ -11,9 +13,11 @@ void RodModel::RegisterContact() {
   contact_.Register(cp, n_, rest_,
                     [&](int k, int c) {
                       internal::NodeCoord nc;
-                      if (k == n_ - 1) nc.control = c;
-                      else if (k == n_) nc.control = 3 + c;
+                      const int end = p_.free_start ? 6 : 0;
+                      if (k == n_ - 1) nc.control = end + c;
+                      else if (k == n_) nc.control = end + 3 + c;
                       else if (k >= 2) nc.state = NodeIndex(k) + c;
+                      else if (p_.free_start) nc.control = 3 * k + c;  // x_0, x_1
                       return nc;
                     },
                     &assembly_);
@@ -25,13 +29,23 @@ const Eigen::Matrix3Xd& RodModel::ContactNodes(const Vec& x, const GraspMaps& gm
   return contact_nodes_;
 }
 
-internal::ControlMap RodModel::ContactControls(const GraspMaps& gms) {
-  const GraspMap& gm = gms.end;  // a clamped rod: the one grasp, of edge n-1
+internal::ControlMap RodModel::ContactControls(const GraspMaps& gms) const {
   internal::ControlMap m;
-  m.jac = gm.jac.topRows<6>();
-  for (int r = 0; r < 6; ++r) {
-    m.hess[r].setZero();
-    m.hess[r].bottomRightCorner<3, 3>() = gm.hess_phi[r];  // linear in p
+  for (auto& h : m.hess) h.setZero();
+  // One grasp's map (rows 0..2 the inner node, 3..5 the held one, over its (p, φ) at
+  // control column `col`) into the rows of its held node `held` and inner node `inner`.
+  auto put = [&](const GraspMap& gm, int held, int inner, int col) {
+    for (int c = 0; c < 3; ++c) {
+      m.jac.block<1, 6>(inner + c, col) = gm.jac.row(c);
+      m.jac.block<1, 6>(held + c, col) = gm.jac.row(3 + c);
+      m.hess[inner + c].block<3, 3>(col + 3, col + 3) = gm.hess_phi[c];  // linear in p
+    }
+  };
+  if (p_.free_start) {
+    put(gms.start, 0, 3, 0);  // x_0 held, x_1 inner: u[0..5]
+    put(gms.end, 9, 6, 6);    // x_n held, x_{n-1} inner: u[6..11]
+  } else {
+    put(gms.end, 3, 0, 0);
   }
   return m;
 }

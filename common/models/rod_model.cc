@@ -28,9 +28,6 @@ bool RodParams::IsValid(std::string* error) const {
   };
   if (n < 3) return fail("n must be at least 3 (the clamp and the grasp hold one edge each)");
   if (free_start && n < 5) return fail("n must be at least 5 without a clamp (two grasps)");
-  // Self-contact maps the grasped nodes through one grasp's controls (rod_contact.cc).
-  if (free_start && contact.enabled)
-    return fail("self-contact (params.contact) is not yet supported with clamp: false");
   if (!(length > 0.0) || !std::isfinite(length)) return fail("length must be positive");
   const double stiffnesses[] = {stretch_stiffness, bend_stiffness, bend_stiffness_2,
                                 twist_stiffness};

@@ -147,10 +147,10 @@ class RodModel final : public Model {
   void BuildTerms();
   // Self-contact (rod_contact.cc): pair terms registered after the elastic ones, node
   // positions into contact_nodes_, and the grasped nodes' map for E_u, E_xu, E_uu
-  // (a clamped rod only: with clamp false the model refuses contact).
+  // (one grasp's two nodes, or both grasps' four without a clamp).
   void RegisterContact();
   const Eigen::Matrix3Xd& ContactNodes(const Vec& x, const GraspMaps& gm) const;
-  static internal::ControlMap ContactControls(const GraspMaps& gm);
+  internal::ControlMap ContactControls(const GraspMaps& gm) const;
   GraspMaps Grasp(const Vec& u, bool derivatives, bool world_rotation = false) const;
   // The map of one grasp: the one of edge n-1 (at_start false) or of edge 0.
   GraspMap OneGrasp(const Vec& u, bool at_start, bool derivatives, bool world_rotation) const;
