@@ -450,6 +450,15 @@ TEST_P(ModelDerivativeTest, FusedEvaluationsEqualSeparateOnesBitForBit) {
     m.Hessian(pt.x, pt.u, &h2);  // over the previous values: still the same
     EXPECT_EQ(std::memcmp(h.valuePtr(), h2.valuePtr(), sizeof(double) * h.nonZeros()), 0) << "E_xx again";
 
+    // E with E_x and E_xx in one pass: Energy()'s value to the last bit.
+    Vec g3;
+    SparseMatrix h3 = m.HessianPattern();
+    const double e = m.Energy(pt.x, pt.u);
+    const double e3 = m.EnergyGradientAndHessian(pt.x, pt.u, &g3, &h3);
+    EXPECT_EQ(std::memcmp(&e, &e3, sizeof e), 0) << "E: " << e << " vs " << e3;
+    EXPECT_EQ(std::memcmp(g.data(), g3.data(), sizeof(double) * g.size()), 0) << "E_x with E";
+    EXPECT_EQ(std::memcmp(h.valuePtr(), h3.valuePtr(), sizeof(double) * h.nonZeros()), 0) << "E_xx with E";
+
     Vec eu, eu2;
     Mat exu, exu2, euu, euu2;
     m.ControlGradient(pt.x, pt.u, &eu);

@@ -93,7 +93,17 @@ void SolveBand(const double* data, int n, int b, double* v, int m, std::ptrdiff_
   // Rows 0 .. head-1 have a band cut off by the matrix' edge (every row without a
   // compile-time B); rows head .. n-1 have the full band of B.
   const int head = B > 0 ? std::min(B, n) : n;
-  for (int i = 0; i < head; ++i) {
+  // Leading rows where every right-hand side is zero stay zero in L y = b (each of their
+  // dot products is a sum of zeros): the forward sweep starts at the first non-zero.
+  // E_xu's columns are zero but for the few nodes next to the grasp, the chain's last.
+  int first = n;
+  for (int c = 0; c < m; ++c) {
+    const double* vc = v + c * stride;
+    int k = 0;
+    while (k < first && vc[k] == 0.0) ++k;
+    first = k;
+  }
+  for (int i = first; i < head; ++i) {
     const double* ri = data + static_cast<std::ptrdiff_t>(i) * ld;
     for (int c = 0; c < m; ++c) {
       double* vc = v + c * stride;
@@ -103,7 +113,7 @@ void SolveBand(const double* data, int n, int b, double* v, int m, std::ptrdiff_
     }
   }
   if constexpr (B > 0) {
-    for (int i = head; i < n; ++i) {
+    for (int i = std::max(head, first); i < n; ++i) {
       const double* ri = data + static_cast<std::ptrdiff_t>(i) * (B + 1);
       for (int c = 0; c < m; ++c) {
         double* xc = v + c * stride + (i - B);  // xc[B] is row i
@@ -255,6 +265,51 @@ LinearSolverStatus BandedLdlt::Factorize(const SparseMatrix& a) {
     }
   }
 
+  return FactorInPlace(scale);
+}
+
+double* BandedLdlt::AssemblyBand(int* bandwidth) {
+  if (pattern_.Empty()) return nullptr;
+  factorized_ = false;
+  if (bandwidth != nullptr) *bandwidth = bandwidth_;
+  return band_.data();
+}
+
+LinearSolverStatus BandedLdlt::FactorizeAssembled() {
+  factorized_ = false;
+  if (pattern_.Empty()) {
+    message_ = "banded: FactorizeAssembled() before a successful Analyze()";
+    return LinearSolverStatus::kInvalidInput;
+  }
+  double* data = band_.data();
+  for (const int slot : holes_) data[slot] = 0.0;
+  // max |a_ij| over the pattern's lower triangle, as Factorize() takes it (the holes are
+  // 0 and the slots outside the matrix, in the first b rows, are not the matrix').
+  const int n = n_;
+  const int b = bandwidth_;
+  const int ld = b + 1;
+  double scale = 0.0;
+  for (int i = 0; i < std::min(b, n); ++i) {
+    for (int j = std::max(0, i - b); j <= i; ++j) scale = std::max(scale, std::abs(data[i * ld + j - i + b]));
+  }
+  const double* rest = data + static_cast<std::ptrdiff_t>(std::min(b, n)) * ld;
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(n - std::min(b, n)) * ld;
+  // Four running maxima (the order of a max does not change it): independent chains
+  // the compiler can pair up, instead of one serial dependency through 27 k entries.
+  double m[4] = {scale, 0.0, 0.0, 0.0};
+  std::ptrdiff_t k = 0;
+  for (; k + 4 <= count; k += 4) {
+    for (int q = 0; q < 4; ++q) m[q] = std::max(m[q], std::abs(rest[k + q]));
+  }
+  for (; k < count; ++k) m[0] = std::max(m[0], std::abs(rest[k]));
+  scale = std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+  return FactorInPlace(scale);
+}
+
+LinearSolverStatus BandedLdlt::FactorInPlace(double scale) {
+  const int n = n_;
+  const int b = bandwidth_;
+  double* data = band_.data();
   double bad_pivot = 0.0;
   const int bad_row = ForBandwidth<FactorKernel>(
       b, data, n, b, internal::kSingularPivotTolerance * scale, &bad_pivot);
@@ -287,9 +342,14 @@ LinearSolverStatus BandedLdlt::SolveMany(const Mat& b_in, Mat* x) const {
     return LinearSolverStatus::kInvalidInput;
   }
   *x = b_in;  // no allocation when x already has B's size
-  // The right-hand sides share each pass over the factor (read once for all).
-  ForBandwidth<SolveKernel>(bandwidth_, band_.data(), n_, bandwidth_, x->data(), static_cast<int>(x->cols()),
-                            std::ptrdiff_t{n_});
+  // Column by column, each forward sweep from its first non-zero: E_xu's three columns
+  // at thread3d n = 1000 took 0.83 M instructions interleaved, 0.49 M this way
+  // (callgrind); the factor (27 k doubles there) stays in cache between the passes. The
+  // same operations per column either way, so the same bits.
+  for (int c = 0; c < x->cols(); ++c) {
+    ForBandwidth<SolveKernel>(bandwidth_, band_.data(), n_, bandwidth_, x->data() + c * std::ptrdiff_t{n_}, 1,
+                              std::ptrdiff_t{n_});
+  }
   return LinearSolverStatus::kSuccess;
 }
 

@@ -34,6 +34,12 @@ class BandedLdlt final : public SymmetricLinearSolver {
   LinearSolverStatus Solve(const Vec& b, Vec* x) const override;
   LinearSolverStatus SolveMany(const Mat& b, Mat* x) const override;
 
+  // The band itself (after Analyze()): the model writes A(i, j), i >= j, at
+  // data[i (b + 1) + j - i + b]; FactorizeAssembled() clears the slots outside the
+  // pattern (the last factor's fill-in) and factorises in place.
+  double* AssemblyBand(int* bandwidth) override;
+  LinearSolverStatus FactorizeAssembled() override;
+
   // Half-bandwidth max |i - j| of the analysed pattern (-1 before Analyze()).
   int HalfBandwidth() const { return bandwidth_; }
 
@@ -51,6 +57,9 @@ class BandedLdlt final : public SymmetricLinearSolver {
   std::vector<Scatter> scatter_;
   std::vector<int> holes_;  // band slots inside the matrix that the pattern leaves empty
   bool factorized_ = false;
+
+  // The factorisation of band_ as it stands (holes cleared), scale = max |a_ij|.
+  LinearSolverStatus FactorInPlace(double scale);
 };
 
 }  // namespace snapthread

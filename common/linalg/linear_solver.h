@@ -42,6 +42,18 @@ class SymmetricLinearSolver {
   // through two scratch vectors, sized on the first call).
   virtual LinearSolverStatus SolveMany(const Mat& b, Mat* x) const;
 
+  // Direct assembly (libigl's precompute / solve split taken one step further): a
+  // backend that factorises in band storage hands out that storage, a model writes the
+  // lower band of the matrix there (the layout of banded_ldlt.h; slots of the analysed
+  // pattern only), and FactorizeAssembled() factorises it in place — the same factor
+  // as Factorize() of the compressed matrix with those values, without the copy. Writing
+  // into it discards the last factorisation. nullptr (the default): no such storage.
+  virtual double* AssemblyBand(int* /*bandwidth*/) { return nullptr; }
+  virtual LinearSolverStatus FactorizeAssembled() {
+    message_ = std::string(Name()) + ": no direct assembly";
+    return LinearSolverStatus::kInvalidInput;
+  }
+
   // Inertia from the pivots of D in A = L D L^T (Sylvester's law of inertia): the
   // number of negative eigenvalues of A (valid after a successful Factorize()).
   // Every backend records both from its pivots in Factorize().

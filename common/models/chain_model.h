@@ -69,6 +69,43 @@ class ChainModel : public Model {
     Self().AddContactHessian(x, u, values);
   }
 
+  // The same pass adding up the terms' energies in ChainEnergy's order (the energy
+  // shift first, then term by term, then self-contact), so E has Energy()'s bits.
+  double EnergyGradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override {
+    if (g->size() != NumStates()) g->resize(NumStates());
+    g->setZero();
+    double* values = assembly_.Values(h, chain_terms_ < assembly_.NumTerms());
+    double e = Self().EnergyShift();
+    for (int t = 0; t < chain_terms_; ++t) {
+      e += Self().Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int ld) {
+        assembly_.AddGradient(t, lg, g->data());
+        assembly_.StoreHessian(t, lh, ld, values);
+      });
+    }
+    Self().AddContactGradient(x, u, g);
+    Self().AddContactHessian(x, u, values);
+    return e + Self().ContactEnergy(x, u);
+  }
+
+  bool EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, double* band, int bandwidth,
+                                    double* energy) const override {
+    // Self-contact adds its pairs through the compressed matrix only.
+    if (chain_terms_ < assembly_.NumTerms() || bandwidth != assembly_.Bandwidth()) return false;
+    if (g->size() != NumStates()) g->resize(NumStates());
+    g->setZero();
+    std::fill(band, band + static_cast<std::ptrdiff_t>(NumStates()) * (bandwidth + 1), 0.0);
+    double e = Self().EnergyShift();
+    for (int t = 0; t < chain_terms_; ++t) {
+      e += Self().Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int ld) {
+        assembly_.AddGradient(t, lg, g->data());
+        assembly_.AddBandHessian(t, lh, ld, band);
+      });
+    }
+    Self().AddContactGradient(x, u, g);
+    *energy = e + Self().ContactEnergy(x, u);
+    return true;
+  }
+
   void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override {
     const int nu = NumControls();
     if (eu->size() != nu) eu->resize(nu);

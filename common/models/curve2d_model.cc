@@ -106,23 +106,28 @@ class Curve2dModel final : public ChainModel<Curve2dModel> {
     assembly_.AddTerm(vars, 2 * nodes);
     terms_.push_back({bend, first_node});
   }
-  // Calls f(local gradient, local Hessian or null, leading dimension) for term t.
+  // Calls f(local gradient, local Hessian or null, leading dimension) for term t;
+  // returns the term's energy (the value ChainEnergy adds for it).
   template <class F>
-  void Local(int t, const Vec& x, const Vec& u, bool want_h, F&& f) const {
+  double Local(int t, const Vec& x, const Vec& u, bool want_h, F&& f) const {
     const int a = terms_[t].first_node;
     if (terms_[t].bend) {
       Eigen::Matrix<double, 6, 1> lg;
       Eigen::Matrix<double, 6, 6> lh;
-      BendTerm<2>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u), beta_, &lg,
-                  want_h ? &lh : nullptr);
+      const double e = BendTerm<2>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u), beta_, &lg,
+                                   want_h ? &lh : nullptr);
       f(lg.data(), lh.data(), 6);
-    } else {
-      Eigen::Matrix<double, 4, 1> lg;
-      Eigen::Matrix<double, 4, 4> lh;
-      StretchTerm<2>(Node(a, x, u), Node(a + 1, x, u), gamma_, l_, &lg, want_h ? &lh : nullptr);
-      f(lg.data(), lh.data(), 4);
+      return e;
     }
+    Eigen::Matrix<double, 4, 1> lg;
+    Eigen::Matrix<double, 4, 4> lh;
+    const double e = StretchTerm<2>(Node(a, x, u), Node(a + 1, x, u), gamma_, l_, &lg, want_h ? &lh : nullptr);
+    f(lg.data(), lh.data(), 4);
+    return e;
   }
+  // The energy of a chain without self-contact is its terms' (ChainModel's hook).
+  double ContactEnergy(const Vec&, const Vec&) const { return 0.0; }
+  double EnergyShift() const { return 0.0; }
 
   const double l_;
   const double beta_;

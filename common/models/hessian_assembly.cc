@@ -97,9 +97,93 @@ void HessianAssembly::Finalize() {
     }
   }
   store_begin_[4 * terms] = static_cast<int>(store_runs_.size());
+  FinalizeBand();
+}
+
+void HessianAssembly::FinalizeBand() {
+  // The lower band's slots, A(i, j) with i >= j at i (b + 1) + j - i + b: along a local
+  // row, consecutive variables are consecutive slots. A term whose variables are
+  // consecutive states v0, v0 + 1, ... (every chain term away from the clamp and the
+  // grasp) needs no table: local row i is one run of i + 1 slots (contiguous_).
+  const int n = num_states_;
+  const int terms = NumTerms();
+  const int ld = bandwidth_ + 1;
+  contiguous_.assign(terms, -1);
+  band_begin_.assign(terms + 1, 0);
+  band_runs_.clear();
+  for (int t = 0; t < terms; ++t) {
+    band_begin_[t] = static_cast<int>(band_runs_.size());
+    const int* v = TermVars(t);
+    const int k = TermSize(t);
+    bool consecutive = v[0] >= 0 && v[k - 1] < n;
+    for (int i = 1; i < k && consecutive; ++i) consecutive = v[i] == v[0] + i;
+    if (consecutive && (k == 6 || k == 9 || k == 4)) {
+      contiguous_[t] = v[0];
+      continue;
+    }
+    for (int i = 0; i < k; ++i) {
+      if (v[i] < 0 || v[i] >= n) continue;
+      for (int j = 0; j < k; ++j) {
+        if (v[j] < 0 || v[j] >= n || v[j] > v[i]) continue;
+        const int slot = v[i] * ld + v[j] - v[i] + bandwidth_;
+        if (static_cast<int>(band_runs_.size()) > band_begin_[t]) {
+          Run& run = band_runs_.back();
+          if (run.local_row == i && run.local_col + run.len == j && run.value + run.len == slot) {
+            ++run.len;
+            continue;
+          }
+        }
+        band_runs_.push_back({i, j, 1, slot, false});
+      }
+    }
+  }
+  band_begin_[terms] = static_cast<int>(band_runs_.size());
+}
+
+namespace {
+
+// The lower triangle of a K x K local Hessian (column-major, leading dimension ld) added
+// to the band rows v0 .. v0 + K - 1: row i's entries (i, 0 .. i) are band slots
+// (v0 + i) (b + 1) + b - i .. (v0 + i) (b + 1) + b, contiguous.
+template <int K>
+inline void AddContiguousBlock(const double* local_h, int ld, double* band, int band_ld, int v0) {
+  double* row = band + static_cast<std::ptrdiff_t>(v0) * band_ld + (band_ld - 1);
+#pragma GCC unroll 16
+  for (int i = 0; i < K; ++i, row += band_ld) {
+#pragma GCC unroll 16
+    for (int j = 0; j <= i; ++j) row[j - i] += local_h[i + j * ld];
+  }
+}
+
+}  // namespace
+
+void HessianAssembly::AddBandHessian(int term, const double* local_h, int ld, double* band) const {
+  const int band_ld = bandwidth_ + 1;
+  const int v0 = contiguous_[term];
+  if (v0 >= 0) {
+    switch (TermSize(term)) {
+      case 4: AddContiguousBlock<4>(local_h, ld, band, band_ld, v0); return;
+      case 6: AddContiguousBlock<6>(local_h, ld, band, band_ld, v0); return;
+      case 9: AddContiguousBlock<9>(local_h, ld, band, band_ld, v0); return;
+      default: break;
+    }
+  }
+  // Entry (i, j) of the local Hessian is local_h[i + j ld]: a run along a row has stride ld.
+  for (const Run* run = band_runs_.data() + band_begin_[term]; run != band_runs_.data() + band_begin_[term + 1];
+       ++run) {
+    const double* src = local_h + run->local_row + run->local_col * ld;
+    double* dst = band + run->value;
+    for (int r = 0; r < run->len; ++r) dst[r] += src[r * ld];
+  }
 }
 
 void HessianAssembly::AddGradient(int term, const double* local_g, double* g) const {
+  const int v0 = contiguous_[term];
+  if (v0 >= 0) {  // the same additions in the same order, without the index checks
+    double* dst = g + v0;
+    for (int i = 0, k = TermSize(term); i < k; ++i) dst[i] += local_g[i];
+    return;
+  }
   const int* v = TermVars(term);
   const int k = TermSize(term);
   for (int i = 0; i < k; ++i) {

@@ -79,11 +79,20 @@ class HessianAssembly {
   // 0 .. NumTerms() - 1. 0 + h == h exactly, so the result is AddHessian's on a zeroed
   // matrix to the last bit, without a pass that clears the whole matrix.
   void StoreHessian(int term, const double* local_h, int ld, double* values) const;
+  // AddHessian's sum in band storage (linalg/banded_ldlt.h: with half-bandwidth
+  // b = Bandwidth(), A(i, j), i >= j, is band[i (b + 1) + j - i + b]), lower triangle
+  // only, each entry read from the local Hessian as AddHessian reads it; the band must
+  // hold zeros first. Over terms 0 .. NumTerms() - 1 in order it holds Hessian()'s
+  // values (0 + h == h exactly; a -0.0 entry may come out as +0.0).
+  void AddBandHessian(int term, const double* local_h, int ld, double* band) const;
   // exu: num_states x num_controls, euu: num_controls x num_controls (presized).
   void AddMixedHessian(int term, const double* local_h, int ld, Mat* exu) const;
   void AddControlHessian(int term, const double* local_h, int ld, Mat* euu) const;
 
  private:
+  // The band runs (AddBandHessian), after the pattern and its bandwidth.
+  void FinalizeBand();
+
   int num_states_ = 0;
   int num_controls_ = 0;
   std::vector<int> term_begin_{0};    // term t's variables are vars_[begin[t], begin[t+1])
@@ -107,6 +116,15 @@ class HessianAssembly {
   // so the order of the runs within a term does not change any sum.
   std::vector<int> store_begin_;
   std::vector<Run> store_runs_;
+  // AddBandHessian's runs for terms whose variables are not consecutive states: local
+  // entries (i, j0 .. j0+len-1) of one local row, read with stride ld (column-major),
+  // to band slots value .. value+len-1 (one band row); term t's are
+  // band_runs_[band_begin_[t], band_begin_[t+1]).
+  std::vector<int> band_begin_;
+  std::vector<Run> band_runs_;
+  // For each term: its first variable v0 when its variables are the states v0, v0 + 1,
+  // ..., v0 + k - 1 (k = 4, 6 or 9: the chains' stretching and bending terms), else -1.
+  std::vector<int> contiguous_;
   std::vector<char> touches_controls_;
   SparseMatrix pattern_;
   int bandwidth_ = 0;

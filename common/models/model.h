@@ -61,6 +61,25 @@ class Model {
     Gradient(x, u, g);
     Hessian(x, u, h);
   }
+  // E(x, u), E_x and E_xx at one state, the same values as Energy(), Gradient() and
+  // Hessian() (to the last bit); returns E. A model may fuse the three passes over its
+  // terms (a converged solve needs all three at its warm start).
+  virtual double EnergyGradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
+    GradientAndHessian(x, u, g, h);
+    return Energy(x, u);
+  }
+  // The same with E_xx written straight into band storage instead of a compressed
+  // matrix: the lower band of half-bandwidth `bandwidth` (linalg/banded_ldlt.h's layout,
+  // A(i, j), i >= j, at band[i (bandwidth + 1) + j - i + bandwidth]; every other slot of
+  // the NumStates() (bandwidth + 1) array is set to 0), the values Hessian() gives (to
+  // the last bit, but for the sign of a zero). Returns
+  // false, writing nothing, where the model cannot (the default; a chain with
+  // self-contact; another bandwidth than HessianBandwidth()). The solvers' banded
+  // factorisation then skips the copy from a compressed matrix.
+  virtual bool EnergyGradientAndBandHessian(const Vec& /*x*/, const Vec& /*u*/, Vec* /*g*/, double* /*band*/,
+                                            int /*bandwidth*/, double* /*energy*/) const {
+    return false;
+  }
   // E_u, size NumControls(). The force on the grasp is F = -E_u (envelope theorem, §2.3.4).
   virtual void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const = 0;
   // E_xu, NumStates() x NumControls() (dense: only a few rows are non-zero).

@@ -208,24 +208,26 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   }
 
   // Calls f(local gradient, local Hessian (valid if want_h), leading dimension) for
-  // term t, in the term's assembly variables.
+  // term t, in the term's assembly variables; returns the term's energy (the value
+  // ChainEnergy adds for it).
   template <class F>
-  void Local(int t, const Vec& x, const Vec& u, bool want_h, F&& f) const {
+  double Local(int t, const Vec& x, const Vec& u, bool want_h, F&& f) const {
     const Term& term = terms_[t];
     const int a = term.first_node;
     Eigen::Matrix<double, 9, 1> lg;
     Eigen::Matrix<double, 9, 9> lh;
+    double energy;
     if (term.bend) {
-      BendTerm<3>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u), half_beta_, &lg,
+      energy = BendTerm<3>(Node(a, x, u), Node(a + 1, x, u), Node(a + 2, x, u), half_beta_, &lg,
                   want_h ? &lh : nullptr);
     } else {
       Eigen::Matrix<double, 6, 1> g6;
       Eigen::Matrix<double, 6, 6> h6;
-      StretchTerm<3>(Node(a, x, u), Node(a + 1, x, u), half_gamma_, rest_, &g6,
-                     want_h ? &h6 : nullptr);
+      energy = StretchTerm<3>(Node(a, x, u), Node(a + 1, x, u), half_gamma_, rest_, &g6,
+                              want_h ? &h6 : nullptr);
       if (!term.grip) {
         f(g6.data(), h6.data(), 6);
-        return;
+        return energy;
       }
       lg.head<6>() = g6;
       lg.tail<3>().setZero();
@@ -236,7 +238,7 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
     }
     if (!term.grip) {
       f(lg.data(), lh.data(), 9);
-      return;
+      return energy;
     }
     // Chain rule to the term's variables through p_{N-1} = P - s d̂, d̂ = d/ρ, ρ = |d|.
     // Its Jacobian w.r.t. g = (s, X, Y, Z, dx, dy, dz) is A = [-d̂ | I | -s Q/ρ] with
@@ -302,6 +304,7 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
       }
     }
     f(gg.data(), hh.data(), kMaxVars);
+    return energy;
   }
 
   const double rest_;        // L
@@ -326,6 +329,11 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
       for (int k = 0; k < 3; ++k) controls_.jac(k, k) = 1.0;
       for (auto& h : controls_.hess) h.setZero();
     }
+  }
+  // ChainModel's hooks for the fused energy: what Energy() adds to the chain's terms.
+  double EnergyShift() const { return energy_shift_; }
+  double ContactEnergy(const Vec& x, const Vec& u) const {
+    return contact_.enabled() ? contact_.Energy(ContactNodes(x, u)) : 0.0;
   }
   const Eigen::Matrix3Xd& ContactNodes(const Vec& x, const Vec& u) const {
     NodePositions(x, u, &contact_nodes_);

@@ -18,6 +18,9 @@ class SmallestEigenpair {
   // wherever H is positive definite or has one slightly negative eigenvalue — the
   // situations near a fold where it matters.
   double Update(const SymmetricLinearSolver& factor, const SparseMatrix& h, int iterations);
+  // The same steps without the fallback: false when no step succeeded (a failed solve,
+  // iterations < 1), and then value() is not updated. Needs no H.
+  bool Iterate(const SymmetricLinearSolver& factor, int n, int iterations);
   const Vec& vector() const { return v_; }
   bool initialized() const { return initialized_; }
   double value() const { return lambda_; }

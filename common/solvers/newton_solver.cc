@@ -35,6 +35,7 @@ SolverBase::SolverBase(const Model& model, const SolverOptions& options)
   w.eig.Resize(n_);
   w.orbits = std::make_unique<SymmetryOrbits>(model_);
   for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch, &w.h_state}) v->resize(n_);
+  w.h_u.resize(model_.NumControls());
 }
 
 void SolverBase::Reset() {
@@ -59,6 +60,8 @@ bool SolverBase::BeginSolve(const Vec& u, const Vec& x, SolverSummary* s) {
   factor_before_tiny_step_ = false;
   // Lagged model data (AcceptState) may have changed E since the last solve.
   hessian_ready_ = false;
+  band_ready_ = false;
+  energy_ready_ = false;
   // Eigen checks sizes only with assertions on: a Release build must check here.
   const char* why = nullptr;
   if (x.size() != n_) why = "the state has the wrong size";
@@ -184,29 +187,67 @@ double SolverBase::EvalGradient(const Vec& x, const Vec& u, SolverSummary* s) {
 }
 
 double SolverBase::EvalGradientAtStart(const Vec& x, const Vec& u, SolverSummary* s) {
-  model_.GradientAndHessian(x, u, &ws_.g, &ws_.h);
+  // A banded factorisation lends its band: the model writes E_xx there, and FactorAt()
+  // factorises it in place (no compressed matrix, no copy; the compressed one is made
+  // only if a globalised or reduction step asks for it, EnsureSparseHessian()).
+  int bandwidth = -1;
+  double* band = ws_.factor->AssemblyBand(&bandwidth);
+  if (band != nullptr && model_.EnergyGradientAndBandHessian(x, u, &ws_.g, band, bandwidth, &h_state_energy_)) {
+    band_ready_ = true;
+    sparse_stale_ = true;
+  } else {
+    h_state_energy_ = model_.EnergyGradientAndHessian(x, u, &ws_.g, &ws_.h);
+    hessian_ready_ = true;
+  }
   ++s->gradient_evaluations;
   ws_.h_state = x;
-  hessian_ready_ = true;
+  ws_.h_u = u;
+  energy_ready_ = true;
   return ws_.g.norm();
+}
+
+bool SolverBase::AtHessianState(const Vec& x) const {
+  return x.size() == ws_.h_state.size() &&
+         std::memcmp(x.data(), ws_.h_state.data(), sizeof(double) * x.size()) == 0;
 }
 
 LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummary* s) {
   // E_xx from EvalGradientAtStart at this very state (bit for bit) is not evaluated again;
   // it counts as this factorisation's evaluation.
-  const bool have_h = hessian_ready_ && x.size() == ws_.h_state.size() &&
-                      std::memcmp(x.data(), ws_.h_state.data(), sizeof(double) * x.size()) == 0;
+  const bool at_start = (hessian_ready_ || band_ready_) && AtHessianState(x);
+  const bool in_band = band_ready_ && at_start;
+  const bool have_h = hessian_ready_ && at_start;
   hessian_ready_ = false;
-  if (!have_h) model_.Hessian(x, u, &ws_.h);
+  band_ready_ = false;
   ++s->hessian_evaluations;
   ++s->factorizations;
-  const LinearSolverStatus st = ws_.factor->Factorize(ws_.h);
+  LinearSolverStatus st;
+  if (in_band) {
+    st = ws_.factor->FactorizeAssembled();  // ws_.h stays stale (sparse_stale_)
+  } else {
+    if (!have_h) model_.Hessian(x, u, &ws_.h);
+    sparse_stale_ = false;
+    st = ws_.factor->Factorize(ws_.h);
+  }
   factor_valid_ = st == LinearSolverStatus::kSuccess;
   factor_before_tiny_step_ = false;
   return st;
 }
 
+void SolverBase::EnsureSparseHessian() {
+  if (!sparse_stale_) return;
+  model_.Hessian(ws_.h_state, ws_.h_u, &ws_.h);
+  sparse_stale_ = false;
+}
+
+double SolverBase::UpdateEigenpair(int iterations) {
+  if (ws_.eig.Iterate(*ws_.factor, n_, iterations)) return ws_.eig.value();
+  EnsureSparseHessian();
+  return ws_.eig.Update(*ws_.factor, ws_.h, 0);
+}
+
 SparseMatrix& SolverBase::ModifiedHessian() {
+  EnsureSparseHessian();
   std::copy(ws_.h.valuePtr(), ws_.h.valuePtr() + ws_.h.nonZeros(), ws_.h_mod.valuePtr());
   return ws_.h_mod;
 }
@@ -230,6 +271,7 @@ bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, SolverSummary* s) {
   const LinearSolverStatus st = FactorAt(*x, u, s);
   const SymmetricLinearSolver* f = w.factor.get();
   if (st != LinearSolverStatus::kSuccess || w.factor->NegativePivots() > 0) {
+    EnsureSparseHessian();
     double max_diag = 0.0;
     for (int i = 0; i < n_; ++i) max_diag = std::max(max_diag, std::abs(w.h.valuePtr()[w.diag_index[i]]));
     double tau = std::max(1e-3 * max_diag, 1e-8);
@@ -286,7 +328,8 @@ bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, SolverSummary* s) {
 
 void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradient_current) {
   s->residual = gradient_current ? ws_.g.norm() : EvalGradient(x, u, s);
-  s->energy = model_.Energy(x, u);
+  // The warm start's energy came with its gradient and E_xx (EvalGradientAtStart).
+  s->energy = energy_ready_ && AtHessianState(x) ? h_state_energy_ : model_.Energy(x, u);
   // The factorisation at the returned state serves implicit differentiation (K) and
   // the eigenvalue estimate (or the one before a tiny last Newton step, kReuseStep).
   const LinearSolverStatus st =
@@ -294,8 +337,10 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradi
   factor_before_tiny_step_ = false;
   if (st == LinearSolverStatus::kSuccess) {
     s->negative_pivots = ws_.factor->NegativePivots();
-    // Two warm-started steps track the eigenpair; a cold start or a new branch needs more.
-    s->lambda_min = UpdateEigenpair(ws_.eig.initialized() && !s->snapped ? 2 : 40);
+    // One warm-started step per update tracks the eigenpair (the vector converges over
+    // the updates, and every iteration of the higher-order loop adds a step near a fold);
+    // a cold start or a new branch needs more.
+    s->lambda_min = UpdateEigenpair(ws_.eig.initialized() && !s->snapped ? 1 : 40);
   } else {
     s->negative_pivots = -1;
     s->lambda_min = 0.0;  // singular to working precision

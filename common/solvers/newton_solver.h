@@ -64,7 +64,12 @@ class SolverBase : public EquilibriumSolver {
   // --- Hessian and its factorisations ------------------------------------------------
   // Assembles E_xx at x and factorises it (HessianFactor()).
   LinearSolverStatus FactorAt(const Vec& x, const Vec& u, SolverSummary* s);
-  const SparseMatrix& Hessian() const { return ws_.h; }
+  // E_xx at the state of HessianFactor() as a compressed matrix (evaluated here when
+  // the factorisation was assembled in band storage, EnsureSparseHessian()).
+  const SparseMatrix& Hessian() {
+    EnsureSparseHessian();
+    return ws_.h;
+  }
   const SymmetricLinearSolver& HessianFactor() const { return *ws_.factor; }
   // A modified copy of E_xx (same pattern): ModifiedHessian() returns the copy with the
   // current values, the method edits its values, FactorModified() factorises it into
@@ -91,7 +96,7 @@ class SolverBase : public EquilibriumSolver {
 
   // --- lowest eigenpair ----------------------------------------------------------------
   // `iterations` steps of inverse iteration with HessianFactor(); the Rayleigh quotient.
-  double UpdateEigenpair(int iterations) { return ws_.eig.Update(*ws_.factor, ws_.h, iterations); }
+  double UpdateEigenpair(int iterations);
   // Sets the deterministic start vector if none has been tracked yet.
   void EnsureEigenvector() { ws_.eig.EnsureInitialized(n_); }
   // lambda_0 at the last regular converged state (DESIGN.md #1); <= 0: none yet.
@@ -108,8 +113,14 @@ class SolverBase : public EquilibriumSolver {
     std::unique_ptr<SymmetryOrbits> orbits;
     Vec g, dx, trial, last_good, dx_scratch;
     Vec h_state;  // the state h was evaluated at by EvalGradientAtStart (hessian_ready_)
+    Vec h_u;      // ... and its controls
   };
 
+  // ws_.h := E_xx at ws_.h_state when the factorisation there was assembled in band
+  // storage (sparse_stale_): the rare steps that edit or read E_xx entry by entry.
+  void EnsureSparseHessian();
+  // x is bit for bit the state of EvalGradientAtStart's E_xx (ws_.h_state).
+  bool AtHessianState(const Vec& x) const;
   bool BudgetLeft(const SolverSummary& s) const;
   // The time budget (options.max_time_us > 0) is spent: one steady_clock read per
   // iteration is the whole cost of the check.
@@ -138,6 +149,13 @@ class SolverBase : public EquilibriumSolver {
   bool factor_before_tiny_step_ = false;
   // ws_.h holds E_xx at ws_.h_state from EvalGradientAtStart, not yet factorised.
   bool hessian_ready_ = false;
+  // The factor's band holds E_xx at ws_.h_state (direct assembly), not yet factorised.
+  bool band_ready_ = false;
+  // ws_.h is not E_xx at the factorised state: that is ws_.h_state's, assembled in band.
+  bool sparse_stale_ = false;
+  // h_state_energy_ is E at ws_.h_state (from EvalGradientAtStart, this solve).
+  bool energy_ready_ = false;
+  double h_state_energy_ = 0.0;
   double lambda_ref_ = -1.0;     // lambda_0 at the last regular converged state
   // MinimizeFully stopped at the time budget: the snap goes on at the next update.
   bool snap_in_progress_ = false;
