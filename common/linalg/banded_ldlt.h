@@ -10,7 +10,7 @@
 // the band (scatter_) and which band slots inside the matrix the pattern leaves empty
 // (holes_, they take fill-in): Factorize() of a compressed matrix is then one pass over
 // the values without per-column bookkeeping, and the band is never cleared as a whole.
-// SolveMany() runs the right-hand sides through one pass over the factor.
+// SolveMany() solves column by column, each forward sweep from the column's first non-zero.
 //
 // Without pivoting the factorisation exists iff every leading principal minor is
 // non-zero; for a symmetric matrix this is enough for indefinite Hessians (the

@@ -13,7 +13,9 @@ class SmallestEigenpair {
  public:
   void Resize(int n);
   // Runs `iterations` steps of inverse iteration with `factor` (a factorisation of h)
-  // and returns the Rayleigh quotient v^T H v of the unit vector v. Inverse iteration
+  // and returns the Rayleigh quotient of the unit vector v, taken from the last solve
+  // (w = H^-1 v gives w^T H w = w^T v: no product with H; H is used only by the
+  // fallback when no step succeeds). Inverse iteration
   // converges to the eigenvalue of smallest modulus, which is the smallest eigenvalue
   // wherever H is positive definite or has one slightly negative eigenvalue — the
   // situations near a fold where it matters.
