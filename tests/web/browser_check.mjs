@@ -12,7 +12,9 @@
 //   auth URL_WITHOUT_TOKEN OUT_DIR TOKEN: HTTP status of the page and of a WebSocket
 //        upgrade without, with a wrong and with the right token (no browser).
 import { createRequire } from 'node:module';
+import { readdirSync, readFileSync } from 'node:fs';
 import http from 'node:http';
+import os from 'node:os';
 import path from 'node:path';
 
 const [modules, browserName, mode, url, out, arg] = process.argv.slice(2);
@@ -32,6 +34,36 @@ const CHROMIUM_ARGS = [
   '--disable-background-timer-throttling', '--disable-renderer-backgrounding',
   '--disable-backgrounding-occluded-windows',
 ];
+
+// CPU seconds (user + system) of this script's descendant processes, summed per kind
+// (Chromium's --type=, else the program's name): whether the browser got the CPU time its
+// pages need is what tells a starved machine from a slow page.
+const TICKS_PER_S = 100;  // USER_HZ on Linux
+function browserCpu() {
+  const procs = new Map();
+  for (const name of readdirSync('/proc')) {
+    if (!/^\d+$/.test(name)) continue;
+    try {
+      const stat = readFileSync(`/proc/${name}/stat`, 'utf8');
+      const f = stat.slice(stat.lastIndexOf(')') + 2).split(' ');  // fields from state on
+      // Chromium rewrites its command line into one string; Firefox's content processes end
+      // theirs with their kind (tab, gpu, rdd, socket, utility).
+      const raw = readFileSync(`/proc/${name}/cmdline`, 'utf8');
+      const args = raw.split(/[\0 ]/).filter((a) => a);
+      const type = (/--type=([\w-]+)/.exec(raw) || [])[1] ||
+                   (args.includes('-contentproc') ? `content-${args[args.length - 1]}` : path.basename(args[0] || '?'));
+      procs.set(Number(name), { ppid: Number(f[1]), cpu: (Number(f[11]) + Number(f[12])) / TICKS_PER_S, type });
+    } catch { /* gone meanwhile */ }
+  }
+  const cpu = {};
+  for (const [pid, p] of procs) {
+    let up = p.ppid;
+    while (up > 1 && up !== process.pid) up = procs.get(up)?.ppid ?? 0;
+    if (up === process.pid && pid !== process.pid) cpu[p.type] = (cpu[p.type] || 0) + p.cpu;
+  }
+  return cpu;
+}
+const cpuSince = (a, b, s) => Object.fromEntries(Object.keys(b).map((k) => [k, Number(((b[k] - (a[k] || 0)) / s).toFixed(3))]));
 
 // One page API over both drivers: open(viewport) gives {page, goto, waitFor, shot, shotAll,
 // select}; page.evaluate(fn) is the same in both.
@@ -98,6 +130,7 @@ const counters = (page) => page.evaluate(() => ({
   seq: Number(document.body.dataset.lastShapeSeq ?? -1),
   status: Number(document.body.dataset.lastShapeStatus ?? -1),
   utime: Number(document.body.dataset.lastShapeUtime ?? 0),
+  round_trip_ms: Number(document.body.dataset.roundTripMs ?? NaN),
   t: performance.now(),
 }));
 
@@ -109,9 +142,14 @@ async function live(browser, pages) {
   }
   for (const p of opened) await p.waitFor(() => Number(document.body.dataset.shapesReceived || 0) > 10);
   await sleep(WARM_UP_S * 1000);
+  const cpuBefore = browserCpu();
+  const wallBefore = Date.now();
   const before = await Promise.all(opened.map(({ page }) => counters(page)));
   await sleep(MEASURE_S * 1000);
   const after = await Promise.all(opened.map(({ page }) => counters(page)));
+  // Cores' worth of CPU each kind of browser process had over the window, and the load.
+  const cpu = cpuSince(cpuBefore, browserCpu(), (Date.now() - wallBefore) / 1000);
+  const load = os.loadavg()[0];
   const result = [];
   for (let i = 0; i < pages; ++i) {
     const { page, shot: shotOf } = opened[i];
@@ -131,9 +169,11 @@ async function live(browser, pages) {
       shapes_per_server_s: (after[i].shapes - before[i].shapes) / ((after[i].utime - before[i].utime) / 1e6),
       frames_per_s: (after[i].frames - before[i].frames) / s,
       shapes: after[i].shapes, frames: after[i].frames, status, screenshot: shot,
+      // The page's last ping to the bridge and back: the ack window's round trip.
+      round_trip_ms: after[i].round_trip_ms,
     });
   }
-  return { pages: result };
+  return { pages: result, browser_cpu: cpu, load };
 }
 
 async function replay(browser) {
