@@ -98,8 +98,8 @@ const DRIVERS = {
         browser: 'firefox', executablePath: '/usr/bin/firefox-esr', headless: true,
         timeout: 60000, protocolTimeout: 120000,
         extraPrefsFirefox: {
-          // No GPU and no display here: let WebGL run on Mesa's software rasteriser
-          // instead of refusing it as a blocklisted driver.
+          // WebGL on whatever GL the display has, blocklisted or not (here Mesa's llvmpipe,
+          // which gave WebGL 2 with and without this pref; without a display, none).
           'webgl.force-enabled': true,
           // Pages in the background keep their timers and animation frames.
           'dom.min_background_timeout_value': 4,
