@@ -7,8 +7,9 @@
 // Shapes and force models come faster than any page is sent them (force models at the
 // update rate: ~1600/s in curve2d_snap; a page gets at most 60/s of each): every one is
 // vetted and counted, but only the newest is turned into JSON, at most kPublishHz times a
-// second per kind, and the newest of a burst once it ends (the loop publishes it within
-// kFlushMs), so the bridge neither spends its CPU on JSON no page gets nor falls behind.
+// second per kind, and the newest of a burst once it ends (the loop publishes it at most
+// 1/kPublishHz + kFlushMs after the one before), so the bridge does not spend its CPU on
+// JSON no page gets.
 #pragma once
 
 #include <array>
