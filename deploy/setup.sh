@@ -16,8 +16,9 @@ packages=(
   libceres-dev liblapack-dev
   iproute2 procps
   # snapthread-web: Boost.Beast (header-only) for its HTTP/WebSocket server, and Debian's
-  # Chromium for its browser tests (driven by playwright-core from the page's npm install).
-  libboost-dev chromium
+  # Chromium and Firefox ESR for its browser tests (driven by playwright-core and
+  # puppeteer-core from the page's npm install; Firefox's WebGL runs on the tests' Xvfb).
+  libboost-dev chromium firefox-esr
 )
 
 missing=()

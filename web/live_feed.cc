@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
+#include <type_traits>
 
 #include "auth/message_gate.h"
 #include "message_json.h"
@@ -80,8 +81,21 @@ void LiveFeed::Stop() {
 
 void LiveFeed::Loop() {
   while (running_) {
-    if (lcm_.handleTimeout(50) < 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (lcm_.handleTimeout(kFlushMs) < 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const Clock::time_point now = Clock::now();
+    PublishIfDue(&newest_shape_, now);
+    PublishIfDue(&newest_model_, now);
   }
+}
+
+template <class Msg>
+void LiveFeed::PublishIfDue(Newest<Msg>* newest, Clock::time_point now) {
+  static const auto kInterval = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / kPublishHz));
+  if (!newest->msg || now - newest->published < kInterval) return;
+  newest->published = now;
+  publish_(KindOf(*newest->msg), std::make_shared<const std::string>(ToJson(*newest->msg)));
+  newest->msg.reset();
 }
 
 template <class Msg>
@@ -130,7 +144,16 @@ void LiveFeed::OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& chan
     return;
   }
   received_[Index(KindOf(msg))]++;
-  publish_(KindOf(msg), std::make_shared<const std::string>(ToJson(msg)));
+  if constexpr (std::is_same_v<Msg, thread_shape_t> || std::is_same_v<Msg, force_model_t>) {
+    auto* newest = [this]() {
+      if constexpr (std::is_same_v<Msg, thread_shape_t>) return &newest_shape_;
+      else return &newest_model_;
+    }();
+    newest->msg = std::move(msg);
+    PublishIfDue(newest, Clock::now());
+  } else {
+    publish_(KindOf(msg), std::make_shared<const std::string>(ToJson(msg)));
+  }
 }
 
 FeedCounts LiveFeed::counts() const {

@@ -4,6 +4,12 @@
 // epoch learned from an authenticated solver status, a strictly increasing auth_seq per
 // sender) and hands each accepted one, as JSON, to `publish`. Bad and refused messages
 // are dropped and counted; handlers never throw. LCM is handled on the feed's own thread.
+// Shapes and force models come faster than any page is sent them (force models at the
+// update rate: ~1600/s in curve2d_snap; a page gets at most 60/s of each): every one is
+// vetted and counted, but only the newest is turned into JSON, at most kPublishHz times a
+// second per kind, and the newest of a burst once it ends (the loop publishes it at most
+// 1/kPublishHz + kFlushMs after the one before), so the bridge does not spend its CPU on
+// JSON no page gets.
 #pragma once
 
 #include <array>
@@ -12,6 +18,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -22,6 +29,8 @@
 #include "auth/session_key.h"
 #include "feed_kind.h"
 #include "client_pacer.h"
+#include "snapthread/force_model_t.hpp"
+#include "snapthread/thread_shape_t.hpp"
 
 namespace snapthread::web {
 
@@ -37,6 +46,10 @@ struct FeedCounts {
 
 class LiveFeed {
  public:
+  // Twice the pages' 60 Hz bound, so what the pacer picks is at most ~8 ms older.
+  static constexpr double kPublishHz = 120.0;
+  static constexpr int kFlushMs = 5;
+
   // Opens LCM at `lcm_url` and subscribes; throws std::runtime_error when LCM cannot start
   // or `session` is not a valid session name. `key` must outlive the feed.
   LiveFeed(const std::string& lcm_url, const std::string& session, const auth::SessionKey& key,
@@ -55,6 +68,14 @@ class LiveFeed {
   template <class Msg>
   auth::FreshnessFilter* FilterFor(const Msg& msg);
   void Loop();
+  // The newest accepted shape or force model not yet published, and when its kind last was.
+  template <class Msg>
+  struct Newest {
+    std::optional<Msg> msg;
+    Clock::time_point published{};
+  };
+  template <class Msg>
+  void PublishIfDue(Newest<Msg>* newest, Clock::time_point now);
 
   lcm::LCM lcm_;
   const auth::SessionKey& key_;
@@ -65,6 +86,8 @@ class LiveFeed {
   auth::FreshnessFilter model_filter_{"FORCE_MODEL"};
   // One sequence per device (each signs its statuses with its own auth_seq).
   std::map<std::string, std::unique_ptr<auth::FreshnessFilter>> device_filters_;
+  Newest<thread_shape_t> newest_shape_;
+  Newest<force_model_t> newest_model_;
   std::thread thread_;
   std::atomic<bool> running_{false};
   std::array<std::atomic<int64_t>, 4> received_{};

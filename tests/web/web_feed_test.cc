@@ -1,7 +1,9 @@
 // snapthread-web's LCM side against real LCM traffic: only what the session key signed
 // reaches the pages (the viewer's checks: MAC, the epoch of a signed status, fresh sequence).
+#include <chrono>
 #include <mutex>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
@@ -60,6 +62,56 @@ TEST(LiveFeed, PassesOnlyMessagesSignedWithTheSessionKey) {
   std::lock_guard<std::mutex> lock(mutex);
   EXPECT_NE(last_shape.find(R"("positions":[0,0,0,1,0.5,0,2,1,0,3,1.5,0])"), std::string::npos)
       << "the 4-node signed shape, not the refused 5- or 6-node ones: " << last_shape;
+}
+
+
+// Force models at the update rate (a burst of 2000 here, sent as fast as LCM sends): every
+// one received is vetted and counted, fewer are turned into JSON, and the newest is always
+// among them once the burst ends.
+TEST(LiveFeed, ABurstOfForceModelsIsCountedWholeAndPublishedUpToTheNewest) {
+  const auth::SessionKey key = auth::SessionKey::Generate();
+  const std::string session = test_support::UniqueSession("WEBBURST");
+  const transport::Channels channels(session);
+  std::mutex mutex;
+  int published = 0;
+  std::string last_model;
+  LiveFeed feed(test_support::kLoopbackLcmUrl, session, key, [&](FeedKind k, Text t) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (k != FeedKind::kForceModel) return;
+    published++;
+    last_model = *t;
+  });
+  feed.Start();
+  lcm::LCM lcm(test_support::kLoopbackLcmUrl);
+  ASSERT_TRUE(lcm.good());
+  const int64_t epoch = auth::NewEpoch();
+  auth::AuthSequence seq;
+  solver_status_t status = test_support::Sample<solver_status_t>();
+  ASSERT_TRUE(auth::Sign(&status, channels.solver_status, epoch, seq.Next(), key));
+  lcm.publish(channels.solver_status, &status);
+  ASSERT_TRUE(test_support::WaitUntil([&] { return feed.counts().epoch == epoch; }, 5.0));
+  auto send = [&](int64_t model_seq) {
+    force_model_t m = test_support::Sample<force_model_t>();
+    m.seq = model_seq;
+    ASSERT_TRUE(auth::Sign(&m, channels.force_model, epoch, seq.Next(), key));
+    lcm.publish(channels.force_model, &m);
+  };
+  // As fast as LCM sends (UDP may drop some of them: the feed counts what it got).
+  constexpr int kBurst = 2000;
+  for (int i = 0; i < kBurst; ++i) send(1000 + i);
+  ASSERT_TRUE(test_support::WaitUntil(
+      [&] { return feed.counts().received[Index(FeedKind::kForceModel)] >= 100; }, 10.0));
+  // Once the burst is over, the last one, alone: it is the newest, and it is published.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  send(9999);
+  EXPECT_TRUE(test_support::WaitUntil([&] {
+    std::lock_guard<std::mutex> lock(mutex);
+    return last_model.find("\"seq\":9999,") != std::string::npos;
+  }, 5.0)) << "the newest force model is published once the burst ends: " << last_model;
+  const int64_t received = feed.counts().received[Index(FeedKind::kForceModel)];
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_LT(published, received) << "every force model received was turned into JSON";
+  EXPECT_GE(published, 1);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // snapthread-web's page: connects to the bridge, draws every shape it gets, charts the
 // force models and shows the statuses. Test hooks (cumulative counters, read by the
 // browser tests): document.body.dataset.shapesReceived and .framesDrawn; also .lastShapeSeq,
-// .lastShapeStatus, .lastShapeUtime (the server's stamp), .connection, and in replay .replayShape / .replayShapes / .replayAtEnd.
+// .lastShapeStatus, .lastShapeUtime (the server's stamp), .connection, .roundTripMs (the
+// last ping's, refreshed 4 times a second), and in replay .replayShape / .replayShapes / .replayAtEnd.
 import { SceneView } from './scene_view.js';
 import { Charts } from './charts.js';
 import { StatusPanel } from './status_panel.js';
@@ -64,6 +65,7 @@ requestAnimationFrame(frame);
 
 setInterval(() => {
   const now = performance.now();
+  data.roundTripMs = connection.roundTripMs.toFixed(1);
   panel.render({
     shapes, frames,
     shapeRate: rate(shapeTimes, now), frameRate: rate(frameTimes, now),
