@@ -38,7 +38,8 @@ fi
 "$here/deploy/multicast-route.sh" || true
 
 # snapthread-web's page is bundled at build time: the build runs `npm ci` from
-# web/page/package-lock.json (three.js, uPlot, esbuild, playwright-core) with Node.js >= 20.
+# web/page/package-lock.json (three.js, uPlot, esbuild, playwright-core for Chromium, puppeteer-core
+# for Firefox over WebDriver BiDi) with Node.js >= 20.
 # The machine's Node.js is used; Debian's (nodejs + npm) only when there is none.
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
   echo "setup: installing Debian's nodejs and npm (snapthread-web's page needs Node.js >= 20)"
