@@ -8,7 +8,18 @@
 // Reach: near a fold lambda_min ~ sqrt(distance) along the motion (the normal form's
 // square-root law, fold_search.h), so lambda^2 falls linearly; from two updates the
 // distance is lambda^2 / (secant slope of lambda^2). A search starts when that estimate
-// (or the tracker's near-fold status) puts a fold within `reach` of the hand.
+// (or the tracker's near-fold status) puts a fold within `reach` of the hand: two
+// length scales, or 50 updates of the hand's travel when that is longer (a fast hand,
+// a slow server). It does not shrink with the update step: at 1 kHz 50 updates were
+// 4 mm, 80 ms of the hand's travel at 0.05 m/s, and a server on a loaded machine can
+// stall longer than that (seen here: 250 ms without a model).
+//
+// A branch keeps its prediction until the branch ends: a later search that finds no
+// fold (along another direction, or beyond its reach) does not take it back; one that
+// finds a fold replaces it. Once a branch has a prediction, it is searched again only
+// when the hand's direction has turned away from the one it was found along. A search
+// that found no fold cleared its segment of the line: the next one along about the same
+// direction starts when the hand has covered half of that reach.
 #pragma once
 
 #include <cstdint>
@@ -53,6 +64,10 @@ class FoldBoundary {
   };
   struct Job {
     int64_t branch = 0;
+    int64_t search = 0;  // its number (searches_), for the log
+    Vec u;               // where it started
+    Vec direction;       // unit, positional controls
+    double reach = 0.0;
     FoldPrediction prediction;
   };
   void NewBranch();
@@ -63,6 +78,10 @@ class FoldBoundary {
   FoldSearch search_;  // used only by the running job
   BackgroundJob<Job> job_;
   std::unique_ptr<FoldPrediction> prediction_;
+  Vec prediction_direction_;  // the search direction that found prediction_
+  // The segment the last search of this branch found no fold on (reach 0: none).
+  Vec clear_u_, clear_direction_;
+  double clear_reach_ = 0.0;
   DeviceFold device_fold_{};
   int64_t branch_ = 1;         // changes at every snap, reset or switch
   int64_t fold_id_ = 0;        // of the current branch's prediction (0: none yet)

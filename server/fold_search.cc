@@ -28,13 +28,25 @@ FoldSearch::FoldSearch(const Scene& scene) {
   dim_ = std::min(tracker_->model().SpatialDimension(), tracker_->model().NumControls());
 }
 
-bool FoldSearch::OnBranch(const Vec& x, const Vec& u) {
+bool FoldSearch::OnBranch(const Vec& x, const Vec& u_x, const Vec& u) {
   // Resume solves at u warm-started from x with the higher-order solver: on the branch
   // it converges next to x; past the fold its reduction finds the followed minimum gone
   // and the snap minimiser takes the state to the other branch (DESIGN.md #3-#4).
   const TrackResult& r = tracker_->Resume(x, u);
   if (!r.summary.IsSolutionUsable()) return false;
-  return (tracker_->state() - x).lpNorm<Eigen::Infinity>() <= jump_threshold_;
+  if ((tracker_->state() - x).lpNorm<Eigen::Infinity>() <= jump_threshold_) return true;
+  // A large change is not yet a snap: near the fold the branch itself moves like
+  // sqrt(distance) ((2.54-2.55)), so a march step can move the state by more than the
+  // threshold while it stays on the branch (that read as a fold that was not there,
+  // and the search then reported none). The two branches coexist before the fold
+  // (hysteresis): solved back at u_x from the new state, the same branch returns to x,
+  // the other one stays away from it.
+  const Vec at_u = tracker_->state();
+  const TrackResult& back = tracker_->Resume(at_u, u_x);
+  const bool same = back.summary.IsSolutionUsable() &&
+                    (tracker_->state() - x).lpNorm<Eigen::Infinity>() <= jump_threshold_;
+  tracker_->Resume(at_u, u);  // the tracker holds the state at u, as its callers expect
+  return same;
 }
 
 bool FoldSearch::Bracket(const Vec& x, const Vec& u, const Vec& d, double reach, double step,
@@ -44,7 +56,7 @@ bool FoldSearch::Bracket(const Vec& x, const Vec& u, const Vec& d, double reach,
   double hi = -1.0;
   for (int k = 1; k <= kMaxMarchSteps; ++k) {
     const double s = std::min(reach, k * step);
-    if (OnBranch(*x_lo, u + s * d)) {
+    if (OnBranch(*x_lo, u + *s_lo * d, u + s * d)) {
       *s_lo = s;
       *x_lo = tracker_->state();
       if (s >= reach) return false;
@@ -56,7 +68,7 @@ bool FoldSearch::Bracket(const Vec& x, const Vec& u, const Vec& d, double reach,
   if (hi < 0.0) return false;
   for (int it = 0; it < kMaxBisections && hi - *s_lo > tol; ++it) {
     const double mid = 0.5 * (*s_lo + hi);
-    if (OnBranch(*x_lo, u + mid * d)) {
+    if (OnBranch(*x_lo, u + *s_lo * d, u + mid * d)) {
       *s_lo = mid;
       *x_lo = tracker_->state();
     } else {
@@ -64,7 +76,7 @@ bool FoldSearch::Bracket(const Vec& x, const Vec& u, const Vec& d, double reach,
     }
   }
   // Leave the tracker on the other branch just past the fold (the post-snap model).
-  if (OnBranch(*x_lo, u + hi * d)) return false;  // the fold moved under round-off
+  if (OnBranch(*x_lo, u + *s_lo * d, u + hi * d)) return false;  // the fold moved under round-off
   *s_hi = hi;
   return true;
 }
@@ -131,7 +143,7 @@ FoldPrediction FoldSearch::Find(const Vec& x, const Vec& u, const Vec& d,
       int found = 0;
       for (int side = 0; side < 2; ++side) {
         const Vec start = p.u_before - lat * n_full + (side == 0 ? lat : -lat) * t_full;
-        if (!OnBranch(p.x_before, start)) break;
+        if (!OnBranch(p.x_before, p.u_before, start)) break;
         const Vec xs = tracker_->state();
         double lo = 0.0, hi = 0.0;
         Vec x_side;

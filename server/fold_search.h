@@ -55,8 +55,9 @@ class FoldSearch {
   const Model& model() const { return tracker_->model(); }
 
  private:
-  // Solves at u from x; true when the state stayed on x's branch.
-  bool OnBranch(const Vec& x, const Vec& u);
+  // Solves at u from x, the equilibrium at u_x; true when the state stayed on x's
+  // branch. The tracker then holds the state at u.
+  bool OnBranch(const Vec& x, const Vec& u_x, const Vec& u);
   // March from (x, u) along d by `step` up to `reach`, then bisect to `tol`: the last
   // parameter on the branch (*s_lo, its state *x_lo) and the first past it (*s_hi; the
   // tracker then holds the snapped state). False when no fold within reach.
