@@ -96,7 +96,10 @@ const DRIVERS = {
       // protocol for Firefox.
       return puppeteer.launch({
         browser: 'firefox', executablePath: '/usr/bin/firefox-esr', headless: true,
-        timeout: 60000, protocolTimeout: 120000,
+        // Start-up allowance, not a speed figure: on a fresh machine (CI) or a loaded one
+        // the first starts of a new Firefox took over 60 s here before its BiDi endpoint
+        // appeared (2 failures in a row right after `apt-get install firefox-esr`, then a pass).
+        timeout: 180000, protocolTimeout: 180000,
         extraPrefsFirefox: {
           // WebGL on whatever GL the display has, blocklisted or not (here Mesa's llvmpipe,
           // which gave WebGL 2 with and without this pref; without a display, none).
