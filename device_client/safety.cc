@@ -243,6 +243,37 @@ namespace {
 void Bump(std::atomic<uint64_t>& c) { c.fetch_add(1, std::memory_order_relaxed); }
 }  // namespace
 
+Limited LimitVector(double v[3], double max_norm, double max_step, double last[3]) {
+  Limited l;
+  const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (!std::isfinite(n)) {
+    // An overflow upstream (absurd but finite inputs): aim at zero through the slew limit.
+    v[0] = v[1] = v[2] = 0.0;
+    l.clamped = true;
+  } else if (n > max_norm) {
+    const double s = max_norm / n;
+    for (int k = 0; k < 3; ++k) v[k] *= s;
+    l.clamped = true;
+  }
+  double d[3], dn2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    d[k] = v[k] - last[k];
+    dn2 += d[k] * d[k];
+  }
+  if (dn2 > max_step * max_step) {
+    const double s = max_step / std::sqrt(dn2);
+    for (int k = 0; k < 3; ++k) v[k] = last[k] + s * d[k];
+    l.slew_limited = true;
+  }
+  // Last line of defence: never a non-finite output.
+  if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+    v[0] = v[1] = v[2] = 0.0;
+    l.nonfinite = true;
+  }
+  for (int k = 0; k < 3; ++k) last[k] = v[k];
+  return l;
+}
+
 void ForceSafety::Step(const double position_m[3], const double orientation[4], bool pose_ok,
                        const LocalModel* model, int64_t now_us, SafetyOutput* out) {
   *out = SafetyOutput{};
@@ -292,19 +323,19 @@ void ForceSafety::Step(const double position_m[3], const double orientation[4], 
     Bump(counters_.poses_rejected);
     // No trusted position to evaluate the model at: the force only fades, toward zero at
     // the slew limit (the envelope |F(t) - F(t-1)| <= max rate x tick holds here too), so a
-    // glitching encoder neither pushes on nor jerks the hand.
-    const double step = limits_.max_force_rate_n_per_s * limits_.tick_period_s;
-    const double n = std::sqrt(last_force_n_[0] * last_force_n_[0] +
-                               last_force_n_[1] * last_force_n_[1] +
-                               last_force_n_[2] * last_force_n_[2]);
-    const double keep = (std::isfinite(n) && n > step) ? (n - step) / n : 0.0;
-    for (int k = 0; k < 3; ++k) {
-      last_force_n_[k] *= keep;
-      out->force_n[k] = last_force_n_[k];
-    }
+    // glitching encoder neither pushes on nor jerks the hand. (The fade is not counted as
+    // a slew-limit event: it is the pose rejection, counted above.)
+    double f[3] = {0.0, 0.0, 0.0};
+    LimitVector(f, limits_.max_force_n, limits_.max_force_rate_n_per_s * limits_.tick_period_s,
+                last_force_n_);
+    for (int k = 0; k < 3; ++k) out->force_n[k] = f[k];
     // The torque the same way, at its own slew limit.
-    double t[3] = {0.0, 0.0, 0.0};
-    if (torque_output_) RenderTorque(t, out);
+    if (torque_output_) {
+      double t[3] = {0.0, 0.0, 0.0};
+      LimitVector(t, limits_.max_torque_nm, limits_.max_torque_rate_nm_per_s * limits_.tick_period_s,
+                  last_torque_nm_);
+      for (int k = 0; k < 3; ++k) out->torque_nm[k] = t[k];
+    }
     return;
   }
 
@@ -319,47 +350,12 @@ void ForceSafety::Step(const double position_m[3], const double orientation[4], 
     }
   }
 
-  // |F| <= max force.
-  double norm = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-  if (!std::isfinite(norm)) {
-    // f0 + K du overflowed (absurd but finite inputs): no direction to keep, so aim at
-    // zero and let the slew limit take the force there.
-    for (double& fi : f) fi = 0.0;
-    out->clamped = true;
-    Bump(counters_.force_clamps);
-  } else if (norm > limits_.max_force_n) {
-    const double s = limits_.max_force_n / norm;
-    for (double& fi : f) fi *= s;
-    out->clamped = true;
-    Bump(counters_.force_clamps);
-  }
-
-  // |F - F_previous| <= max rate * tick period.
-  const double max_step = limits_.max_force_rate_n_per_s * limits_.tick_period_s;
-  double d[3], dn2 = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    d[k] = f[k] - last_force_n_[k];
-    dn2 += d[k] * d[k];
-  }
-  if (dn2 > max_step * max_step) {
-    const double s = max_step / std::sqrt(dn2);
-    for (int k = 0; k < 3; ++k) f[k] = last_force_n_[k] + s * d[k];
-    out->slew_limited = true;
-    Bump(counters_.slew_limits);
-  }
-
-  // Last line of defence: never a non-finite force (e.g. an overflow in f0 + K du).
-  bool finite = true;
-  for (double fi : f) finite = finite && std::isfinite(fi);
-  if (!finite) {
-    Bump(counters_.nonfinite_outputs);
-    for (double& fi : f) fi = 0.0;
-  }
-  for (int k = 0; k < 3; ++k) {
-    out->force_n[k] = f[k];
-    last_force_n_[k] = f[k];
-  }
-  norm = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+  // |F| <= max force, |F - F_previous| <= max rate * tick, never non-finite.
+  const Limited lf = LimitVector(f, limits_.max_force_n,
+                                 limits_.max_force_rate_n_per_s * limits_.tick_period_s, last_force_n_);
+  Count(lf, &out->clamped, &out->slew_limited, counters_.force_clamps, counters_.slew_limits);
+  for (int k = 0; k < 3; ++k) out->force_n[k] = f[k];
+  const double norm = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
   if (norm > max_force_n_.load(std::memory_order_relaxed)) {
     max_force_n_.store(norm, std::memory_order_relaxed);
   }
@@ -368,41 +364,24 @@ void ForceSafety::Step(const double position_m[3], const double orientation[4], 
 }
 
 void ForceSafety::RenderTorque(double t[3], SafetyOutput* out) {
-  // Non-finite (an overflow of τ0 + K6 d): aim at zero, through the slew limit.
-  double tn2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
-  if (!std::isfinite(tn2)) {
-    t[0] = t[1] = t[2] = 0.0;
-    tn2 = 0.0;
+  const Limited lt = LimitVector(t, limits_.max_torque_nm,
+                                 limits_.max_torque_rate_nm_per_s * limits_.tick_period_s, last_torque_nm_);
+  Count(lt, &out->torque_clamped, &out->torque_slew_limited, counters_.torque_clamps,
+        counters_.torque_slew_limits);
+  for (int k = 0; k < 3; ++k) out->torque_nm[k] = t[k];
+}
+
+void ForceSafety::Count(const Limited& l, bool* clamped, bool* slewed, std::atomic<uint64_t>& clamps,
+                        std::atomic<uint64_t>& slews) {
+  if (l.clamped) {
+    *clamped = true;
+    Bump(clamps);
   }
-  const double tn = std::sqrt(tn2);
-  if (tn > limits_.max_torque_nm) {
-    const double s = limits_.max_torque_nm / tn;
-    for (int k = 0; k < 3; ++k) t[k] *= s;
-    out->torque_clamped = true;
-    Bump(counters_.torque_clamps);
+  if (l.slew_limited) {
+    *slewed = true;
+    Bump(slews);
   }
-  const double max_step = limits_.max_torque_rate_nm_per_s * limits_.tick_period_s;
-  double d[3], dn2 = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    d[k] = t[k] - last_torque_nm_[k];
-    dn2 += d[k] * d[k];
-  }
-  if (dn2 > max_step * max_step) {
-    const double s = max_step / std::sqrt(dn2);
-    for (int k = 0; k < 3; ++k) t[k] = last_torque_nm_[k] + s * d[k];
-    out->torque_slew_limited = true;
-    Bump(counters_.torque_slew_limits);
-  }
-  bool finite = true;
-  for (int k = 0; k < 3; ++k) finite = finite && std::isfinite(t[k]);
-  if (!finite) {
-    Bump(counters_.nonfinite_outputs);
-    for (int k = 0; k < 3; ++k) t[k] = 0.0;
-  }
-  for (int k = 0; k < 3; ++k) {
-    out->torque_nm[k] = t[k];
-    last_torque_nm_[k] = t[k];
-  }
+  if (l.nonfinite) Bump(counters_.nonfinite_outputs);
 }
 
 }  // namespace snapthread::device

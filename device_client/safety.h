@@ -122,6 +122,18 @@ ModelVerdict PrepareModel(const force_model_t& msg, int64_t receive_us,
 void EvaluateLocalModel(const LocalModel& model, const double position_m[3], const double orientation[4],
                         double force_n[3], double torque_nm[3]);
 
+// The envelope one rendered vector (the force, or the torque) goes through each tick, in
+// this order: a non-finite v aims at zero (counted as a clamp: no direction to keep);
+// |v| <= max_norm; |v - last| <= max_step (the slew limit per tick); a non-finite result
+// (which the steps above cannot make from a finite last) is zeroed. v is changed in
+// place and last becomes it. Fixed size, no allocation (the servo tick calls it).
+struct Limited {
+  bool clamped = false;       // the norm limit acted (or v was non-finite)
+  bool slew_limited = false;  // the slew limit acted
+  bool nonfinite = false;     // the result was zeroed: must never happen
+};
+Limited LimitVector(double v[3], double max_norm, double max_step, double last[3]);
+
 // Counters written by the servo thread, read by any thread.
 struct SafetyCounters {
   std::atomic<uint64_t> force_clamps{0};       // ticks where |F| was clamped
@@ -179,6 +191,9 @@ class ForceSafety {
   SafetyLimits limits_;
   // The torque half of Step: τ (model, faded) -> clamped, slew-limited, finite.
   void RenderTorque(double t[3], SafetyOutput* out);
+  // A LimitVector verdict into the tick's flags and the counters.
+  void Count(const Limited& l, bool* clamped, bool* slewed, std::atomic<uint64_t>& clamps,
+             std::atomic<uint64_t>& slews);
 
   bool has_orientation_;
   bool torque_output_;

@@ -288,5 +288,40 @@ TEST(DeviceWrenchSafetyTest, SimPathRollsAndKeepsTheCommandedTorque) {
   EXPECT_EQ(device.last_torque_nm()[2], 0.01);
 }
 
+// The one envelope the force and the torque both go through (LimitVector): the norm
+// clamp, then the slew limit from the last output, a non-finite input aimed at zero
+// through the slew limit, and last updated to the output.
+TEST(DeviceEnvelopeTest, LimitVectorClampsSlewsAndNeverPassesNonFinite) {
+  double last[3] = {0.0, 0.0, 0.0};
+  double v[3] = {6.0, 8.0, 0.0};  // |v| = 10 > 3: clamped to (1.8, 2.4, 0), then slewed by 1
+  Limited l = LimitVector(v, 3.0, 1.0, last);
+  EXPECT_TRUE(l.clamped);
+  EXPECT_TRUE(l.slew_limited);
+  EXPECT_FALSE(l.nonfinite);
+  EXPECT_NEAR(v[0], 0.6, 1e-15);
+  EXPECT_NEAR(v[1], 0.8, 1e-15);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(last[k], v[k]);
+  // Within both limits: passed as it is.
+  double w[3] = {1.0, 1.2, 0.1};
+  l = LimitVector(w, 3.0, 1.0, last);
+  EXPECT_FALSE(l.clamped || l.slew_limited || l.nonfinite);
+  EXPECT_EQ(w[0], 1.0);
+  EXPECT_EQ(w[2], 0.1);
+  // NaN and inf: no direction to keep; the output walks to zero at the slew limit.
+  double bad[3] = {kNaN, 1.0, std::numeric_limits<double>::infinity()};
+  l = LimitVector(bad, 3.0, 0.5, last);
+  EXPECT_TRUE(l.clamped);
+  EXPECT_TRUE(l.slew_limited);
+  EXPECT_FALSE(l.nonfinite);
+  const double before = std::sqrt(1.0 + 1.44 + 0.01);
+  EXPECT_NEAR(Norm(bad), before - 0.5, 1e-12);
+  for (double x : bad) EXPECT_TRUE(std::isfinite(x));
+  // Overflowing arithmetic cannot leak: a huge finite last and a huge step.
+  double huge_last[3] = {1e308, 1e308, 0.0};
+  double huge[3] = {-1e308, -1e308, 0.0};
+  l = LimitVector(huge, 1e308, 1e308, huge_last);
+  for (double x : huge) EXPECT_TRUE(std::isfinite(x));
+}
+
 }  // namespace
 }  // namespace snapthread::device
