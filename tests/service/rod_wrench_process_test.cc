@@ -95,7 +95,8 @@ TEST(RodWrenchProcess, DeviceRendersTheTwistTorqueBeforeTheBuckle) {
 
   auto dev = test_support::ReadJsonNumbers(dir + "/device.json");
   ASSERT_GT(dev.count("ticks"), 0u);
-  EXPECT_GT(dev["wrench_models"], 0.5 * dev["ticks"]) << device.Out();
+  // Models per tick is the server's solve speed: a slower (sanitized) build divides it.
+  EXPECT_GT(dev["wrench_models"], 0.5 / test_support::SpeedScale() * dev["ticks"]) << device.Out();
   EXPECT_EQ(dev["wrench_models"], dev["models_received"]);
   EXPECT_EQ(dev["nonfinite_outputs"], 0);
   EXPECT_GT(dev["torque_clamps"], 0);

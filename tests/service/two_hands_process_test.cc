@@ -85,7 +85,8 @@ TEST(TwoHandsProcess, EachHandGetsItsOwnModelsAtServoRate) {
                 dev["tick_rate_hz"], dev["models_received"], 100.0 * dev["models_received"] / dev["ticks"],
                 dev["models_rejected"]);
     EXPECT_GT(dev["tick_rate_hz"], 900.0) << grasp;
-    EXPECT_GT(dev["models_received"], 0.8 * dev["ticks"]) << grasp;
+    // Models per tick is the server's solve speed: a slower (sanitized) build divides it.
+    EXPECT_GT(dev["models_received"], 0.8 / test_support::SpeedScale() * dev["ticks"]) << grasp;
     // A model for the other hand would answer no pose of this one: none got through.
     EXPECT_EQ(dev["models_rejected"], 0) << grasp;
     EXPECT_EQ(dev["nonfinite_outputs"], 0) << grasp;

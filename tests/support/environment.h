@@ -21,9 +21,11 @@ std::string ScenePath(const std::string& file);  // SourceDir()/scenes/file
 std::string UniqueSession(const std::string& prefix);
 
 // $SNAPTHREAD_SPEED_SCALE (default 1, at least 1): how many times slower than the Release
-// build this build runs; deploy/test.sh sets it for the sanitizer run. Only wall-clock
-// thresholds that are about speed (a time budget) are multiplied by it, never a safety
-// property (|F| limits, finiteness, ordering, rejection counts).
+// build this build runs; deploy/test.sh sets it for the sanitizer run (16: the rod's
+// sweep takes 14x the CPU time under ASan + UBSan). Only thresholds that are about speed
+// are scaled by it (a time budget, a start-up-and-refusal time, models per servo tick,
+// shapes per second), never a safety property (|F| limits, finiteness, ordering,
+// rejection counts, the servo's own tick rate).
 double SpeedScale();
 
 // The whole file ("" when it cannot be read).
