@@ -30,6 +30,7 @@ using V3 = Eigen::Vector3d;
 struct KnotRun {
   std::map<int, std::vector<V3>> shapes;           // step -> nodes
   std::vector<std::map<std::string, double>> rows;  // sweep CSV, numeric columns
+  std::vector<std::string> terminations;            // sweep CSV, the solver's termination
 };
 
 KnotRun SweepKnot(const test_support::ScopedTempDir& dir) {
@@ -61,7 +62,10 @@ KnotRun SweepKnot(const test_support::ScopedTempDir& dir) {
     std::stringstream ls(line);
     std::map<std::string, double> row;
     size_t k = 0;
-    for (std::string v; std::getline(ls, v, ',') && k < names.size(); ++k) row[names[k]] = std::atof(v.c_str());
+    for (std::string v; std::getline(ls, v, ',') && k < names.size(); ++k) {
+      row[names[k]] = std::atof(v.c_str());
+      if (names[k] == "termination") run.terminations.push_back(v);
+    }
     run.rows.push_back(row);
   }
   return run;
@@ -161,6 +165,14 @@ TEST_F(KnotOverhand, HandsForcesBalance) {
   ASSERT_GT(fmax, 0.0);
   for (size_t k = 0; k < run_->rows.size(); ++k)
     EXPECT_LE((f(run_->rows[k], "f") + f(run_->rows[k], "f2")).norm(), 1e-5 * fmax) << "row " << k;
+}
+
+// Every row is an equilibrium: the solver converged (snaps included), none ran out of
+// iterations or failed in its linear solver.
+TEST_F(KnotOverhand, EveryRowConverges) {
+  ASSERT_EQ(run_->terminations.size(), run_->rows.size());
+  for (size_t k = 0; k < run_->terminations.size(); ++k)
+    EXPECT_EQ(run_->terminations[k], "converged") << "row " << k;
 }
 
 }  // namespace
