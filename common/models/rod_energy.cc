@@ -21,13 +21,13 @@ namespace {
 inline void LowerRank1(double s, const Vec8& v, Mat8* h) {
   for (int c = 0; c < 8; ++c) {
     const double sc = s * v[c];
-    for (int r = c; r < 8; ++r) (*h)(r, c) += sc * v[r];
+    (*h).col(c) += sc * v;
   }
 }
 // v wᵀ + w vᵀ.
 inline void LowerRank2(const Vec8& v, const Vec8& w, Mat8* h) {
   for (int c = 0; c < 8; ++c) {
-    for (int r = c; r < 8; ++r) (*h)(r, c) += v[r] * w[c] + w[r] * v[c];
+    (*h).col(c) += w[c] * v + v[c] * w;
   }
 }
 // s M into block (j, c) of the edge coordinates (j >= c; a diagonal block's lower part).
