@@ -3,6 +3,7 @@
 // frame computed once per evaluation (PrepareEdges), then the chain rule through the grasp
 // map for the terms that touch a grasp, then the assembly (hessian_assembly.h).
 #include <algorithm>
+#include <cstring>
 
 #include "models/rod_model.h"
 
@@ -18,6 +19,26 @@ constexpr int kMaxVars = internal::HessianAssembly::kMaxTermVars;
 int GraspCoordinate(int code) { return code <= -9 ? -9 - code : -2 - code; }
 
 }  // namespace
+
+bool RodModel::StateKey::Matches(const Vec& x1, const Vec& u1) const {
+  return valid && x1.size() == x.size() && u1.size() == u.size() &&
+         std::memcmp(x1.data(), x.data(), sizeof(double) * x.size()) == 0 &&
+         std::memcmp(u1.data(), u.data(), sizeof(double) * u.size()) == 0;
+}
+
+void RodModel::StateKey::Set(const Vec& x1, const Vec& u1) {
+  valid = x1.size() == x.size() && u1.size() == u.size();  // sized at construction
+  if (valid) {
+    x = x1;
+    u = u1;
+  }
+}
+
+void RodModel::InvalidateCaches() {
+  grasp_cache_valid_ = false;
+  energy_key_.valid = false;
+  band_key_.valid = false;
+}
 
 void RodModel::PrepareEdges(const Vec& x, const GraspMaps& gm, bool want_h, bool control_terms_only) const {
   auto edge = [&](int j) {
@@ -37,7 +58,15 @@ void RodModel::PrepareEdges(const Vec& x, const GraspMaps& gm, bool want_h, bool
 double RodModel::StretchEnergy(int j, Eigen::Matrix<double, 6, 1>* g, Eigen::Matrix<double, 6, 6>* h) const {
   // ½ EA (|e|/ℓ - 1)² ℓ = (EA / 2ℓ) (|e| - ℓ)²  [DER (2) with the stretching of DVT §4]
   // (the segment from 0 to e: e - 0 is e exactly).
-  return internal::StretchTerm<3>(V3::Zero(), edges_[j].e, 0.5 * p_.stretch_stiffness / rest_, rest_, g, h);
+  const double e = internal::StretchTerm<3>(V3::Zero(), edges_[j].e, 0.5 * p_.stretch_stiffness / rest_, rest_, g, h);
+  if (h != nullptr) {
+    // Its lower triangle mirrored: symmetric to the bit (the outer product w wᵀ scaled is
+    // not always), so E_xx is, and its lower band gives back the whole matrix.
+    for (int c = 0; c < 6; ++c) {
+      for (int r = c + 1; r < 6; ++r) (*h)(c, r) = (*h)(r, c);
+    }
+  }
+  return e;
 }
 
 template <class F>
@@ -69,7 +98,7 @@ double RodModel::Local(int t, const GraspMaps& gms, bool want_h, F&& f) const {
       hy.block<3, 3>(0, 0) = h00;
       hy.block<3, 3>(3, 0) = h10 - h00;
       hy.block<3, 3>(6, 0) = -h10;
-      hy.block<3, 3>(3, 3) = h00 - h10 - h10.transpose() + h11;
+      hy.block<3, 3>(3, 3) = (h00 + h11) - (h10 + h10.transpose());  // symmetric to the bit
       hy.block<3, 3>(6, 3) = h10 - h11;
       hy.block<3, 3>(6, 6) = h11;
       hy.block<3, 3>(0, 3) = hy.block<3, 3>(3, 0).transpose();
@@ -150,6 +179,8 @@ double RodModel::Local(int t, const GraspMaps& gms, bool want_h, F&& f) const {
 }
 
 double RodModel::Energy(const Vec& x, const Vec& u) const {
+  // The energy of the last state evaluated (the same operations gave it: the same bits).
+  if (energy_key_.Matches(x, u)) return energy_cache_;
   const GraspMaps gm = Grasp(u, false);
   PrepareEdges(x, gm, false, false);
   double e = 0.0;
@@ -159,6 +190,8 @@ double RodModel::Energy(const Vec& x, const Vec& u) const {
                      : StretchEnergy(i, nullptr, nullptr);
   }
   if (contact_.enabled()) e += contact_.Energy(ContactNodes(x, gm));
+  energy_key_.Set(x, u);
+  energy_cache_ = e;
   return e;
 }
 
@@ -177,6 +210,20 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
   // StoreHessian: every elastic slot is reached by an elastic term first, so no clearing
   // pass; slots only a contact pair reaches are cleared when contact is on.
   double* values = assembly_.Values(h, contact_.enabled());
+  if (band_key_.Matches(x, u)) {
+    // At the state of the last band (a solver that factorised it in place asks for the
+    // compressed matrix there): its values, read back (the sign of a zero aside, model.h).
+    const int b = assembly_.Bandwidth();
+    const int* outer = h->outerIndexPtr();
+    const int* inner = h->innerIndexPtr();
+    for (int j = 0; j < nx_; ++j) {
+      for (int k = outer[j]; k < outer[j + 1]; ++k) {
+        const int r = std::max(inner[k], j), c = std::min(inner[k], j);
+        values[k] = band_cache_[static_cast<size_t>(r) * (b + 1) + c - r + b];
+      }
+    }
+    return;
+  }
   const GraspMaps& gm = GraspDerivatives(u);
   PrepareEdges(x, gm, true, false);
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
@@ -208,6 +255,8 @@ double RodModel::EnergyGradientAndHessian(const Vec& x, const Vec& u, Vec* g, Sp
     contact_.AddHessian(nodes, values);
     e += contact_.Energy(nodes);
   }
+  energy_key_.Set(x, u);
+  energy_cache_ = e;
   return e;
 }
 
@@ -227,6 +276,10 @@ bool RodModel::EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, 
     });
   }
   *energy = e;
+  energy_key_.Set(x, u);
+  energy_cache_ = e;
+  std::copy(band, band + band_cache_.size(), band_cache_.begin());
+  band_key_.Set(x, u);
   return true;
 }
 

@@ -56,7 +56,12 @@ RodModel::RodModel(const RodParams& params) : p_(params) {
   assembly_ = internal::HessianAssembly(nx_, nu_);
   edges_.resize(n_);
   grasp_cache_u_ = Vec::Zero(nu_);
+  for (StateKey* key : {&energy_key_, &band_key_}) {
+    key->x = Vec::Zero(nx_);
+    key->u = Vec::Zero(nu_);
+  }
   BuildTerms();
+  band_cache_.assign(static_cast<size_t>(nx_) * (assembly_.Bandwidth() + 1), 0.0);
   ResetHistory();
 }
 
@@ -64,7 +69,7 @@ void RodModel::ResetHistory() {
   // Reference frames of the rest rod: straight along the clamp, no turns at the grasp.
   sources_.assign(n_, FrameSource{p_.clamp_rotation.col(0), p_.clamp_rotation.col(1)});
   twist_near_.assign(n_, 0.0);
-  grasp_cache_valid_ = false;
+  InvalidateCaches();
   grasp_theta_near_ = 0.0;
   start_theta_near_ = 0.0;
   const GraspMaps gm = Grasp(Vec::Zero(nu_), false);
@@ -248,7 +253,7 @@ void RodModel::AcceptState(const Vec& x, const Vec& u) {
     sources_[j].t = t;
     sources_[j].a = (a - a.dot(t) * t).normalized();
   }
-  grasp_cache_valid_ = false;  // the grasp maps depend on the frames and angles moved here
+  InvalidateCaches();  // the grasp maps and energies depend on the frames and angles moved here
 }
 
 // ---------------------------------------------------------------------------------

@@ -197,6 +197,20 @@ class RodModel final : public Model {
   mutable GraspMaps grasp_cache_;
   mutable Vec grasp_cache_u_;
   mutable bool grasp_cache_valid_ = false;
+  // The last state whose energy was evaluated (Energy, or a fused pass), and the band of the
+  // last EnergyGradientAndBandHessian with its state: a solver asks for E again at a state
+  // it has evaluated, and for the compressed E_xx at the state of a band it factorised
+  // (rod_evaluate.cc). Invalidated with the grasp maps (the lagged data moved).
+  struct StateKey {
+    Vec x, u;
+    bool valid = false;
+    bool Matches(const Vec& x1, const Vec& u1) const;
+    void Set(const Vec& x1, const Vec& u1);
+  };
+  mutable StateKey energy_key_, band_key_;
+  mutable double energy_cache_ = 0.0;
+  mutable std::vector<double> band_cache_;
+  void InvalidateCaches();
   // Lagged data (AcceptState): per edge the frame source, per vertex the reference twist,
   // and the grasp's material angle, each the value at the last accepted state.
   std::vector<rod::FrameSource> sources_;
