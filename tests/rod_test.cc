@@ -6,13 +6,10 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <limits>
 #include <memory>
 #include <numbers>
 #include <random>
 #include <string>
-#include <vector>
 
 #include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
@@ -266,119 +263,6 @@ TEST(RodModel, HessianRefillDoesNotAllocate) {
   EXPECT_TRUE(std::isfinite(e));
   EXPECT_EQ((Mat(h) - first).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(model.HessianBandwidth(), 10);  // a vertex spans nodes i-1 .. i+1
-}
-
-// E_xx straight into the banded factorisation's storage (model.h): every lower-triangle
-// entry of the pattern at its band slot (over NaN-filled storage, so each is written) with
-// Hessian()'s value, zeros elsewhere, E and E_x of Energy() and Gradient() to the last bit;
-// another bandwidth, or self-contact (its pairs go through the compressed matrix), is
-// declined without writing.
-TEST(RodModel, BandAssemblyHoldsHessiansValues) {
-  std::mt19937 rng(17);
-  for (bool free_start : {false, true}) {
-    RodParams p = BentParams(9);
-    p.free_start = free_start;
-    RodModel model(p);
-    Vec x, u;
-    if (!free_start) {
-      const RandomState s = RandomBentState(&model, &rng);
-      x = s.x;
-      u = s.u;
-    } else {  // two grasps: the first near the clamp's pose, the second further on, turned
-      u.resize(12);
-      u << p.clamp_position, 0.1, -0.2, 0.05, p.clamp_position + 0.7 * p.length * p.clamp_rotation.col(0),
-          0.3, -0.5, 1.2;
-      std::uniform_real_distribution<double> d(-1.0, 1.0);
-      x = model.InitialState(u);
-      for (int i = 0; i < x.size(); ++i) x[i] += 0.03 * d(rng);
-    }
-    SparseMatrix h = model.HessianPattern();
-    Vec g;
-    model.Hessian(x, u, &h);
-    model.Gradient(x, u, &g);
-    const double e = model.Energy(x, u);
-    const int b = model.HessianBandwidth();
-    const int n = model.NumStates();
-    std::vector<double> band(static_cast<size_t>(n) * (b + 1), std::numeric_limits<double>::quiet_NaN());
-    Vec g4;
-    double e4 = 0.0;
-    ASSERT_TRUE(model.EnergyGradientAndBandHessian(x, u, &g4, band.data(), b, &e4));
-    EXPECT_EQ(std::memcmp(&e, &e4, sizeof e), 0) << e << " vs " << e4;
-    ASSERT_EQ(g4.size(), g.size());
-    EXPECT_EQ(std::memcmp(g.data(), g4.data(), sizeof(double) * g.size()), 0);
-    std::vector<char> in_pattern(band.size(), 0);
-    for (int j = 0; j < n; ++j) {
-      for (SparseMatrix::InnerIterator it(h, j); it; ++it) {
-        if (it.row() < j) continue;
-        const size_t slot = static_cast<size_t>(it.row()) * (b + 1) + j - it.row() + b;
-        in_pattern[slot] = 1;
-        EXPECT_EQ(band[slot], it.value()) << "E_xx(" << it.row() << ", " << j << ")";
-      }
-    }
-    for (size_t k = 0; k < band.size(); ++k) {
-      if (!in_pattern[k]) {
-        EXPECT_EQ(band[k], 0.0) << "slot " << k << " outside the pattern";
-      }
-    }
-    // The compressed matrix asked for at the band's state (a solver that factorised the
-    // band in place does): the same values.
-    SparseMatrix h2 = model.HessianPattern();
-    model.Hessian(x, u, &h2);
-    for (int j = 0; j < n; ++j) {
-      for (int k = h.outerIndexPtr()[j]; k < h.outerIndexPtr()[j + 1]; ++k) {
-        EXPECT_EQ(h2.valuePtr()[k], h.valuePtr()[k]) << "E_xx(" << h.innerIndexPtr()[k] << ", " << j << ")"
-                                                     << (free_start ? " without a clamp" : "");
-      }
-    }
-    std::fill(band.begin(), band.end(), std::numeric_limits<double>::quiet_NaN());
-    band.resize(static_cast<size_t>(n) * (b + 2), std::numeric_limits<double>::quiet_NaN());
-    EXPECT_FALSE(model.EnergyGradientAndBandHessian(x, u, &g4, band.data(), b + 1, &e4));
-    for (double v : band) EXPECT_TRUE(std::isnan(v)) << "a declining model wrote the band";
-  }
-  RodParams pc = BentParams(9);
-  pc.contact.enabled = true;
-  RodModel contact(pc);
-  const RandomState s = RandomBentState(&contact, &rng);
-  const int b = contact.HessianBandwidth();
-  std::vector<double> band(static_cast<size_t>(contact.NumStates()) * (b + 1), std::numeric_limits<double>::quiet_NaN());
-  Vec g;
-  double e = 0.0;
-  EXPECT_FALSE(contact.EnergyGradientAndBandHessian(s.x, s.u, &g, band.data(), b, &e));
-  for (double v : band) EXPECT_TRUE(std::isnan(v)) << "the model with contact wrote the band";
-}
-
-// The grasp maps are kept for the last u (every evaluation of an update asks for the same
-// u) and the energy for the last state, but both depend on the lagged frames: after
-// AcceptState an evaluation at that same state gives what a model with the same history
-// and nothing kept gives, to the last bit.
-TEST(RodModel, GraspMapsFollowTheAcceptedFrames) {
-  std::mt19937 rng(41);
-  const RodParams p = BentParams(8);
-  RodModel kept(p), fresh(p);
-  const RandomPair pair = RandomBentPair(kept, &rng);
-  const RandomState& s = pair.newer;
-  Vec g0, eu0;
-  kept.Gradient(s.x, s.u, &g0);  // fills the cache at s.u against the rest frames
-  kept.ControlGradient(s.x, s.u, &eu0);
-  const double e0 = kept.Energy(s.x, s.u);
-  kept.AcceptState(pair.older.x, pair.older.u);
-  fresh.AcceptState(pair.older.x, pair.older.u);
-  const double e1 = kept.Energy(s.x, s.u), e2 = fresh.Energy(s.x, s.u);
-  EXPECT_NE(e1, e0);
-  EXPECT_EQ(std::memcmp(&e1, &e2, sizeof e1), 0) << e1 << " vs " << e2;
-  Vec g1, g2, eu1, eu2;
-  kept.Gradient(s.x, s.u, &g1);
-  fresh.Gradient(s.x, s.u, &g2);
-  kept.ControlGradient(s.x, s.u, &eu1);
-  fresh.ControlGradient(s.x, s.u, &eu2);
-  EXPECT_GT((g1 - g0).norm(), 0.0);  // the frames moved: the values did change
-  EXPECT_EQ(std::memcmp(g1.data(), g2.data(), sizeof(double) * g1.size()), 0);
-  EXPECT_EQ(std::memcmp(eu1.data(), eu2.data(), sizeof(double) * eu1.size()), 0);
-  kept.ResetHistory();
-  RodModel rest(p);
-  kept.Gradient(s.x, s.u, &g1);
-  rest.Gradient(s.x, s.u, &g2);
-  EXPECT_EQ(std::memcmp(g1.data(), g2.data(), sizeof(double) * g1.size()), 0);
 }
 
 // Rotating and translating everything (clamp, grasp, nodes, and the lagged frames by
