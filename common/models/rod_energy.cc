@@ -16,29 +16,49 @@
 namespace snapthread::rod {
 namespace {
 
-using Mat6 = Eigen::Matrix<double, 6, 6>;
-using Vec6 = Eigen::Matrix<double, 6, 1>;
-
-// Hessian of W·κb with respect to (e0, e1) for a fixed vector W.
-Mat6 ContractedCurvatureHessian(const V3& e0, const V3& e1, double l0, double l1, const V3& t0,
-                                const V3& t1, double chi, const V3& w) {
-  const double f = 2.0 * w.dot(e0.cross(e1)) / chi;
-  Vec6 gn, gchi;
-  gn << 2.0 * e1.cross(w), 2.0 * w.cross(e0);
-  gchi << l1 * t0 + e1, l0 * t1 + e0;
-  Mat6 hn = Mat6::Zero();
-  hn.block<3, 3>(0, 3) = -2.0 * Cross(w);
-  hn.block<3, 3>(3, 0) = 2.0 * Cross(w);
-  Mat6 hchi;
-  hchi.block<3, 3>(0, 0) = (l1 / l0) * (M3::Identity() - t0 * t0.transpose());
-  hchi.block<3, 3>(3, 3) = (l0 / l1) * (M3::Identity() - t1 * t1.transpose());
-  hchi.block<3, 3>(0, 3) = M3::Identity() + t0 * t1.transpose();
-  hchi.block<3, 3>(3, 0) = M3::Identity() + t1 * t0.transpose();
-  const Vec6 gf = (gn - f * gchi) / chi;
-  return (hn - f * hchi - gchi * gf.transpose() - gf * gchi.transpose()) / chi;
+// Lower-triangle accumulation into a symmetric 8x8 (mirrored at the end): a sum's lower
+// triangle is the sum of its pieces' lower triangles, symmetric pieces or not.
+inline void LowerRank1(double s, const Vec8& v, Mat8* h) {
+  for (int c = 0; c < 8; ++c) {
+    const double sc = s * v[c];
+    (*h).col(c) += sc * v;
+  }
+}
+// v wᵀ + w vᵀ.
+inline void LowerRank2(const Vec8& v, const Vec8& w, Mat8* h) {
+  for (int c = 0; c < 8; ++c) {
+    (*h).col(c) += w[c] * v + v[c] * w;
+  }
+}
+// s M into block (j, c) of the edge coordinates (j >= c; a diagonal block's lower part).
+inline void LowerBlock(int j, int c, double s, const M3& m, Mat8* h) {
+  for (int cc = 0; cc < 3; ++cc) {
+    for (int rr = (j == c ? cc : 0); rr < 3; ++rr) (*h)(3 * j + rr, 3 * c + cc) += s * m(rr, cc);
+  }
 }
 
 }  // namespace
+
+void ComputeEdgeFrame(const V3& e, double theta, const FrameSource& s, bool want_h, EdgeFrame* f) {
+  f->e = e;
+  f->theta = theta;
+  f->l = e.norm();
+  f->t = e / f->l;
+  V3 b;
+  ReferenceFrame(s, f->t, &f->a, &b);
+  const double c = std::cos(theta), sn = std::sin(theta);
+  f->m1 = c * f->a + sn * b;
+  f->m2 = -sn * f->a + c * b;
+  const double inv_l = 1.0 / f->l;
+  const double den = 1.0 / (1.0 + s.t.dot(f->t));
+  const V3 ahat = f->t.cross(s.t) * den;  // Â (TwistRate)
+  f->alpha = ahat * inv_l;
+  if (want_h) {
+    // (dÂ/dt)(I - t tᵀ) - Â tᵀ, dÂ/dt = -([t_s]× + Â t_sᵀ)/(1 + t_s·t) (TwistRateJacobian).
+    const M3 da = -(Cross(s.t) + ahat * s.t.transpose()) * den;
+    f->dalpha = (da - (da * f->t + ahat) * f->t.transpose()) * (inv_l * inv_l);
+  }
+}
 
 double ReferenceTwist(const V3& e0, const V3& e1, const FrameSource& s0, const FrameSource& s1,
                       double near) {
@@ -52,93 +72,112 @@ double ReferenceTwist(const V3& e0, const V3& e1, const FrameSource& s0, const F
 double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
                     const FrameSource& s0, const FrameSource& s1, double twist_near,
                     const VertexStiffness& k, Vec8* g, Mat8* h) {
-  const V3 e[2] = {e0, e1};
-  const FrameSource* src[2] = {&s0, &s1};
-  const double th[2] = {theta0, theta1};
-  double l[2];
-  V3 t[2], a[2], m1[2], m2[2];
-  for (int j = 0; j < 2; ++j) {
-    l[j] = e[j].norm();
-    t[j] = e[j] / l[j];
-    V3 b;
-    ReferenceFrame(*src[j], t[j], &a[j], &b);
-    const double c = std::cos(th[j]), s = std::sin(th[j]);
-    m1[j] = c * a[j] + s * b;
-    m2[j] = -s * a[j] + c * b;
-  }
-  const double chi = l[0] * l[1] + e0.dot(e1);
+  EdgeFrame f0, f1;
+  ComputeEdgeFrame(e0, theta0, s0, h != nullptr, &f0);
+  ComputeEdgeFrame(e1, theta1, s1, h != nullptr, &f1);
+  return VertexEnergy(f0, f1, twist_near, k, g, h);
+}
+
+double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
+                    const VertexStiffness& k, Vec8* g, Mat8* h) {
+  const EdgeFrame* f[2] = {&f0, &f1};
+  const V3& e0 = f0.e;
+  const V3& e1 = f1.e;
+  const double chi = f0.l * f1.l + e0.dot(e1);
   const V3 kb = (2.0 / chi) * e0.cross(e1);  // [DER (1)]
-  // Material curvatures of each edge [DER §4.2]: κ^j = (κb·m2_j, -κb·m1_j).
-  double r1[2], r2[2];
+  // Material curvatures of each edge [DER §4.2]: κ^j = (κb·m2_j, -κb·m1_j) = (q_j, -p_j).
+  double p[2], q[2], r1[2], r2[2];
   double bend = 0.0;
   for (int j = 0; j < 2; ++j) {
-    r1[j] = kb.dot(m2[j]) - k.kappa1_bar;
-    r2[j] = -kb.dot(m1[j]) - k.kappa2_bar;
+    p[j] = kb.dot(f[j]->m1);
+    q[j] = kb.dot(f[j]->m2);
+    r1[j] = q[j] - k.kappa1_bar;
+    r2[j] = -p[j] - k.kappa2_bar;
     bend += k.c1 * r1[j] * r1[j] + k.c2 * r2[j] * r2[j];
   }
-  const double mref = AngleAbout(t[1], Transport(t[0], t[1], a[0]), a[1], twist_near);
-  const double tau = theta1 - theta0 + mref;
+  const double mref = AngleAbout(f1.t, Transport(f0.t, f1.t, f0.a), f1.a, twist_near);
+  const double tau = f1.theta - f0.theta + mref;
   // Bending: the mean of the two edges' energies [DER (4)]; twist [DVT (4)].
   const double energy = 0.25 * bend + 0.5 * k.ct * tau * tau;
   if (g == nullptr && h == nullptr) return energy;
 
-  // ∂κb/∂e0, ∂κb/∂e1 [DER §6]: (±2[e]× - κb ∇χᵀ)/χ.
-  M3 jk[2];
-  jk[0] = (-2.0 * Cross(e1) - kb * (l[1] * t[0] + e1).transpose()) / chi;
-  jk[1] = (2.0 * Cross(e0) - kb * (l[0] * t[1] + e0).transpose()) / chi;
-  Vec8 dphi[2], jm1[2], jm2[2], gq[2], gp[2];
-  V3 alpha[2];
-  double p[2], q[2];
+  // ∂κb/∂e_c = (±2[e_other]× - κb ∇χ_cᵀ)/χ [DER §6], ∇χ = (|e1| t0 + e1, |e0| t1 + e0);
+  // applied transposed to a vector v: ((2 e1 × v, -2 e0 × v) - (κb·v) ∇χ)/χ.
+  const double inv_chi = 1.0 / chi;
+  const V3 gchi[2] = {f1.l * f0.t + e1, f0.l * f1.t + e0};
+  Vec8 dphi[2], gq[2], gp[2], jm1[2], jm2[2];
   for (int j = 0; j < 2; ++j) {
-    p[j] = m1[j].dot(kb);
-    q[j] = m2[j].dot(kb);
-    alpha[j] = TwistRate(src[j]->t, t[j]) / l[j];
+    const V3& m1 = f[j]->m1;
+    const V3& m2 = f[j]->m2;
+    jm1[j] << (2.0 * e1.cross(m1) - p[j] * gchi[0]) * inv_chi, (-2.0 * e0.cross(m1) - p[j] * gchi[1]) * inv_chi,
+        0.0, 0.0;
+    jm2[j] << (2.0 * e1.cross(m2) - q[j] * gchi[0]) * inv_chi, (-2.0 * e0.cross(m2) - q[j] * gchi[1]) * inv_chi,
+        0.0, 0.0;
     dphi[j].setZero();
-    dphi[j].segment<3>(3 * j) = alpha[j];
+    dphi[j].segment<3>(3 * j) = f[j]->alpha;
     dphi[j][6 + j] = 1.0;
-    jm1[j] << jk[0].transpose() * m1[j], jk[1].transpose() * m1[j], 0.0, 0.0;
-    jm2[j] << jk[0].transpose() * m2[j], jk[1].transpose() * m2[j], 0.0, 0.0;
-    gq[j] = -p[j] * dphi[j] + jm2[j];
-    gp[j] = q[j] * dphi[j] + jm1[j];
+    gq[j] = jm2[j] - p[j] * dphi[j];
+    gp[j] = jm1[j] + q[j] * dphi[j];
   }
   Vec8 gtau;
-  gtau << kb / (2.0 * l[0]) - alpha[0], kb / (2.0 * l[1]) + alpha[1], -1.0, 1.0;
+  gtau << kb / (2.0 * f0.l) - f0.alpha, kb / (2.0 * f1.l) + f1.alpha, -1.0, 1.0;
   if (g != nullptr) {
     *g = k.ct * tau * gtau;
     for (int j = 0; j < 2; ++j) *g += 0.5 * (k.c1 * r1[j] * gq[j] - k.c2 * r2[j] * gp[j]);
   }
   if (h == nullptr) return energy;
 
+  // The lower triangle of every piece (rod_energy.cc's header for the derivation), then
+  // the mirror.
   Mat8& hh = *h;
-  hh = k.ct * gtau * gtau.transpose();
-  M3 balpha[2];
+  hh.setZero();
+  const double ct = k.ct * tau;
+  LowerRank1(k.ct, gtau, &hh);
   V3 w = V3::Zero();
   for (int j = 0; j < 2; ++j) {
-    hh.noalias() += 0.5 * k.c1 * gq[j] * gq[j].transpose() + 0.5 * k.c2 * gp[j] * gp[j].transpose();
+    const EdgeFrame& fj = *f[j];
+    LowerRank1(0.5 * k.c1, gq[j], &hh);
+    LowerRank1(0.5 * k.c2, gp[j], &hh);
     const double wq = 0.5 * k.c1 * r1[j];   // weight of d²q_j in E
     const double wp = -0.5 * k.c2 * r2[j];  // weight of d²p_j in E
-    w += wq * m2[j] + wp * m1[j];
-    const double inv_l2 = 1.0 / (l[j] * l[j]);
-    const M3 proj = M3::Identity() - t[j] * t[j].transpose();
-    balpha[j] = (TwistRateJacobian(src[j]->t, t[j]) * proj - TwistRate(src[j]->t, t[j]) *
-                 t[j].transpose()) * inv_l2;
-    const Vec8 side = -wq * jm1[j] + wp * jm2[j];
-    hh.noalias() -= (wq * q[j] + wp * p[j]) * dphi[j] * dphi[j].transpose();
-    hh.noalias() += dphi[j] * side.transpose() + side * dphi[j].transpose();
-    hh.block<3, 3>(3 * j, 3 * j) += (wp * q[j] - wq * p[j]) * balpha[j] +
-                                    inv_l2 * kb * (wq * m2[j] + wp * m1[j]).transpose();
+    w += wq * fj.m2 + wp * fj.m1;
+    // -(wq q + wp p) dφ dφᵀ + dφ sideᵀ + side dφᵀ = dφ vᵀ + v dφᵀ, v = side - ½(wq q + wp p) dφ.
+    const Vec8 v = wp * jm2[j] - wq * jm1[j] - (0.5 * (wq * q[j] + wp * p[j])) * dphi[j];
+    LowerRank2(dphi[j], v, &hh);
+    // Block (j, j): the twist-rate derivative (bending and twist) and the (κb·de)(m·de)/|e|²
+    // terms with the twist's -ct κb tᵀ/(2|e|²).
+    const double inv_l2 = 1.0 / (fj.l * fj.l);
+    const M3 blk = (wp * q[j] - wq * p[j] + (j == 0 ? -ct : ct)) * fj.dalpha +
+                   inv_l2 * kb * (wq * fj.m2 + wp * fj.m1 - (0.5 * ct) * fj.t).transpose();
+    LowerBlock(j, j, 1.0, blk, &hh);
   }
-  hh.topLeftCorner<6, 6>() += ContractedCurvatureHessian(e0, e1, l[0], l[1], t[0], t[1], chi, w);
-  // Twist: ct τ ∇²m, from dm above.
-  const double ct = k.ct * tau;
-  for (int j = 0; j < 2; ++j) {
-    for (int c = 0; c < 2; ++c) {
-      hh.block<3, 3>(3 * j, 3 * c) += (ct / (2.0 * l[j])) * jk[c];
+  // Twist: ct ∂(κb/(2|e_j|))/∂e_c, blocks (0, 0), (1, 0), (1, 1).
+  const M3 jk0 = (-2.0 * Cross(e1) - kb * gchi[0].transpose()) * inv_chi;
+  const M3 jk1 = (2.0 * Cross(e0) - kb * gchi[1].transpose()) * inv_chi;
+  LowerBlock(0, 0, ct / (2.0 * f0.l), jk0, &hh);
+  LowerBlock(1, 0, ct / (2.0 * f1.l), jk0, &hh);
+  LowerBlock(1, 1, ct / (2.0 * f1.l), jk1, &hh);
+  // W·d²κb for W = w: the Hessian of W·κb = W·(2 e0 × e1)/χ as a quotient,
+  // (hn - f hchi - gχ gfᵀ - gf gχᵀ)/χ with f = W·κb, gf = (gn - f gχ)/χ.
+  {
+    const double fw = w.dot(kb);
+    Eigen::Matrix<double, 6, 1> gc, gf;
+    gc << gchi[0], gchi[1];
+    gf << 2.0 * e1.cross(w), 2.0 * w.cross(e0);
+    gf = (gf - fw * gc) * inv_chi;
+    for (int c = 0; c < 6; ++c) {
+      for (int r = c; r < 6; ++r) hh(r, c) -= (gc[r] * gf[c] + gf[r] * gc[c]) * inv_chi;
     }
-    hh.block<3, 3>(3 * j, 3 * j) -= (ct / (2.0 * l[j] * l[j])) * kb * t[j].transpose();
+    // hn: block (1, 0) = 2[W]×; hchi: diagonal blocks (|e_o|/|e_j|)(I - t tᵀ), (1, 0) = I + t1 t0ᵀ.
+    const double s = fw * inv_chi;
+    LowerBlock(1, 0, 2.0 * inv_chi, Cross(w), &hh);
+    LowerBlock(1, 0, -s, M3::Identity() + f1.t * f0.t.transpose(), &hh);
+    LowerBlock(0, 0, -s * f1.l / f0.l, M3::Identity() - f0.t * f0.t.transpose(), &hh);
+    LowerBlock(1, 1, -s * f0.l / f1.l, M3::Identity() - f1.t * f1.t.transpose(), &hh);
   }
-  hh.block<3, 3>(0, 0) -= ct * balpha[0];
-  hh.block<3, 3>(3, 3) += ct * balpha[1];
+  for (int c = 0; c < 8; ++c) {
+    for (int r = c + 1; r < 8; ++r) hh(c, r) = hh(r, c);
+  }
   return energy;
 }
 

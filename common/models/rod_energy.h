@@ -63,7 +63,27 @@ struct VertexStiffness {
   double kappa2_bar = 0.0;
 };
 
-// Returns the vertex energy; g (8) and h (8x8, symmetric) may be null.
+// What the two vertices of an edge share (computed once per edge and evaluation): the
+// edge vector e, |e|, the unit tangent t, the reference director a = P_{t_s}^{t} a_s,
+// the material directors m1, m2 at angle θ, the twist rate α = Â/|e| of the reference
+// frame (the dφ of rod_energy.h's header is dθ + α·de) and, for Hessians only, its
+// Jacobian ∂α/∂e = (dÂ/dt)(I - t tᵀ)/|e|² - Â tᵀ/|e|² (rod_frames.h).
+struct EdgeFrame {
+  V3 e, t, a, m1, m2, alpha;
+  double l = 0.0;
+  double theta = 0.0;
+  M3 dalpha;  // set only when asked for (want_h)
+};
+void ComputeEdgeFrame(const V3& e, double theta, const FrameSource& s, bool want_h, EdgeFrame* f);
+
+// Returns the vertex energy of the edges f0 = (e0, θ0), f1 = (e1, θ1); g (8) and h (8x8,
+// symmetric: the lower triangle is computed and mirrored) may be null. h needs both
+// frames computed with want_h. The energy does not depend on whether g and h are asked
+// for (the same operations, the same bits).
+double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
+                    const VertexStiffness& k, Vec8* g, Mat8* h);
+
+// The same from the edges themselves (both frames computed here).
 double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
                     const FrameSource& s0, const FrameSource& s1, double twist_near,
                     const VertexStiffness& k, Vec8* g, Mat8* h);

@@ -11,16 +11,9 @@
 namespace snapthread {
 
 using rod::FrameSource;
-using rod::Jet;
-using rod::JetVec;
 using V3 = Eigen::Vector3d;
 using M3 = Eigen::Matrix3d;
 constexpr int kMaxVars = internal::HessianAssembly::kMaxTermVars;
-
-// The grasp coordinate g of a local code (RodModel::Term): -2 - g, or -9 - g for the grasp
-// of edge 0.
-int GraspCoordinate(int code) { return code <= -9 ? -9 - code : -2 - code; }
-
 bool RodParams::IsValid(std::string* error) const {
   auto fail = [&](const std::string& why) {
     if (error != nullptr) *error = "rod: " + why;
@@ -61,7 +54,14 @@ RodModel::RodModel(const RodParams& params) : p_(params) {
   stiffness_.kappa1_bar = p_.natural_curvature * rest_;
   stiffness_.kappa2_bar = p_.natural_curvature_2 * rest_;
   assembly_ = internal::HessianAssembly(nx_, nu_);
+  edges_.resize(n_);
+  grasp_cache_u_ = Vec::Zero(nu_);
+  for (StateKey* key : {&energy_key_, &band_key_}) {
+    key->x = Vec::Zero(nx_);
+    key->u = Vec::Zero(nu_);
+  }
   BuildTerms();
+  band_cache_.assign(static_cast<size_t>(nx_) * (assembly_.Bandwidth() + 1), 0.0);
   ResetHistory();
 }
 
@@ -69,6 +69,7 @@ void RodModel::ResetHistory() {
   // Reference frames of the rest rod: straight along the clamp, no turns at the grasp.
   sources_.assign(n_, FrameSource{p_.clamp_rotation.col(0), p_.clamp_rotation.col(1)});
   twist_near_.assign(n_, 0.0);
+  InvalidateCaches();
   grasp_theta_near_ = 0.0;
   start_theta_near_ = 0.0;
   const GraspMaps gm = Grasp(Vec::Zero(nu_), false);
@@ -152,66 +153,6 @@ void RodModel::BuildTerms() {
   }
 }
 
-RodModel::GraspMaps RodModel::Grasp(const Vec& u, bool derivatives, bool world_rotation) const {
-  GraspMaps gm;
-  gm.end = OneGrasp(u, false, derivatives, world_rotation);
-  if (p_.free_start) gm.start = OneGrasp(u, true, derivatives, world_rotation);
-  return gm;
-}
-
-// The held end node is xn (x_n, or x_0 for the grasp of edge 0), the inner one xn1
-// (x_{n-1}, or x_1): the edge's tangent t = R e_x points from x_{n-1} to x_n and from x_0
-// to x_1, so the inner node is the held one ∓ ℓ t.
-RodModel::GraspMap RodModel::OneGrasp(const Vec& u, bool at_start, bool derivatives,
-                                      bool world_rotation) const {
-  GraspMap gm;
-  const int offset = p_.free_start && !at_start ? 6 : 0;
-  const V3 pos = u.segment<3>(offset);
-  const V3 phi = u.segment<3>(offset + 3);
-  const M3& r_start = at_start ? p_.clamp_rotation : p_.grasp_rotation;
-  const double side = at_start ? rest_ : -rest_;
-  const FrameSource& src = sources_[at_start ? 0 : n_ - 1];
-  const double near = at_start ? start_theta_near_ : grasp_theta_near_;
-  if (!derivatives) {
-    // Values only (Energy, line searches): the rotation and one angle.
-    const M3 r = rod::ExpMap(phi) * r_start;
-    const V3 t = r.col(0);
-    gm.xn = pos;
-    gm.xn1 = pos + side * t;
-    V3 a, b;
-    rod::ReferenceFrame(src, t, &a, &b);
-    gm.theta = rod::AngleAbout(t, a, r.col(1), near);
-    return gm;
-  }
-  // Derivatives in φ, or in a world rotation δ of the current orientation
-  // (exp([δ]×) R(u), δ = 0) for the torque.
-  const M3 rot = world_rotation ? M3(rod::ExpMap(phi) * r_start) : r_start;
-  const V3 at = world_rotation ? V3::Zero() : phi;
-  const JetVec t = rod::RotateJet(at, rot.col(0));
-  const JetVec m1 = rod::RotateJet(at, rot.col(1));
-  gm.xn = pos;
-  gm.xn1 = pos + side * t.Value();
-  // θ_{n-1}: the angle of m1 about t from the time-parallel reference director
-  // a = P_{t_s}^{t} a_s = a_s - (a_s·t)/(1 + t_s·t) (t_s + t) (a_s ⊥ t_s).
-  const FrameSource& s = src;
-  const Jet k = Dot(s.a, t) * rod::Inverse(Jet::Constant(1.0) + Dot(s.t, t));
-  const JetVec a = JetVec::Constant(s.a) - k * (JetVec::Constant(s.t) + t);
-  const JetVec b = rod::CrossJ(t, a);
-  const Jet theta = rod::Atan2(Dot(b, m1), Dot(a, m1));
-  gm.theta = near + std::remainder(theta.v - near, 2.0 * std::numbers::pi);
-  gm.jac.setZero();
-  for (int c = 0; c < 3; ++c) {
-    gm.jac(c, c) = 1.0;
-    gm.jac(3 + c, c) = 1.0;
-    gm.jac.block<1, 3>(c, 3) = side * t.c[c].g.transpose();
-    gm.hess_phi[c] = side * t.c[c].h;
-    gm.hess_phi[3 + c].setZero();
-  }
-  gm.jac.block<1, 3>(6, 3) = theta.g.transpose();
-  gm.hess_phi[6] = theta.h;
-  return gm;
-}
-
 V3 RodModel::Node(int k, const Vec& x, const GraspMaps& gm) const {
   if (k == 0) return p_.free_start ? gm.start.xn : p_.clamp_position;
   if (k == 1) return p_.free_start ? gm.start.xn1 : V3(p_.clamp_position + rest_ * p_.clamp_rotation.col(0));
@@ -224,203 +165,6 @@ double RodModel::Theta(int j, const Vec& x, const GraspMaps& gm) const {
   if (j == 0) return p_.free_start ? gm.start.theta : 0.0;
   if (j == n_ - 1) return gm.end.theta;
   return x[ThetaIndex(j)];
-}
-
-template <class F>
-void RodModel::Local(int t, const Vec& x, const GraspMaps& gms, bool want_h, F&& f) const {
-  const Term& term = terms_[t];
-  const GraspMap& gm = term.at_start ? gms.start : gms.end;
-  Eigen::Matrix<double, kMaxLocal, 1> gy;
-  Eigen::Matrix<double, kMaxLocal, kMaxLocal> hy;
-  const int i = term.index;
-  if (term.grasp) {
-    // The chain rule below multiplies full fixed-size blocks (no dynamic temporaries).
-    gy.setZero();
-    hy.setZero();
-  }
-  if (!term.vertex) {
-    Eigen::Matrix<double, 6, 1> g6;
-    Eigen::Matrix<double, 6, 6> h6;
-    // ½ EA (|e|/ℓ - 1)² ℓ = (EA / 2ℓ) (|e| - ℓ)²  [DER (2) with the stretching of DVT §4]
-    internal::StretchTerm<3>(Node(i, x, gms), Node(i + 1, x, gms),
-                             0.5 * p_.stretch_stiffness / rest_, rest_, &g6,
-                             want_h ? &h6 : nullptr);
-    gy.head<6>() = g6;
-    if (want_h) hy.topLeftCorner<6, 6>() = h6;
-  } else {
-    const V3 xa = Node(i - 1, x, gms), xb = Node(i, x, gms), xc = Node(i + 1, x, gms);
-    rod::Vec8 g8;
-    rod::Mat8 h8;
-    rod::VertexEnergy(xb - xa, xc - xb, Theta(i - 1, x, gms), Theta(i, x, gms), sources_[i - 1],
-                      sources_[i], twist_near_[i], stiffness_, &g8, want_h ? &h8 : nullptr);
-    // (e0, e1) = (x_i - x_{i-1}, x_{i+1} - x_i).
-    gy.segment<3>(0) = -g8.segment<3>(0);
-    gy.segment<3>(3) = g8.segment<3>(0) - g8.segment<3>(3);
-    gy.segment<3>(6) = g8.segment<3>(3);
-    gy.segment<2>(9) = g8.tail<2>();
-    if (want_h) {
-      // Hy = Lᵀ H8 L with node a's edge coefficients D(a, ·) = (-1, 0), (1, -1), (0, 1),
-      // block by block (the dense product would cost several times more).
-      static constexpr double kD[3][2] = {{-1.0, 0.0}, {1.0, -1.0}, {0.0, 1.0}};
-      for (int a = 0; a < 3; ++a) {
-        for (int b = 0; b < 3; ++b) {
-          M3 blk = M3::Zero();
-          for (int e = 0; e < 2; ++e) {
-            if (kD[a][e] == 0.0) continue;
-            for (int f = 0; f < 2; ++f) {
-              if (kD[b][f] != 0.0) blk += (kD[a][e] * kD[b][f]) * h8.block<3, 3>(3 * e, 3 * f);
-            }
-          }
-          hy.block<3, 3>(3 * a, 3 * b) = blk;
-        }
-        Eigen::Matrix<double, 3, 2> side = Eigen::Matrix<double, 3, 2>::Zero();
-        for (int e = 0; e < 2; ++e) {
-          if (kD[a][e] != 0.0) side += kD[a][e] * h8.block<3, 2>(3 * e, 6);
-        }
-        hy.block<3, 2>(3 * a, 9) = side;
-        hy.block<2, 3>(9, 3 * a) = side.transpose();
-      }
-      hy.block<2, 2>(9, 9) = h8.block<2, 2>(6, 6);
-    }
-  }
-  const int nloc = term.nloc;
-  if (!term.grasp) {
-    f(gy.data(), hy.data(), kMaxLocal);
-    return;
-  }
-  // Chain rule through the grasp map: y = C z (+ curvature of the grasp coordinates).
-  const int k = assembly_.TermSize(t);
-  Eigen::Matrix<double, kMaxLocal, kMaxVars> c = Eigen::Matrix<double, kMaxLocal, kMaxVars>::Zero();
-  for (int r = 0; r < nloc; ++r) {
-    if (term.code[r] >= 0) {
-      c(r, term.pos[r]) = 1.0;
-    } else if (term.code[r] <= -2) {
-      c.block<1, 6>(r, k - 6) = gm.jac.row(GraspCoordinate(term.code[r]));
-    }
-  }
-  Eigen::Matrix<double, kMaxVars, 1> ga;
-  Eigen::Matrix<double, kMaxVars, kMaxVars> ha;
-  ga.noalias() = c.transpose() * gy;
-  if (want_h) {
-    const Eigen::Matrix<double, kMaxLocal, kMaxVars> hc = hy * c;
-    ha.noalias() = c.transpose() * hc;
-    for (int r = 0; r < nloc; ++r) {
-      if (term.code[r] <= -2) ha.block<3, 3>(k - 3, k - 3) += gy[r] * gm.hess_phi[GraspCoordinate(term.code[r])];
-    }
-  }
-  f(ga.data(), ha.data(), kMaxVars);
-}
-
-double RodModel::Energy(const Vec& x, const Vec& u) const {
-  const GraspMaps gm = Grasp(u, false);
-  double e = 0.0;
-  for (const Term& term : terms_) {
-    const int i = term.index;
-    if (!term.vertex) {
-      e += internal::StretchTerm<3>(Node(i, x, gm), Node(i + 1, x, gm),
-                                    0.5 * p_.stretch_stiffness / rest_, rest_, nullptr, nullptr);
-    } else {
-      const V3 xa = Node(i - 1, x, gm), xb = Node(i, x, gm), xc = Node(i + 1, x, gm);
-      e += rod::VertexEnergy(xb - xa, xc - xb, Theta(i - 1, x, gm), Theta(i, x, gm),
-                             sources_[i - 1], sources_[i], twist_near_[i], stiffness_, nullptr,
-                             nullptr);
-    }
-  }
-  if (contact_.enabled()) e += contact_.Energy(ContactNodes(x, gm));
-  return e;
-}
-
-void RodModel::Gradient(const Vec& x, const Vec& u, Vec* g) const {
-  if (g->size() != nx_) g->resize(nx_);
-  g->setZero();
-  const GraspMaps gm = Grasp(u, true);
-  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
-    Local(t, x, gm, false,
-          [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
-  }
-  if (contact_.enabled()) contact_.AddGradient(ContactNodes(x, gm), g->data());
-}
-
-void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
-  // StoreHessian: every elastic slot is reached by an elastic term first, so no clearing
-  // pass; slots only a contact pair reaches are cleared when contact is on.
-  double* values = assembly_.Values(h, contact_.enabled());
-  const GraspMaps gm = Grasp(u, true);
-  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
-    Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
-      assembly_.StoreHessian(t, lh, ld, values);
-    });
-  }
-  if (contact_.enabled()) contact_.AddHessian(ContactNodes(x, gm), values);
-}
-
-void RodModel::GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
-  if (g->size() != nx_) g->resize(nx_);
-  g->setZero();
-  double* values = assembly_.Values(h, contact_.enabled());
-  const GraspMaps gm = Grasp(u, true);
-  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
-    Local(t, x, gm, true, [&](const double* lg, const double* lh, int ld) {
-      assembly_.AddGradient(t, lg, g->data());
-      assembly_.StoreHessian(t, lh, ld, values);
-    });
-  }
-  if (contact_.enabled()) {
-    contact_.AddGradient(ContactNodes(x, gm), g->data());
-    contact_.AddHessian(ContactNodes(x, gm), values);
-  }
-}
-
-void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
-  if (eu->size() != nu_) eu->resize(nu_);
-  eu->setZero();
-  const GraspMaps gm = Grasp(u, true);
-  for (int t : control_terms_) {
-    Local(t, x, gm, false, [&](const double* lg, const double*, int) {
-      assembly_.AddControlGradient(t, lg, eu->data());
-    });
-  }
-  if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, gm), ContactControls(gm), eu->data());
-}
-
-bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const {
-  // The E_u of a grasp map differentiated in a world rotation δ instead of φ: the
-  // rotation-vector gradient E_φ = J_l(φ)ᵀ E_δ loses the torque where J_l is singular
-  // (|φ| = 2π, 4π: two turns of a roll).
-  const GraspMaps gm = Grasp(u, true, true);
-  Eigen::Matrix<double, 12, 1> e = Eigen::Matrix<double, 12, 1>::Zero();
-  for (int t : control_terms_) {
-    Local(t, x, gm, false, [&](const double* lg, const double*, int) {
-      assembly_.AddControlGradient(t, lg, e.data());
-    });
-  }
-  if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, gm), ContactControls(gm), e.data());
-  *torque = -e.segment<3>(3);  // the first grasp's (edge 0's without a clamp)
-  return true;
-}
-
-void RodModel::MixedHessian(const Vec& x, const Vec& u, Mat* exu) const {
-  if (exu->rows() != nx_ || exu->cols() != nu_) exu->resize(nx_, nu_);
-  exu->setZero();
-  const GraspMaps gm = Grasp(u, true);
-  for (int t : control_terms_) {
-    Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
-      assembly_.AddMixedHessian(t, lh, ld, exu);
-    });
-  }
-  if (contact_.enabled()) contact_.AddMixedHessian(ContactNodes(x, gm), ContactControls(gm), exu);
-}
-
-void RodModel::ControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
-  if (euu->rows() != nu_ || euu->cols() != nu_) euu->resize(nu_, nu_);
-  euu->setZero();
-  const GraspMaps gm = Grasp(u, true);
-  for (int t : control_terms_) {
-    Local(t, x, gm, true, [&](const double*, const double* lh, int ld) {
-      assembly_.AddControlHessian(t, lh, ld, euu);
-    });
-  }
-  if (contact_.enabled()) contact_.AddControlHessian(ContactNodes(x, gm), ContactControls(gm), euu);
 }
 
 Vec RodModel::InitialState(const Vec& u) const {
@@ -509,6 +253,7 @@ void RodModel::AcceptState(const Vec& x, const Vec& u) {
     sources_[j].t = t;
     sources_[j].a = (a - a.dot(t) * t).normalized();
   }
+  InvalidateCaches();  // the grasp maps and energies depend on the frames and angles moved here
 }
 
 // ---------------------------------------------------------------------------------

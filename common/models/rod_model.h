@@ -72,9 +72,17 @@ class RodModel final : public Model {
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override;
   // One pass over the terms for both (the same operations as the two, the same bits).
   void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override;
+  // One pass for E, E_x and E_xx (Energy()'s sum in its order: the same bits).
+  double EnergyGradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override;
+  // The same with E_xx written straight into the band (false with self-contact, whose
+  // pairs go through the compressed matrix, or another bandwidth).
+  bool EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, double* band, int bandwidth,
+                                    double* energy) const override;
   void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const override;
   void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const override;
   void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const override;
+  // One pass over the terms that touch the grasp for all three (the same bits).
+  void ControlDerivatives(const Vec& x, const Vec& u, Vec* eu, Mat* exu, Mat* euu) const override;
   // -dE/dδ for a world rotation exp([δ]×) of the grasp: the torque about x_n (N m)
   // (free_start: of the first grasp, about x_0).
   bool GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const override;
@@ -151,15 +159,25 @@ class RodModel final : public Model {
   void RegisterContact();
   const Eigen::Matrix3Xd& ContactNodes(const Vec& x, const GraspMaps& gm) const;
   internal::ControlMap ContactControls(const GraspMaps& gm) const;
+  // rod_grasp.cc. The values (nodes, angle) do not depend on `derivatives`: the same
+  // operations, the same bits.
   GraspMaps Grasp(const Vec& u, bool derivatives, bool world_rotation = false) const;
+  // Grasp(u, true), kept for the last u until the lagged data move (AcceptState,
+  // ResetHistory): every evaluation of one update asks for the same u.
+  const GraspMaps& GraspDerivatives(const Vec& u) const;
   // The map of one grasp: the one of edge n-1 (at_start false) or of edge 0.
   GraspMap OneGrasp(const Vec& u, bool at_start, bool derivatives, bool world_rotation) const;
   Eigen::Vector3d Node(int k, const Vec& x, const GraspMaps& gm) const;
   double Theta(int j, const Vec& x, const GraspMaps& gm) const;
+  // Each edge's frame once per evaluation (both of its vertices use it) into edges_: every
+  // edge, or (control_terms_only) those of the terms that touch the grasp.
+  void PrepareEdges(const Vec& x, const GraspMaps& gm, bool want_h, bool control_terms_only) const;
+  // The stretching term of edge j from edges_ (g, h may be null).
+  double StretchEnergy(int j, Eigen::Matrix<double, 6, 1>* g, Eigen::Matrix<double, 6, 6>* h) const;
   // Calls f(local gradient, local Hessian, leading dimension) for term t in its
-  // assembly variables.
+  // assembly variables, with its edges in edges_ (PrepareEdges); returns the term's energy.
   template <class F>
-  void Local(int t, const Vec& x, const GraspMaps& gm, bool want_h, F&& f) const;
+  double Local(int t, const GraspMaps& gm, bool want_h, F&& f) const;
 
   RodParams p_;
   int n_;
@@ -173,6 +191,26 @@ class RodModel final : public Model {
   internal::ContactTerms contact_;
   mutable Eigen::Matrix3Xd contact_nodes_, contact_to_;
   mutable Vec contact_trial_;
+  // Evaluation scratch (sized at construction; one model is evaluated by one thread at a
+  // time, as the tracker does): the edge frames and the cached grasp maps.
+  mutable std::vector<rod::EdgeFrame> edges_;
+  mutable GraspMaps grasp_cache_;
+  mutable Vec grasp_cache_u_;
+  mutable bool grasp_cache_valid_ = false;
+  // The last state whose energy was evaluated (Energy, or a fused pass), and the band of the
+  // last EnergyGradientAndBandHessian with its state: a solver asks for E again at a state
+  // it has evaluated, and for the compressed E_xx at the state of a band it factorised
+  // (rod_evaluate.cc). Invalidated with the grasp maps (the lagged data moved).
+  struct StateKey {
+    Vec x, u;
+    bool valid = false;
+    bool Matches(const Vec& x1, const Vec& u1) const;
+    void Set(const Vec& x1, const Vec& u1);
+  };
+  mutable StateKey energy_key_, band_key_;
+  mutable double energy_cache_ = 0.0;
+  mutable std::vector<double> band_cache_;
+  void InvalidateCaches();
   // Lagged data (AcceptState): per edge the frame source, per vertex the reference twist,
   // and the grasp's material angle, each the value at the last accepted state.
   std::vector<rod::FrameSource> sources_;
