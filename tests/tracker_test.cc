@@ -146,5 +146,35 @@ TEST(Tracker, StiffnessStaysFiniteThroughSnaps) {
   }
 }
 
+// The tangent predictor dx = -E_xx^-1 E_xu du comes from the solver's factorisation of
+// the last state (solved at the next update); SetOptions replaces the solver, so the
+// tracker keeps the tangent as full columns first. The update after SetOptions then
+// starts from the same prediction as a tracker that kept its solver: where that
+// prediction is within the cutoff (no iteration), both return it.
+TEST(Tracker, TangentPredictorSurvivesSetOptions) {
+  ModelParams t;
+  t.model = "thread3d";
+  t.Set("n", 8);
+  SolverOptions o;
+  o.method = "higher-order";
+  EquilibriumTracker kept(MakeModel(t), o), switched(MakeModel(t), o);
+  Vec u(3);
+  u << 6.5, 2.0, 1.0;
+  kept.Reset(u);
+  switched.Reset(u);
+  for (int i = 0; i < 5; ++i) {
+    u[1] += 1e-4;
+    kept.Update(u);
+    switched.Update(u);
+  }
+  switched.SetOptions(o);
+  u[1] += 1e-4;
+  const TrackResult& a = kept.Update(u);
+  const TrackResult& b = switched.Update(u);
+  ASSERT_EQ(a.summary.iterations, 0) << "the prediction should land within the cutoff here";
+  EXPECT_EQ(b.summary.iterations, 0);
+  EXPECT_LE((kept.state() - switched.state()).lpNorm<Eigen::Infinity>(), 1e-12 * kept.state().lpNorm<Eigen::Infinity>());
+}
+
 }  // namespace
 }  // namespace snapthread

@@ -2,8 +2,8 @@
 // with its neighbours only, so its half-bandwidth b is a small constant).
 //
 // Storage is row-band: column i of a (b+1) x n column-major array holds
-// [L(i,i-b) ... L(i,i-1), d_i], so the dot products of the factorisation and of both
-// triangular solves run over contiguous memory. O(n b^2) factorisation, O(n b) solve,
+// [L(i,i-b) ... L(i,i-1), d_i] (and 1/d_i beside it), so the dot products of the
+// factorisation and of both triangular solves run over contiguous memory. O(n b^2) factorisation, O(n b) solve,
 // no allocation after Analyze() (Solve() allocates only if *x has the wrong size).
 //
 // Analyze() also records where each stored lower-triangle value of the pattern goes in
@@ -33,6 +33,8 @@ class BandedLdlt final : public SymmetricLinearSolver {
   LinearSolverStatus Factorize(const SparseMatrix& a) override;
   LinearSolverStatus Solve(const Vec& b, Vec* x) const override;
   LinearSolverStatus SolveMany(const Mat& b, Mat* x) const override;
+  // Forward sweeps only: (L^-1 B)^T D^-1 (L^-1 B), each column from its first non-zero.
+  LinearSolverStatus InverseQuadraticForm(const Mat& b, Mat* out) const override;
 
   // The band itself (after Analyze()): the model writes A(i, j), i >= j, at
   // data[i (b + 1) + j - i + b]; FactorizeAssembled() clears the slots outside the
@@ -48,6 +50,9 @@ class BandedLdlt final : public SymmetricLinearSolver {
   int n_ = 0;
   int bandwidth_ = -1;
   Mat band_;  // (b+1) x n, see the file comment
+  Vec dinv_;  // 1 / d_i of the factorisation (multiplications in the factor and the solves)
+  mutable Mat quad_y_;              // InverseQuadraticForm's L^-1 B
+  mutable std::vector<int> first_;  // ... and each column's first non-zero row
   // Each stored lower-triangle entry of a compressed matrix: its index in valuePtr()
   // and its slot in band_ (strictly upper entries are not read: A is symmetric).
   struct Scatter {
@@ -58,8 +63,9 @@ class BandedLdlt final : public SymmetricLinearSolver {
   std::vector<int> holes_;  // band slots inside the matrix that the pattern leaves empty
   bool factorized_ = false;
 
-  // The factorisation of band_ as it stands (holes cleared), scale = max |a_ij|.
-  LinearSolverStatus FactorInPlace(double scale);
+  // The factorisation of band_ as it stands (holes cleared); the singularity test's
+  // scale max |a_ij| is taken on the way.
+  LinearSolverStatus FactorInPlace();
 };
 
 }  // namespace snapthread

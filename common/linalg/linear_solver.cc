@@ -27,6 +27,19 @@ LinearSolverStatus SymmetricLinearSolver::SolveMany(const Mat& b, Mat* x) const 
   return LinearSolverStatus::kSuccess;
 }
 
+LinearSolverStatus SymmetricLinearSolver::InverseQuadraticForm(const Mat& b, Mat* out) const {
+  if (out == nullptr || out == &b) return LinearSolverStatus::kInvalidInput;
+  const LinearSolverStatus st = SolveMany(b, &quad_x_);
+  if (st != LinearSolverStatus::kSuccess) return st;
+  const int m = static_cast<int>(b.cols());
+  if (out->rows() != m || out->cols() != m) out->resize(m, m);
+  // Column dots (no temporaries); the upper triangle mirrored, so exactly symmetric.
+  for (int j = 0; j < m; ++j) {
+    for (int i = 0; i <= j; ++i) (*out)(i, j) = (*out)(j, i) = b.col(i).dot(quad_x_.col(j));
+  }
+  return LinearSolverStatus::kSuccess;
+}
+
 std::vector<std::string> LinearSolverNames() { return {"auto", "cholmod", "dense", "banded"}; }
 
 // "auto", measured with snapthread-linear-bench (Release, 2 cores shared with other

@@ -41,6 +41,14 @@ class SymmetricLinearSolver {
   // nothing; no allocation once *x has B's size (this default version copies each column
   // through two scratch vectors, sized on the first call).
   virtual LinearSolverStatus SolveMany(const Mat& b, Mat* x) const;
+  // B^T A^-1 B (cols x cols) with the last factorisation: the implicit differentiation's
+  // E_ux E_xx^-1 E_xu (2.14-2.15) without the full solves. With A = L D L^T it is
+  // (L^-1 B)^T D^-1 (L^-1 B): the banded backend runs the forward sweeps only, each from
+  // its column's first non-zero, so a B that is non-zero on the last rows only (E_xu:
+  // the nodes next to the grasp) costs O(b) per column instead of O(n b). Exactly
+  // symmetric. out may alias nothing; no allocation once *out is cols x cols (this
+  // default version, SolveMany() and a product, sizes its scratch on the first call).
+  virtual LinearSolverStatus InverseQuadraticForm(const Mat& b, Mat* out) const;
 
   // Direct assembly (libigl's precompute / solve split taken one step further): a
   // backend that factorises in band storage hands out that storage, a model writes the
@@ -67,8 +75,9 @@ class SymmetricLinearSolver {
  protected:
   std::string message_;
   int negative_pivots_ = 0;
-  // SolveMany()'s scratch columns (default version only).
+  // SolveMany()'s scratch columns and InverseQuadraticForm()'s A^-1 B (default versions).
   mutable Vec many_rhs_, many_x_;
+  mutable Mat quad_x_;
   double min_abs_pivot_ = 0.0;
 };
 

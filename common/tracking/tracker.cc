@@ -22,12 +22,22 @@ EquilibriumTracker::EquilibriumTracker(std::unique_ptr<Model> model, const Solve
   exu_.resize(n, m);
   euu_.resize(m, m);
   sol_.resize(n, m);
+  quad_.resize(m, m);
+  vexu_.resize(m);
+  rhs_.resize(n);
   du_.resize(m);
   result_.force = Vec::Zero(m);
   result_.stiffness = Mat::Zero(m, m);
 }
 
 void EquilibriumTracker::SetOptions(const SolverOptions& options) {
+  // The predictor's tangent lives in the old solver's factorisation: keep it as the full
+  // columns E_xx^-1 E_xu before that solver goes.
+  if (have_tangent_ && !tangent_in_sol_) {
+    const SymmetricLinearSolver* f = solver_->Factorization();
+    tangent_in_sol_ = f != nullptr && f->SolveMany(exu_, &sol_) == LinearSolverStatus::kSuccess && sol_.allFinite();
+    have_tangent_ = tangent_in_sol_;
+  }
   options_ = options;
   solver_ = MakeSolver(*model_, options_);
   have_prev_ = false;
@@ -102,8 +112,8 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   if (u.size() != model_->NumControls())
     throw std::invalid_argument("EquilibriumTracker::Update: control size mismatch");
   // Warm start (DESIGN.md #5). Where the last state was regular, the tangent
-  // dx/du = -E_xx^-1 E_xu from its implicit differentiation (sol_, already computed for
-  // K) is the better predictor: exact to first order without history, and unaffected
+  // dx/du = -E_xx^-1 E_xu from its implicit differentiation (TangentPrediction, with
+  // the factorisation that gave K) is the better predictor: exact to first order without history, and unaffected
   // by a budget-limited previous update or by the grasp turning round. Near a fold
   // (the floored eigenvalue makes the tangent arbitrary) fall back to the secant
   // 2 x_{i-1} - x_{i-2}, scaled by how much of the previous control step the new one
@@ -114,13 +124,8 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   const bool continuing_snap = result_.summary.termination == Termination::kSnapping;
   const bool tangent_ok = have_tangent_ && !result_.stiffness_regularized &&
                           result_.summary.status != EquilibriumStatus::kNearFold;
-  if (options_.secant_predictor && tangent_ok) {
-    du_ = u - u_;
-    scratch_.noalias() = sol_ * du_;
-    const double step = scratch_.lpNorm<Eigen::Infinity>();
-    const double cap = 5.0 * snap_threshold_;
-    x_pred_ -= (step > cap ? cap / step : 1.0) * scratch_;
-  } else if (options_.secant_predictor && have_prev_) {
+  const bool predicted = options_.secant_predictor && tangent_ok && TangentPrediction(u);
+  if (!predicted && options_.secant_predictor && have_prev_) {
     const double d2 = (u_ - u_prev_).squaredNorm();
     if (d2 > 0.0) {
       const double a = std::clamp((u - u_).dot(u_ - u_prev_) / d2, 0.0, 2.0);
@@ -146,6 +151,27 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   ComputeForces();
   model_->AcceptState(x_, u_);
   return result_;
+}
+
+bool EquilibriumTracker::TangentPrediction(const Vec& u) {
+  // dx = E_xx^-1 E_xu du: one solve with the factorisation of the last update's state
+  // (still the solver's until this update's Solve), of a right-hand side that is
+  // non-zero on the last nodes only. (The three columns E_xx^-1 E_xu themselves are
+  // kept only across a change of solver, SetOptions.)
+  du_ = u - u_;
+  if (tangent_in_sol_) {
+    scratch_.noalias() = sol_ * du_;
+  } else {
+    const SymmetricLinearSolver* f = solver_->Factorization();
+    if (f == nullptr) return false;
+    rhs_.noalias() = exu_ * du_;
+    if (f->Solve(rhs_, &scratch_) != LinearSolverStatus::kSuccess) return false;
+  }
+  if (!scratch_.allFinite()) return false;
+  const double step = scratch_.lpNorm<Eigen::Infinity>();
+  const double cap = 5.0 * snap_threshold_;
+  x_pred_ -= (step > cap ? cap / step : 1.0) * scratch_;
+  return true;
 }
 
 void EquilibriumTracker::LimitPrediction(const Vec& u) {
@@ -183,9 +209,11 @@ void EquilibriumTracker::ComputeForces() {
     have_tangent_ = false;
     return;
   }
-  // All columns of E_xx^-1 E_xu in one pass over the factor the solver returned.
+  // E_ux E_xx^-1 E_xu from the factorisation the solver returned: (L^-1 E_xu)^T D^-1
+  // (L^-1 E_xu), the forward sweeps alone, where E_xu is non-zero (the grasp's nodes).
   const SymmetricLinearSolver* f = solver_->Factorization();
-  const bool ok = f != nullptr && f->SolveMany(exu_, &sol_) == LinearSolverStatus::kSuccess && sol_.allFinite();
+  const bool ok = f != nullptr && f->InverseQuadraticForm(exu_, &quad_) == LinearSolverStatus::kSuccess &&
+                  quad_.allFinite();
   const double lambda0 = result_.summary.lambda_min;
   const bool regular_state = ok && result_.summary.negative_pivots == 0 &&
                              result_.summary.status == EquilibriumStatus::kRegular;
@@ -193,23 +221,26 @@ void EquilibriumTracker::ComputeForces() {
   if (ok && !regular_state && result_.summary.negative_pivots <= 1) {
     // Near a fold E_xx^-1 blows up along its lowest mode v: floor that one eigenvalue
     // at tau * lambda_ref (the spectral term v v^T / lambda_0 becomes v v^T / floor),
-    // so K is finite and continuous while the rest of the response is exact.
+    // so K is finite and continuous while the rest of the response is exact: the term
+    // adds (1/floor - 1/lambda_0) (E_ux v)(E_ux v)^T.
     const Vec& v = solver_->LowestEigenvector();
     const double floor = std::max(options_.degeneracy_ratio * std::max(lambda_ref_, 0.0), 1e-12);
-    if (v.size() == sol_.rows() && lambda0 < floor && lambda0 != 0.0) {
+    if (v.size() == exu_.rows() && lambda0 < floor && lambda0 != 0.0) {
       const double corr = 1.0 / floor - 1.0 / lambda0;
-      for (int j = 0; j < sol_.cols(); ++j) sol_.col(j) += v * (corr * v.dot(exu_.col(j)));
+      for (int j = 0; j < exu_.cols(); ++j) vexu_[j] = v.dot(exu_.col(j));
+      for (int j = 0; j < quad_.cols(); ++j) {
+        for (int i = 0; i < quad_.rows(); ++i) quad_(i, j) += corr * (vexu_[i] * vexu_[j]);
+      }
       result_.stiffness_regularized = true;
     }
   }
   have_tangent_ = ok;
+  tangent_in_sol_ = false;
   Mat& k = result_.stiffness;
   if (ok) {
-    // -(E_uu - E_ux sol), written without temporaries (no allocation per update).
-    // (A column dot per entry: a general matrix product packs its operands first, a
-    // tenth of an update at n = 1000.)
+    // -(E_uu - E_ux E_xx^-1 E_xu), element by element (no temporaries, no allocation).
     for (int j = 0; j < k.cols(); ++j) {
-      for (int i = 0; i < k.rows(); ++i) k(i, j) = exu_.col(i).dot(sol_.col(j)) - euu_(i, j);
+      for (int i = 0; i < k.rows(); ++i) k(i, j) = quad_(i, j) - euu_(i, j);
     }
   }
   if (!ok || !k.allFinite()) {

@@ -73,6 +73,9 @@ class EquilibriumTracker {
   // Shortens the predicted state change x_pred_ - x_ until the node motion from (x_, u_)
   // to (x_pred_, u) passes no segment through another (self-contact; model.h).
   void LimitPrediction(const Vec& u);
+  // x_pred_ -= the tangent step E_xx^-1 E_xu (u - u_) (capped at 5 snap thresholds);
+  // false, x_pred_ unchanged, when there is no factorisation or the step is not finite.
+  bool TangentPrediction(const Vec& u);
   void ComputeForces();
 
   std::unique_ptr<Model> model_;
@@ -81,13 +84,16 @@ class EquilibriumTracker {
   Vec x_, x_prev_, u_, u_prev_;
   Vec snap_origin_;  // the predicted state of the update where the current snap began
   bool have_prev_ = false;
-  bool have_tangent_ = false;  // sol_ holds E_xx^-1 E_xu of the current state
+  // The solver's factorisation (or sol_, tangent_in_sol_) gives E_xx^-1 E_xu of the
+  // current state.
+  bool have_tangent_ = false;
+  bool tangent_in_sol_ = false;  // sol_ holds E_xx^-1 E_xu (kept across SetOptions)
   double snap_threshold_ = 0.1;
   double lambda_ref_ = -1.0;
   TrackResult result_;
   // scratch
-  Vec eu_, scratch_, x_pred_, du_;
-  Mat exu_, euu_, sol_;
+  Vec eu_, scratch_, x_pred_, du_, rhs_, vexu_;
+  Mat exu_, euu_, sol_, quad_;
 };
 
 }  // namespace snapthread

@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
               bin_dir = ExeDir(), advise, methods_text, cutoffs_text, budgets_text, ns_text, backends_text,
               sweeps_text, ladder_text, service_scenes, path_ns_text;
   std::vector<std::string> sets;
-  bool quick = false, no_plot = false, fixed_length = false;
+  bool quick = false, no_plot = false, fixed_length = false, no_ceres = false;
   int repetitions = 0, reference_n = 0, path_steps = 0;
   double service_duration = 0.0, target_force_error = 0.0, target_rate_hz = 0.0;
   app.add_flag("--quick", quick, "small grids, one repetition, short service run (for development)");
@@ -87,6 +87,7 @@ int main(int argc, char** argv) {
                "scaling: keep the thread's total length (finer segments) instead of n segments of length L");
   app.add_option("--backends", backends_text, "scaling: linear solvers (default auto,banded,cholmod,dense)");
   app.add_option("--path-ns", path_ns_text, "path: segment counts (default 10,100,1000)");
+  app.add_flag("--no-ceres", no_ceres, "path: skip the Ceres run (profiling the project's update alone)");
   app.add_option("--path-steps", path_steps, "path: control steps per n (default 1000, quick 200)")
       ->check(CLI::Range(1, 1000000));
   app.add_option("--service-scenes", service_scenes, "service: scene names (default curve2d_snap,thread3d_loop)");
@@ -227,6 +228,7 @@ int main(int argc, char** argv) {
       }
       if (!path_ns_text.empty()) o.ns = ParseCounts(path_ns_text, "--path-ns");
       if (path_steps > 0) o.steps = path_steps;
+      if (no_ceres) o.ceres = false;
       const auto rows = RunPathBench(scenes_dir, o, &std::cerr);
       std::ostringstream table;
       table << "== path: thread3d (n - 0.5, 0.5, 0) -> (n - 0.5, 0.8, 0.2), " << o.steps << " steps, " << o.method

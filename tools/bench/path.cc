@@ -211,7 +211,9 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
       *progress << "bench path: n=" << n << ": " << std::fixed << std::setprecision(2) << row.update_us.median
                 << " us/update (floor " << row.floor_us.median << " us, ratio " << row.FloorRatio() << ")\n"
                 << std::defaultfloat << std::flush;
-    if (o.ceres) {
+    if (!o.ceres) {
+      row.ceres.note = "not run (--no-ceres)";
+    } else {
       row.ceres = RunCeresPath(scene, controls, states, forces, o.cutoff);
       if (progress && row.ceres.ran)
         *progress << "bench path: n=" << n << " Ceres: " << row.ceres.update_us.median << " us/update, "
