@@ -84,7 +84,7 @@ void FoldBoundary::Collect() {
   if (spdlog::should_log(spdlog::level::debug)) {
     spdlog::debug("fold: search {} for branch {} (now {}) ended: {}", done->search, done->branch, branch_,
                   done->prediction.found ? "fold at " + Controls(done->prediction.u_fold)
-                                         : std::string("no fold"));
+                                         : std::string("no fold: ") + done->prediction.why_not);
   }
   // A search for an earlier branch says nothing of this one; one that found no fold
   // leaves the prediction the branch has (see the header).

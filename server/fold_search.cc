@@ -112,18 +112,27 @@ FoldPrediction FoldSearch::Find(const Vec& x, const Vec& u, const Vec& d,
     const double step = options.reach / 16.0;
     double s_lo = 0.0, s_hi = 0.0;
     Vec x_lo;
-    if (!Bracket(x, u, d, options.reach, step, options.tolerance, &s_lo, &x_lo, &s_hi)) return p;
+    if (!Bracket(x, u, d, options.reach, step, options.tolerance, &s_lo, &x_lo, &s_hi)) {
+      p.why_not = "the branch goes on within reach";
+      return p;
+    }
     p.x_after = tracker_->state();
     p.u_after = u + s_hi * d;
     p.after = tracker_->last();
     p.x_before = x_lo;
     p.u_before = u + s_lo * d;
     p.u_fold = u + (0.5 * (s_lo + s_hi)) * d;
-    if (!FoldNormal(p.x_before, p.u_before, &p.normal)) return p;
+    if (!FoldNormal(p.x_before, p.u_before, &p.normal)) {
+      p.why_not = "no normal";
+      return p;
+    }
     // The hand crosses along +normal: it moves along d towards the fold.
     if (p.normal.dot(d) < 0.0) p.normal = -p.normal;
     // A fold the hand's motion hardly reaches: the boundary is not what the hand crosses.
-    if (p.normal.dot(d) < 0.1 * d.norm()) return p;
+    if (p.normal.dot(d) < 0.1 * d.norm()) {
+      p.why_not = "the motion hardly reaches it";
+      return p;
+    }
     // Curvature from two side searches at +-lateral along a positional tangent t (normal
     // to the normal's positional part, in the plane of d's positional part when the hand
     // moves): the boundary n.w = (kappa/2) |w_t|^2 puts the side fold points
@@ -168,6 +177,7 @@ FoldPrediction FoldSearch::Find(const Vec& x, const Vec& u, const Vec& d,
     p.found = true;
   } catch (const std::exception&) {
     p.found = false;  // numeric trouble in the search: no prediction, never a bad one
+    p.why_not = "numeric trouble";
   }
   return p;
 }

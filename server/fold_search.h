@@ -35,6 +35,7 @@ struct FoldPrediction {
   Vec x_after;          // the equilibrium past the fold (the other branch) at u_after
   Vec u_after;
   TrackResult after;    // its force and K (model units)
+  const char* why_not = "";  // found = false: why (for the log)
 };
 
 struct FoldSearchOptions {
