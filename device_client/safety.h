@@ -83,9 +83,15 @@ struct LocalModel {
   double fold_point_m[3] = {0.0, 0.0, 0.0};
   double fold_normal[3] = {0.0, 0.0, 0.0};
   double fold_curvature_per_m = 0.0;
+  // A fold reached by turning: the orientation there and the normal's rotational part
+  // (m/rad; (fold_normal, fold_normal_r) is a unit vector). has_fold_rotation: it is not 0.
+  bool has_fold_rotation = false;
+  double fold_q[4] = {1.0, 0.0, 0.0, 0.0};
+  double fold_normal_r[3] = {0.0, 0.0, 0.0};
   double post_u0_m[3] = {0.0, 0.0, 0.0};
   double post_f0_n[3] = {0.0, 0.0, 0.0};
   double post_K_n_per_m[3][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+  double post_torque0_nm[3] = {0.0, 0.0, 0.0};  // with has_torque
 };
 
 // K (dF/du, N/m) with the stiffness S = -sym(K) clamped to [0, max stable stiffness] into

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <Eigen/Geometry>
+
 #include "messages/pose_mapping.h"
 #include "numeric/so3.h"
 #include "scene/input_file.h"
@@ -64,16 +66,28 @@ ScriptedPath ScriptedPath::FromScene(const Scene& scene, double speed_m_per_s, i
   const DeviceMapping mapping = GraspDeviceMapping(scene, grasp);
   const int m = scene.grasp_layout.NumControls();
   const int offset = grasp > 0 && grasp < static_cast<int>(scene.grasps.size()) ? scene.grasps[grasp].offset : 0;
+  const int dim = scene.grasp_layout.spatial_dimension;
+  const Eigen::Vector3d rest = messages::RestGripDirection(scene);
+  Eigen::Matrix3d turned = Eigen::Matrix3d::Identity();  // grip direction layouts: R so far
+  Eigen::Vector3d last_r = Eigen::Vector3d::Zero();
   auto add = [&](const Vec& controls) {
     const Vec control = controls.size() >= offset + m ? Vec(controls.segment(offset, m)) : controls;
     const Eigen::Vector3d p = messages::ControlsToPosition(mapping, scene.grasp_layout, control);
     pts.push_back({p[0], p[1], p[2]});
     // The rotation vector as the pose mapping sends it back (exp of it: the device's
     // rotation from rest); kept as the path's own value so whole turns accumulate.
-    const int dim = scene.grasp_layout.spatial_dimension;
     std::array<double, 3> r = {0.0, 0.0, 0.0};
     if (scene.grasp_layout.grip_rotation && control.size() >= dim + 3) {
       for (int k = 0; k < 3; ++k) r[k] = control[dim + k];
+    } else if (scene.grasp_layout.grip_direction && control.size() >= dim + 3) {
+      // A grip direction d = R(q) d_rest (pose_mapping.h): the hand turns from the last
+      // waypoint's direction to this one by the smallest rotation, and the rotation
+      // vector continues the last one (whole turns accumulate, thread3d_loop's 720
+      // degrees), so the path turns the grip through the scene's directions.
+      turned = so3::SmallestRotation(turned * rest, control.segment<3>(dim)) * turned;
+      const Eigen::Quaterniond q(turned);
+      last_r = so3::NearestRepresentative(so3::LogQuaternion(q.w(), q.x(), q.y(), q.z()), last_r);
+      for (int k = 0; k < 3; ++k) r[k] = last_r[k];
     }
     rotations.push_back(r);
   };

@@ -28,7 +28,9 @@ class ScriptedPath {
   // The path of scene grasp `grasp` (an index into scene.grasps; 0 for a single grasp),
   // in that grasp's device mapping.
   // A grasp that holds its orientation (the rod) turns as the path's rotation vectors
-  // say (messages::ControlsToOrientation), at angular_speed_rad_per_s.
+  // say (messages::ControlsToOrientation), at angular_speed_rad_per_s; a grip direction
+  // (thread3d_loop) turns from each waypoint's direction to the next by the smallest
+  // rotation (d = R(q) d_rest, messages::PoseToControls), whole turns accumulating.
   static ScriptedPath FromScene(const Scene& scene, double speed_m_per_s, int grasp = 0,
                                 double angular_speed_rad_per_s = kDefaultAngularSpeed);
   // 45 degrees per second: rod_greenhill's buckle (515 degrees) in about 11 s.
@@ -46,6 +48,8 @@ class ScriptedPath {
                 double orientation[4]) const;
 
   double length_m() const { return total_length_m_; }
+  // One pass from the first waypoint to the last, seconds (turning legs included).
+  double duration_s() const { return total_time_s_; }
   const std::vector<std::array<double, 3>>& waypoints_m() const { return waypoints_; }
   // Largest distance of a waypoint from the origin, metres.
   double max_radius_m() const;

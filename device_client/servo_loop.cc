@@ -33,7 +33,8 @@ void ServoTick::Tick(int64_t now_us, int64_t lateness_us) {
   if (!read_ok) counters_.read_failures.fetch_add(1, std::memory_order_relaxed);
 
   const LocalModel* model = models_->Latest();  // wait-free
-  if (snap_ahead_ != nullptr && read_ok) model = snap_ahead_->Select(model, state_.position_m, pose_seq_);
+  if (snap_ahead_ != nullptr && read_ok)
+    model = snap_ahead_->Select(model, state_.position_m, state_.orientation, pose_seq_);
   safety_->Step(state_.position_m, state_.orientation, read_ok, model, now_us, &last_);
   if (!device_->Command(last_.force_n, last_.torque_nm)) {
     counters_.command_failures.fetch_add(1, std::memory_order_relaxed);

@@ -1,6 +1,11 @@
 #include "snap_ahead.h"
 
 #include <cmath>
+#include <numbers>
+
+#include <Eigen/Core>
+
+#include "numeric/so3.h"
 
 namespace snapthread::device {
 
@@ -13,47 +18,75 @@ bool PrepareFold(const force_model_t& msg, const SafetyLimits& limits, LocalMode
     return false;
   };
   if (msg.has_fold != 1 || msg.fold_id <= 0) return bad("has_fold must be 0 or 1 and fold_id > 0");
-  double n2 = 0.0;
+  double n2 = 0.0, r2 = 0.0, q2 = 0.0;
   bool finite = std::isfinite(msg.fold_curvature);
   for (int i = 0; i < 3; ++i) {
     n2 += msg.fold_normal[i] * msg.fold_normal[i];
+    r2 += msg.fold_normal_r[i] * msg.fold_normal_r[i];
     finite = finite && std::isfinite(msg.fold_point[i]) && std::isfinite(msg.fold_normal[i]) &&
-             std::isfinite(msg.post_u0[i]) && std::isfinite(msg.post_f0[i]);
+             std::isfinite(msg.fold_normal_r[i]) && std::isfinite(msg.post_u0[i]) &&
+             std::isfinite(msg.post_f0[i]) && std::isfinite(msg.post_torque0[i]);
     for (int j = 0; j < 3; ++j) finite = finite && std::isfinite(msg.post_K[i][j]);
   }
+  for (double q : msg.fold_q) {
+    q2 += q * q;
+    finite = finite && std::isfinite(q);
+  }
   if (!finite) return bad("not finite");
-  if (std::abs(std::sqrt(n2) - 1.0) > 1e-6) return bad("fold_normal is not a unit vector");
+  if (std::abs(std::sqrt(n2 + r2) - 1.0) > 1e-6) return bad("(fold_normal, fold_normal_r) is not a unit vector");
+  if (std::abs(std::sqrt(q2) - 1.0) > 1e-6) return bad("fold_q is not a unit quaternion");
   bool post_clamped = false;
   if (!ClampStiffness(msg.post_K, limits, out->post_K_n_per_m, &post_clamped, why)) return false;
   *clamped = *clamped || post_clamped;
   out->has_fold = true;
   out->fold_id = msg.fold_id;
   out->fold_curvature_per_m = msg.fold_curvature;
+  out->has_fold_rotation = r2 > 0.0;
+  for (int i = 0; i < 4; ++i) out->fold_q[i] = msg.fold_q[i];
   for (int i = 0; i < 3; ++i) {
     out->fold_point_m[i] = msg.fold_point[i];
     out->fold_normal[i] = msg.fold_normal[i];
+    out->fold_normal_r[i] = msg.fold_normal_r[i];
     out->post_u0_m[i] = msg.post_u0[i];
     out->post_f0_n[i] = msg.post_f0[i];
+    out->post_torque0_nm[i] = out->has_torque ? msg.post_torque0[i] : 0.0;
   }
   return true;
 }
 
-bool PastFold(const LocalModel& model, const double position_m[3]) {
-  double w[3], a = 0.0;
+double FoldSide(const LocalModel& model, const double position_m[3], const double orientation[4]) {
+  double w[3], a = 0.0, n2 = 0.0;
   for (int i = 0; i < 3; ++i) {
     w[i] = position_m[i] - model.fold_point_m[i];
     a += model.fold_normal[i] * w[i];
+    n2 += model.fold_normal[i] * model.fold_normal[i];
   }
+  // w_perp: w less its part along the positional normal (all of w when there is none).
+  const double along = n2 > 0.0 ? a / n2 : 0.0;
   double perp2 = 0.0;
   for (int i = 0; i < 3; ++i) {
-    const double p = w[i] - a * model.fold_normal[i];
+    const double p = w[i] - along * model.fold_normal[i];
     perp2 += p * p;
   }
-  return a >= 0.5 * model.fold_curvature_per_m * perp2;
+  if (model.has_fold_rotation) {
+    // The turn from the fold's orientation, in the chart K6 uses (r = log(R R_fold^T));
+    // a device that senses no orientation is at rest (the identity), as its poses say.
+    static constexpr double kRest[4] = {1.0, 0.0, 0.0, 0.0};
+    const Eigen::Vector3d r = so3::RotationVectorBetween(orientation != nullptr ? orientation : kRest, model.fold_q);
+    // The linear boundary describes the fold near it only: a hand a quarter turn or more
+    // away (where log wraps at half a turn) has not crossed it.
+    if (r.squaredNorm() > 0.25 * std::numbers::pi * std::numbers::pi) return -1.0;
+    for (int i = 0; i < 3; ++i) a += model.fold_normal_r[i] * r[i];
+  }
+  return a - 0.5 * model.fold_curvature_per_m * perp2;
+}
+
+bool PastFold(const LocalModel& model, const double position_m[3], const double orientation[4]) {
+  return FoldSide(model, position_m, orientation) >= 0.0;
 }
 
 const LocalModel* SnapAhead::Select(const LocalModel* latest, const double position_m[3],
-                                    int64_t next_pose_seq) {
+                                    const double orientation[4], int64_t next_pose_seq) {
   if (latest == nullptr) return latest;
   if (active_) {
     // A model for a pose sent after the switch comes from the new branch: render it.
@@ -65,15 +98,19 @@ const LocalModel* SnapAhead::Select(const LocalModel* latest, const double posit
     }
   }
   if (!latest->has_fold || latest->fold_id == switched_fold_id_ ||
-      latest->status == force_model_t::STATUS_INVALID || !PastFold(*latest, position_m)) {
+      latest->status == force_model_t::STATUS_INVALID || !PastFold(*latest, position_m, orientation)) {
     return latest;
   }
   post_ = *latest;
   post_.has_fold = false;
+  // The post-snap model is a force model about post_u0 (force_model_t.post_K): the old
+  // branch's 6-DoF terms do not describe the new branch.
+  post_.has_wrench = false;
   post_.status = force_model_t::STATUS_SNAPPED;
   for (int i = 0; i < 3; ++i) {
     post_.u0_m[i] = latest->post_u0_m[i];
     post_.f0_n[i] = latest->post_f0_n[i];
+    post_.torque0_nm[i] = latest->post_torque0_nm[i];
     for (int j = 0; j < 3; ++j) post_.K_n_per_m[i][j] = latest->post_K_n_per_m[i][j];
   }
   active_ = true;

@@ -7,6 +7,11 @@
 //
 // The boundary: w = p - point, a = n . w, w_perp = w - a n; the hand is past the fold when
 //   a >= (curvature / 2) |w_perp|^2      (curvature > 0: the fold bends away from the hand).
+// A fold reached by turning the grasp (thread3d_loop's grip) has a rotational part too:
+// a = n . w + n_r . r with r = log(R R_fold^T), the hand's turn from the fold's
+// orientation in the chart of the 6-DoF model (K6), from the quaternion the device reads
+// each tick; (n, n_r) is a unit vector, and w_perp is w less its part along n. That
+// boundary is linear in r, so it counts only within a quarter turn of R_fold.
 // Hysteresis: a fold switches once (its id is remembered); crossing back does not switch
 // back, the other branch's fold governs. The post-snap model is rendered until a model
 // arrives that answers a pose sent after the switch (the server had the switch then);
@@ -32,8 +37,12 @@ namespace snapthread::device {
 bool PrepareFold(const force_model_t& msg, const SafetyLimits& limits, LocalModel* out,
                  bool* clamped, std::string* why);
 
-// True when position_m is on the far side of model's fold boundary.
-bool PastFold(const LocalModel& model, const double position_m[3]);
+// Which side of model's fold boundary the pose (position_m, orientation (w, x, y, z);
+// null: the identity) is on: a - (curvature / 2) |w_perp|^2, >= 0 past the fold; -1 a
+// quarter turn or more from the fold's orientation. No allocation.
+double FoldSide(const LocalModel& model, const double position_m[3], const double orientation[4]);
+// FoldSide >= 0.
+bool PastFold(const LocalModel& model, const double position_m[3], const double orientation[4]);
 
 class SnapAhead {
  public:
@@ -41,7 +50,7 @@ class SnapAhead {
   // after the hand crossed latest's fold. next_pose_seq: the seq the next published pose
   // will carry. Allocation-free.
   const LocalModel* Select(const LocalModel* latest, const double position_m[3],
-                           int64_t next_pose_seq);
+                           const double orientation[4], int64_t next_pose_seq);
 
   // The fold id of the last switch (0: none), for the poses.
   int64_t snap_fold_id() const { return switched_fold_id_; }

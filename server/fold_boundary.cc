@@ -10,6 +10,7 @@
 #include "messages/pose_mapping.h"
 #include "messages/validate.h"
 #include "models/registry.h"
+#include "fold_chart.h"
 #include "server_messages.h"
 
 namespace snapthread::server {
@@ -26,10 +27,10 @@ constexpr double kReach = 2.0, kMaxReach = 4.0;  // x the snap length scale
 // more than ~25 degrees from the one the prediction was found along.
 constexpr double kTurnedCos = 0.9;
 
-// The positional controls, for the log.
-std::string Controls(const Vec& u, int dim) {
+// The controls, for the log.
+std::string Controls(const Vec& u) {
   std::string s;
-  for (int i = 0; i < dim && i < u.size(); ++i) s += (i ? ", " : "") + std::to_string(u[i]);
+  for (int i = 0; i < u.size(); ++i) s += (i ? ", " : "") + std::to_string(u[i]);
   return "(" + s + ")";
 }
 
@@ -82,8 +83,8 @@ void FoldBoundary::Collect() {
   if (state != BackgroundJob<Job>::State::kDone) return;
   if (spdlog::should_log(spdlog::level::debug)) {
     spdlog::debug("fold: search {} for branch {} (now {}) ended: {}", done->search, done->branch, branch_,
-                  done->prediction.found ? "fold at " + Controls(done->prediction.u_fold, done->direction.size())
-                                         : std::string("no fold"));
+                  done->prediction.found ? "fold at " + Controls(done->prediction.u_fold)
+                                         : std::string("no fold: ") + done->prediction.why_not);
   }
   // A search for an earlier branch says nothing of this one; one that found no fold
   // leaves the prediction the branch has (see the header).
@@ -96,14 +97,23 @@ void FoldBoundary::Collect() {
   }
   const FoldPrediction& p = done->prediction;
   const DeviceMapping& map = scene_.device;
-  const double s = map.model_units_per_metre;
-  const Eigen::Vector3d point = messages::ControlsToPosition(map, scene_.grasp_layout, p.u_fold);
+  // The boundary in the device's pose chart (fold_chart.h).
+  PoseChartFold chart;
+  if (!FoldInPoseChart(scene_, p.u_fold, p.normal, p.curvature, done->u, done->orientation, &chart)) return;
   DeviceFold f{};
   for (int i = 0; i < 3; ++i) {
-    f.point[i] = point[i];
-    f.normal[i] = i < p.normal.size() ? p.normal[i] : 0.0;
+    f.point[i] = chart.point_m[i];
+    f.normal[i] = chart.normal[i];
+    f.normal_r[i] = chart.normal_r[i];
   }
-  f.curvature = p.curvature * s;  // 1/model unit -> 1/m
+  for (int i = 0; i < 4; ++i) f.q[i] = chart.q[i];
+  f.curvature = chart.curvature_per_m;
+  if (spdlog::should_log(spdlog::level::debug)) {
+    spdlog::debug("fold: boundary at ({:.6g}, {:.6g}, {:.6g}) m, q ({:.6g}, {:.6g}, {:.6g}, {:.6g}), normal "
+                  "({:.4g}, {:.4g}, {:.4g}), rotational ({:.4g}, {:.4g}, {:.4g}), curvature {:.4g} / m",
+                  f.point[0], f.point[1], f.point[2], f.q[0], f.q[1], f.q[2], f.q[3], f.normal[0], f.normal[1],
+                  f.normal[2], f.normal_r[0], f.normal_r[1], f.normal_r[2], f.curvature);
+  }
   // The post-snap local model exactly as a force model for its state would be.
   ForceModelInputs in;
   in.mapping = &map;
@@ -111,11 +121,13 @@ void FoldBoundary::Collect() {
   in.u = p.u_after;
   in.position_m = messages::ControlsToPosition(map, scene_.grasp_layout, p.u_after);
   in.result = &p.after;
+  in.layout = &scene_.grasp_layout;
   const force_model_t post = BuildForceModel(in);
   if (post.status == force_model_t::STATUS_INVALID) return;  // no usable post-snap model
   for (int i = 0; i < 3; ++i) {
     f.post_u0[i] = post.u0[i];
     f.post_f0[i] = post.f0[i];
+    f.post_torque0[i] = post.torque0[i];
     for (int j = 0; j < 3; ++j) f.post_K[i][j] = post.K[i][j];
   }
   if (fold_id_ == 0) fold_id_ = next_fold_id_++;
@@ -124,23 +136,60 @@ void FoldBoundary::Collect() {
   device_fold_ = f;
 }
 
-void FoldBoundary::AfterUpdate(const EquilibriumTracker& tracker, const Vec& u) {
+bool FoldBoundary::StillBeforeFold(const Vec& x, const Vec& u) const {
+  // The tracker calls a state change larger than its threshold a snap. Near a fold the
+  // branch itself moves like sqrt(distance) ((2.54-2.55), fold_search.h), so a large
+  // update step there (30 Hz on thread3d_loop: 1.5 degrees of turn) reads as a snap
+  // before the fold while the state stays on the branch; dropping the prediction then
+  // left the device without the fold it was about to cross. Such a state is nearer the
+  // branch's last state before the fold than the state past it.
+  const FoldPrediction* p = prediction_.get();
+  if (p == nullptr || p->normal.size() != u.size() || x.size() != p->x_before.size() ||
+      x.size() != p->x_after.size() || p->normal.dot(u - p->u_fold) >= 0.0) {
+    return false;
+  }
+  const double to_before = (x - p->x_before).lpNorm<Eigen::Infinity>();
+  const double to_after = (x - p->x_after).lpNorm<Eigen::Infinity>();
+  const bool before = to_before < to_after;
+  if (spdlog::should_log(spdlog::level::debug)) {
+    spdlog::debug("fold: a snap at u = {} before fold {}: {:.4g} from the branch's end, {:.4g} from past it: {}",
+                  Controls(u), fold_id_, to_before, to_after, before ? "still on the branch" : "a snap");
+  }
+  return before;
+}
+
+void FoldBoundary::AfterUpdate(const EquilibriumTracker& tracker, const Vec& u,
+                               const Eigen::Vector4d& orientation) {
   const TrackResult& r = tracker.last();
   // A snap, a reset or a resume puts the tracker on another branch: its fold is another.
   if (r.snapped || (have_last_ && (tracker.state() - x_last_).lpNorm<Eigen::Infinity>() >
                                       10.0 * jump_threshold_)) {
-    NewBranch();
+    if (!StillBeforeFold(tracker.state(), u)) NewBranch();
   }
   Collect();
+  // The hand went past the predicted boundary and the branch goes on: that fold is not
+  // this branch's here. A grip's controls are periodic and a branch is not: after a whole
+  // turn the state differs (thread3d_loop: the loop), so a fold found one turn on lies at
+  // controls the branch passes again without a snap, and the device must not switch
+  // there. Nor is a boundary the hand has passed without a snap (a device ignoring folds,
+  // one whose models came late) still ahead of it.
+  if (prediction_ != nullptr && !r.snapped && r.summary.IsSolutionUsable() &&
+      prediction_->normal.size() == u.size() && prediction_->normal.dot(u - prediction_->u_fold) > 0.0) {
+    if (spdlog::should_log(spdlog::level::debug)) {
+      spdlog::debug("fold: branch {} passed fold {} at u = {} without a snap: dropped", branch_, fold_id_,
+                    Controls(u));
+    }
+    prediction_.reset();
+    fold_id_ = 0;
+  }
 
   // Is a fold within reach? The square-root law: lambda^2 falls linearly with the
   // distance to the fold, so distance = lambda^2 / (lambda_prev^2 - lambda^2) * |du|.
   const double lambda = r.summary.lambda_min;
   const bool usable = r.summary.IsSolutionUsable() && r.summary.status != EquilibriumStatus::kSnapping;
   if (have_last_ && usable && !job_.busy()) {
-    const int dim = std::min(tracker.model().SpatialDimension(), static_cast<int>(u.size()));
-    Vec d = Vec::Zero(u.size());
-    d.head(dim) = (u - u_last_).head(dim);
+    // The hand's motion in all of its controls: a grip it turns too (fold_search.h).
+    Vec d = u - u_last_;
     const double step = d.norm();
     const double scale = SnapLengthScale(scene_.params);
     const double reach = std::clamp(kReachUpdates * step, kReach * scale, kMaxReach * scale);
@@ -156,7 +205,7 @@ void FoldBoundary::AfterUpdate(const EquilibriumTracker& tracker, const Vec& u) 
                        d.dot(prediction_direction_) > kTurnedCos;
     const bool clear = clear_reach_ > 0.0 && clear_direction_.size() == d.size() &&
                        d.dot(clear_direction_) > kTurnedCos &&
-                       (u - clear_u_).head(dim).dot(clear_direction_.head(dim)) < 0.5 * clear_reach_;
+                       (u - clear_u_).dot(clear_direction_) < 0.5 * clear_reach_;
     if (within && step > 0.0 && !known && !clear) {
       const Vec x = tracker.state();
       const Vec u0 = u;
@@ -168,14 +217,15 @@ void FoldBoundary::AfterUpdate(const EquilibriumTracker& tracker, const Vec& u) 
       ++searches_;
       if (spdlog::should_log(spdlog::level::debug)) {
         spdlog::debug("fold: search {} on branch {} from u = {}: lambda {:.4g} (was {:.4g}), reach {:.4g}",
-                      searches_, branch_, Controls(u0, dim), lambda, lambda_last_, reach);
+                      searches_, branch_, Controls(u0), lambda, lambda_last_, reach);
       }
       job_.Start(
-          [this, x, u0, d, branch, options, search = searches_] {
+          [this, x, u0, d, branch, options, orientation, search = searches_] {
             auto job = std::make_unique<Job>();
             job->branch = branch;
             job->search = search;
             job->u = u0;
+            job->orientation = orientation;
             job->direction = d;
             job->reach = options.reach;
             job->prediction = search_.Find(x, u0, d, options);
@@ -199,9 +249,12 @@ void FoldBoundary::Fill(force_model_t* msg) const {
   msg->fold_id = 0;
   msg->fold_curvature = 0.0;
   for (int i = 0; i < 3; ++i) {
-    msg->fold_point[i] = msg->fold_normal[i] = msg->post_u0[i] = msg->post_f0[i] = 0.0;
+    msg->fold_point[i] = msg->fold_normal[i] = msg->fold_normal_r[i] = 0.0;
+    msg->post_u0[i] = msg->post_f0[i] = msg->post_torque0[i] = 0.0;
     for (int j = 0; j < 3; ++j) msg->post_K[i][j] = 0.0;
   }
+  msg->fold_q[0] = 1.0;
+  msg->fold_q[1] = msg->fold_q[2] = msg->fold_q[3] = 0.0;
   if (prediction_ == nullptr || msg->status == force_model_t::STATUS_INVALID ||
       msg->status == force_model_t::STATUS_SNAPPING) {
     return;
@@ -210,11 +263,14 @@ void FoldBoundary::Fill(force_model_t* msg) const {
   msg->has_fold = 1;
   msg->fold_id = fold_id_;
   msg->fold_curvature = f.curvature;
+  for (int i = 0; i < 4; ++i) msg->fold_q[i] = f.q[i];
   for (int i = 0; i < 3; ++i) {
     msg->fold_point[i] = f.point[i];
     msg->fold_normal[i] = f.normal[i];
+    msg->fold_normal_r[i] = f.normal_r[i];
     msg->post_u0[i] = f.post_u0[i];
     msg->post_f0[i] = f.post_f0[i];
+    msg->post_torque0[i] = f.post_torque0[i];
     for (int j = 0; j < 3; ++j) msg->post_K[i][j] = f.post_K[i][j];
   }
   // The last line before the device: a prediction that fails the check is not sent.

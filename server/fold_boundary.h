@@ -1,7 +1,7 @@
 // Snap-ahead on the solve thread (issue 17): decides when a fold is within reach of the
 // hand, runs the FoldSearch in the background (BackgroundJob), keeps the current fold
 // prediction for the branch the tracker follows, writes it into each force model in
-// device units (force_model_t.has_fold ... post_K) and, when a pose says the device
+// device units (force_model_t.has_fold ... fold_normal_r; the pose chart, fold_chart.h) and, when a pose says the device
 // switched to a fold's post-snap model (device_state_t.snap_fold_id), hands the solve
 // the post-snap state so the next update starts on the new branch.
 //
@@ -16,7 +16,8 @@
 //
 // A branch keeps its prediction until the branch ends: a later search that finds no
 // fold (along another direction, or beyond its reach) does not take it back; one that
-// finds a fold replaces it. Once a branch has a prediction, it is searched again only
+// finds a fold replaces it; an update past the boundary that did not snap drops it (a
+// grip's controls repeat every turn, the branch does not). Once a branch has a prediction, it is searched again only
 // when the hand's direction has turned away from the one it was found along. A search
 // that found no fold cleared its segment of the line: the next one along about the same
 // direction starts when the hand has covered half of that reach.
@@ -24,6 +25,8 @@
 
 #include <cstdint>
 #include <memory>
+
+#include <Eigen/Core>
 
 #include "background_job.h"
 #include "fold_search.h"
@@ -43,9 +46,13 @@ class FoldBoundary {
   // Before an update for a pose that carries snap_fold_id: true (with the state and
   // controls to resume at) the first time the device reports the current fold's switch.
   bool TakeSwitch(int64_t snap_fold_id, Vec* x_after, Vec* u_after);
-  // After each update at controls u: notes branch changes, collects a finished search
-  // and starts one when a fold is within reach.
-  void AfterUpdate(const EquilibriumTracker& tracker, const Vec& u);
+  // After each update at controls u (the device at `orientation`, (w, x, y, z): a
+  // search's fold boundary is sent in the device's pose chart, fold_chart.h): notes
+  // branch changes, collects a finished search and starts one when a fold is within
+  // reach. The search follows all of the hand's controls: its position and the grip it
+  // turns (thread3d_loop's folds are reached by turning).
+  void AfterUpdate(const EquilibriumTracker& tracker, const Vec& u,
+                   const Eigen::Vector4d& orientation = Eigen::Vector4d(1.0, 0.0, 0.0, 0.0));
   // Writes the current prediction into msg (device units; has_fold = 0 when there is
   // none or msg is not a usable model). The post-snap fields come from BuildForceModel.
   void Fill(force_model_t* msg) const;
@@ -60,17 +67,23 @@ class FoldBoundary {
  private:
   // The prediction in device units, as force_model_t carries it.
   struct DeviceFold {
-    double point[3], normal[3], curvature, post_u0[3], post_f0[3], post_K[3][3];
+    double point[3], normal[3], curvature, post_u0[3], post_f0[3], post_K[3][3], q[4], normal_r[3],
+        post_torque0[3];
   };
   struct Job {
     int64_t branch = 0;
     int64_t search = 0;  // its number (searches_), for the log
     Vec u;               // where it started
-    Vec direction;       // unit, positional controls
+    Eigen::Vector4d orientation = Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);  // the device there
+    Vec direction;       // unit, all controls
     double reach = 0.0;
     FoldPrediction prediction;
   };
   void NewBranch();
+  // After an update the tracker called a snap (or a large state change): true when the
+  // hand is still short of the predicted boundary and the state nearer the followed
+  // branch's end than the state past the fold (the branch moving fast near its fold).
+  bool StillBeforeFold(const Vec& x, const Vec& u) const;
   // Takes a finished search's prediction (when it is for the current branch).
   void Collect();
 

@@ -96,8 +96,9 @@ bool FoldSearch::FoldNormal(const Vec& x, const Vec& u, Vec* normal) {
   eig.Update(*factor, h, 20);
   Mat exu(model.NumStates(), model.NumControls());
   model.MixedHessian(x, u, &exu);
-  // grad_u phi1 = E_ux v: the normal of the fold set (see the header).
-  const Vec n = (exu.transpose() * eig.vector()).head(dim_);
+  // grad_u phi1 = E_ux v: the normal of the fold set (see the header), in all of the
+  // controls: a fold reached by turning the grasp has its normal in the turning ones.
+  const Vec n = exu.transpose() * eig.vector();
   const double norm = n.norm();
   if (!(norm > 0.0) || !n.allFinite()) return false;
   *normal = n / norm;
@@ -111,33 +112,52 @@ FoldPrediction FoldSearch::Find(const Vec& x, const Vec& u, const Vec& d,
     const double step = options.reach / 16.0;
     double s_lo = 0.0, s_hi = 0.0;
     Vec x_lo;
-    if (!Bracket(x, u, d, options.reach, step, options.tolerance, &s_lo, &x_lo, &s_hi)) return p;
+    if (!Bracket(x, u, d, options.reach, step, options.tolerance, &s_lo, &x_lo, &s_hi)) {
+      p.why_not = "the branch goes on within reach";
+      return p;
+    }
     p.x_after = tracker_->state();
     p.u_after = u + s_hi * d;
     p.after = tracker_->last();
     p.x_before = x_lo;
     p.u_before = u + s_lo * d;
     p.u_fold = u + (0.5 * (s_lo + s_hi)) * d;
-    if (!FoldNormal(p.x_before, p.u_before, &p.normal)) return p;
-    // The hand crosses along +normal: it moves along d towards the fold.
-    if (p.normal.dot(d.head(dim_)) < 0.0) p.normal = -p.normal;
-    // A fold the hand's position hardly reaches (one driven by the grip direction): its
-    // boundary in position space is not what the hand crosses.
-    if (p.normal.dot(d.head(dim_)) < 0.1 * d.head(dim_).norm()) return p;
-    // Curvature from two side searches at +-lateral along the tangent in the plane of d
-    // and the normal: the boundary n.w = (kappa/2) |w_perp|^2 puts the side fold points
-    // kappa lateral^2 / 2 further along n.
-    Vec t = d.head(dim_) - p.normal * p.normal.dot(d.head(dim_));
-    if (t.norm() < 1e-6 && dim_ >= 2) {
-      t = Vec::Zero(dim_);
-      t[p.normal[0] < 0.9 && p.normal[0] > -0.9 ? 0 : 1] = 1.0;
-      t -= p.normal * p.normal.dot(t);
+    if (!FoldNormal(p.x_before, p.u_before, &p.normal)) {
+      p.why_not = "no normal";
+      return p;
     }
-    if (t.norm() > 0.0) {
+    // The hand crosses along +normal: it moves along d towards the fold.
+    if (p.normal.dot(d) < 0.0) p.normal = -p.normal;
+    // A fold the hand's motion hardly reaches: the boundary is not what the hand crosses.
+    if (p.normal.dot(d) < 0.1 * d.norm()) {
+      p.why_not = "the motion hardly reaches it";
+      return p;
+    }
+    // Curvature from two side searches at +-lateral along a positional tangent t (normal
+    // to the normal's positional part, in the plane of d's positional part when the hand
+    // moves): the boundary n.w = (kappa/2) |w_t|^2 puts the side fold points
+    // kappa lateral^2 / 2 further along n. t is normal to n, so the sides start on the
+    // tangent plane.
+    const Vec n_pos = p.normal.head(dim_);
+    const double np2 = n_pos.squaredNorm();
+    Vec t = d.head(dim_);
+    if (np2 > 0.0) t -= n_pos * (n_pos.dot(t) / np2);
+    if (t.norm() < 1e-6 && dim_ >= 2) {
+      // The hand turns in place (or moves along the normal): the positional axis least
+      // along the normal.
+      t = Vec::Zero(dim_);
+      int axis = 0;
+      for (int i = 1; i < dim_; ++i) {
+        if (std::abs(n_pos[i]) < std::abs(n_pos[axis])) axis = i;
+      }
+      t[axis] = 1.0;
+      if (np2 > 0.0) t -= n_pos * (n_pos.dot(t) / np2);
+    }
+    if (t.norm() > 1e-6) {
       t.normalize();
-      Vec n_full = Vec::Zero(u.size()), t_full = Vec::Zero(u.size());
-      n_full.head(dim_) = p.normal;
+      Vec t_full = Vec::Zero(u.size());
       t_full.head(dim_) = t;
+      const Vec& n_full = p.normal;
       const double lat = options.lateral;
       double offsets[2];
       int found = 0;
@@ -157,6 +177,7 @@ FoldPrediction FoldSearch::Find(const Vec& x, const Vec& u, const Vec& d,
     p.found = true;
   } catch (const std::exception&) {
     p.found = false;  // numeric trouble in the search: no prediction, never a bad one
+    p.why_not = "numeric trouble";
   }
   return p;
 }

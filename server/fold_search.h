@@ -25,15 +25,17 @@ namespace snapthread::server {
 struct FoldPrediction {
   bool found = false;
   Vec u_fold;           // the fold point, full controls (model units)
-  Vec normal;           // unit, positional controls; the hand crosses along +normal
-  // Of the boundary n.w = (curvature / 2) |w_perp|^2 (w = u - u_fold, positional): > 0
-  // bends away from the approaching hand. 1 / model unit.
+  Vec normal;           // unit, all controls (a grip's too); the hand crosses along +normal
+  // Of the boundary n.w = (curvature / 2) |w_t|^2 (w = u - u_fold; w_t its part along
+  // positional directions normal to n): > 0 bends away from the approaching hand.
+  // 1 / model unit.
   double curvature = 0.0;
   Vec x_before;         // last state on the followed branch (at u_before)
   Vec u_before;
   Vec x_after;          // the equilibrium past the fold (the other branch) at u_after
   Vec u_after;
   TrackResult after;    // its force and K (model units)
+  const char* why_not = "";  // found = false: why (for the log)
 };
 
 struct FoldSearchOptions {
@@ -47,8 +49,10 @@ class FoldSearch {
   // Its own tracker from the scene (MakeTracker) with an unlimited iteration budget and
   // no time budget: accuracy, not latency, matters off the solve thread.
   explicit FoldSearch(const Scene& scene);
-  // From the equilibrium x at controls u, along the unit direction d (full controls,
-  // zero beyond the positional ones). found = false when the branch goes on for `reach`.
+  // From the equilibrium x at controls u, along the unit direction d (full controls: the
+  // hand's motion, turning a grip included; the models see a grip direction's
+  // direction only, so a line of grip controls is the great circle it turns through).
+  // found = false when the branch goes on for `reach`.
   // Never throws for numeric trouble (found = false).
   FoldPrediction Find(const Vec& x, const Vec& u, const Vec& d, const FoldSearchOptions& options);
   // Its model (for building messages once no search runs).
@@ -63,12 +67,13 @@ class FoldSearch {
   // tracker then holds the snapped state). False when no fold within reach.
   bool Bracket(const Vec& x, const Vec& u, const Vec& d, double reach, double step, double tol,
                double* s_lo, Vec* x_lo, double* s_hi);
-  // E_ux v at (x, u) with v the lowest eigenvector of E_xx (inverse iteration).
+  // E_ux v at (x, u) with v the lowest eigenvector of E_xx (inverse iteration), unit,
+  // all controls.
   bool FoldNormal(const Vec& x, const Vec& u, Vec* normal);
 
   std::unique_ptr<EquilibriumTracker> tracker_;
   double jump_threshold_ = 0.1;
-  int dim_ = 0;
+  int dim_ = 0;  // positional controls
 };
 
 }  // namespace snapthread::server

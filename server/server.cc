@@ -369,7 +369,17 @@ void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
   }
   const double solve_us = std::chrono::duration<double, std::micro>(SteadyClock::now() - t0).count();
   if (hooks_.after_update && result != nullptr) hooks_.after_update(u, tracker);
-  if (session_->fold && result != nullptr) session_->fold->AfterUpdate(tracker, u);
+  if (session_->fold && result != nullptr) {
+    // The hand's orientation: a fold reached by turning is sent in its pose chart.
+    Eigen::Vector4d q(1.0, 0.0, 0.0, 0.0);
+    for (size_t k = 0; k < poses.size(); ++k) {
+      if (grasp_of[k] >= 0) {
+        const double* o = poses[k].state.orientation;
+        q = Eigen::Vector4d(o[0], o[1], o[2], o[3]);
+      }
+    }
+    session_->fold->AfterUpdate(tracker, u, q);
+  }
 
   updates_.fetch_add(1);
   if (ClassifyStatus(result) == force_model_t::STATUS_SNAPPED || (switched_ && result != nullptr)) {

@@ -38,15 +38,21 @@ bool WrenchOrientation(const force_model_t& msg, std::string* why) {
   return msg.has_wrench == 0 || UnitQuaternion(msg.q0, "q0", why);
 }
 
-// A fold boundary's normal must be a unit vector when the fold is used.
+// A fold boundary's normal (fold_normal, fold_normal_r: position and rotation parts) must
+// be a unit vector, and its orientation a quaternion, when the fold is used.
 bool FoldNormal(const force_model_t& msg, std::string* why) {
   if (msg.has_fold == 0) return true;
   double n2 = 0.0;
   for (double v : msg.fold_normal) n2 += v * v;
+  for (double v : msg.fold_normal_r) n2 += v * v;
   if (std::abs(std::sqrt(n2) - 1.0) > 1e-3) {
-    return Fail(why, "fold_normal is not a unit vector (norm " + std::to_string(std::sqrt(n2)) + ")");
+    return Fail(why, "(fold_normal, fold_normal_r) is not a unit vector (norm " + std::to_string(std::sqrt(n2)) + ")");
   }
   return true;
+}
+
+bool FoldOrientation(const force_model_t& msg, std::string* why) {
+  return msg.has_fold == 0 || UnitQuaternion(msg.fold_q, "fold_q", why);
 }
 
 // Rows of a variable array: as many as its count says, `per_row` finite values each.
@@ -121,11 +127,14 @@ const Field<F> kForceModel[] = {
     Member<&F::has_fold>("has_fold", 0, 1),
     Member<&F::fold_id>("fold_id"),
     Member<&F::fold_point>("fold_point"),
-    With(Member<&F::fold_normal>("fold_normal"), &FoldNormal),
+    Member<&F::fold_normal>("fold_normal"),
     Member<&F::fold_curvature>("fold_curvature"),
     Member<&F::post_u0>("post_u0"),
     Member<&F::post_f0>("post_f0"),
     Member<&F::post_K>("post_K"),
+    With(Member<&F::fold_q>("fold_q"), &FoldOrientation),
+    With(Member<&F::fold_normal_r>("fold_normal_r"), &FoldNormal),
+    Member<&F::post_torque0>("post_torque0"),
     Member<&F::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&F::auth_seq>("auth_seq"),
     Member<&F::mac>("mac"),

@@ -109,4 +109,19 @@ inline Eigen::Matrix3d LeftJacobianDerivative(const Eigen::Vector3d& phi, const 
   return k.da_over_theta * pw * h + k.a * hw + k.db_over_theta * pw * h * h + k.b * (hw * h + h * hw);
 }
 
+// The smallest rotation taking the direction `from` to `to` (the identity for a zero or
+// non-finite vector; half a turn about an axis normal to `from` when they are opposite).
+// Turns a grip direction (thread3d's grasp: a direction, not a frame) into a rotation.
+inline Eigen::Matrix3d SmallestRotation(const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+  const double nf = from.norm(), nt = to.norm();
+  if (!(nf > 0.0) || !(nt > 0.0) || !from.allFinite() || !to.allFinite()) return Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d a = from / nf, b = to / nt;
+  const Eigen::Vector3d axis = a.cross(b);
+  const double s = axis.norm();
+  if (s > 1e-12) return Exp((std::atan2(s, a.dot(b)) / s) * axis);
+  if (a.dot(b) > 0.0) return Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d normal = a.cross(std::abs(a.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY());
+  return Exp((std::numbers::pi / normal.norm()) * normal);
+}
+
 }  // namespace snapthread::so3

@@ -3,8 +3,9 @@
 // (tests/support/allocation_counter.h, after Drake's iiwa_command_sender_test.cc malloc
 // guard), one warm-up tick runs, then 10,000 ticks must allocate nothing, through fresh
 // models, stale-model fades, out-of-workspace poses, full rings and both simulated
-// backends; and the same through DeviceClient::Tick (the production path) with its
-// receive and io steps run between the ticks.
+// backends, a snap-ahead crossing of a fold reached by turning; and the same through
+// DeviceClient::Tick (the production path) with its receive and io steps run between
+// the ticks.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -67,8 +68,26 @@ force_model_t WrenchModel(int64_t seq) {
   return m;
 }
 
-// Runs the ticks; returns the number of rejected poses.
-uint64_t RunTicks(HapticDevice* device, int ticks, bool wrench = false) {
+// The same with a fold reached by turning about z (snap-ahead, issue 17 item 5): the
+// boundary in the pose chart, at 1.5 rad, a new fold id every 200 models; device_seq
+// outruns the poses' seq so a switch ends at the next model and the check runs again.
+force_model_t TurningFoldModel(int64_t seq) {
+  force_model_t m = WrenchModel(seq);
+  m.device_seq = 10 * seq;
+  m.has_fold = 1;
+  m.fold_id = 1 + seq / 200;
+  m.fold_normal_r[2] = 1.0;
+  m.fold_q[0] = std::cos(0.75);
+  m.fold_q[3] = std::sin(0.75);
+  m.post_f0[1] = -0.5;
+  m.post_torque0[2] = 0.01;
+  for (int i = 0; i < 3; ++i) m.post_K[i][i] = -200.0;
+  return m;
+}
+
+// Runs the ticks; returns the number of rejected poses. With `snap_ahead` the tick
+// selects through it (and the models carry a turning fold).
+uint64_t RunTicks(HapticDevice* device, int ticks, bool wrench = false, SnapAhead* snap_ahead = nullptr) {
   EXPECT_TRUE(device->Open(nullptr));
   SafetyLimits limits;
   limits.workspace_radius_m = 0.05;
@@ -80,6 +99,7 @@ uint64_t RunTicks(HapticDevice* device, int ticks, bool wrench = false) {
   ServoTickOptions options;
   options.publish_divisor = 2;
   ServoTick tick(device, &safety, models.get(), poses.get(), trace.get(), lateness.get(), options);
+  if (snap_ahead != nullptr) tick.SetSnapAhead(snap_ahead);
 
   // Warm-up tick (first use of everything).
   g_now_us += 1000;
@@ -95,7 +115,10 @@ uint64_t RunTicks(HapticDevice* device, int ticks, bool wrench = false) {
     if (i % 5 == 0 && !silent) {
       LocalModel m;
       ++seq;
-      PrepareModel(wrench ? WrenchModel(seq) : SpringModel(seq), g_now_us, limits, &m, nullptr);
+      const force_model_t msg = snap_ahead != nullptr ? TurningFoldModel(seq)
+                                : wrench              ? WrenchModel(seq)
+                                                      : SpringModel(seq);
+      EXPECT_NE(PrepareModel(msg, g_now_us, limits, &m, nullptr), ModelVerdict::kRejected);
       models->Write(m);
     }
     if (i % 100 == 0 && i < 1000) {
@@ -139,6 +162,16 @@ TEST(DeviceServoTickAllocationTest, SimPathWrenchTickNeverAllocates) {
                                  0.05, 3.0),
                     &TestClock);
   RunTicks(&sim, 10000, true);
+}
+
+// Snap-ahead's crossing check from the hand's quaternion (a fold reached by turning):
+// the hand turns back and forth through the fold, the tick switches to post-snap models.
+TEST(DeviceServoTickAllocationTest, TurningFoldCrossingNeverAllocates) {
+  SimPathDevice sim(ScriptedPath({{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}}, {{0.0, 0.0, 0.0}, {0.0, 0.0, 3.0}}, 0.05, 3.0),
+                    &TestClock);
+  SnapAhead snap_ahead;
+  RunTicks(&sim, 10000, true, &snap_ahead);
+  EXPECT_GE(snap_ahead.switches(), 3u) << "the hand crossed the fold and the tick switched";
 }
 
 TEST(DeviceServoTickAllocationTest, DeviceClientTickNeverAllocates) {

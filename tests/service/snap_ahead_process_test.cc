@@ -34,6 +34,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "messages/pose_mapping.h"
 #include "safety.h"
 #include "scene/scene.h"
 #include "snap_session.h"
@@ -211,7 +212,10 @@ class SnapAheadProcessTest : public ::testing::Test {
     ASSERT_TRUE(probe.good()) << "LCM udpm does not start here (deploy/multicast-route.sh)";
     tmp_ = std::make_unique<test_support::ScopedTempDir>("snap_ahead_" + test_support::UniqueSession("SA"));
     scene_path_ = source_ + "/scenes/curve2d_snap.yaml";
-    folds_ = TrueFolds(LoadScene(scene_path_), 0.01);
+    // The true folds' controls, as device positions (curve2d_snap is reached by moving).
+    const Scene scene = LoadScene(scene_path_);
+    for (const Vec& u : TrueFolds(scene, 0.01))
+      folds_.push_back(messages::ControlsToPosition(scene.device, scene.grasp_layout, u));
     ASSERT_EQ(folds_.size(), 2u) << "curve2d_snap's path crosses two folds";
   }
 

@@ -2,8 +2,9 @@
 # The snap-ahead chart in docs/images (issue 17): snap position error, in servo ticks of
 # travel, against the server's update rate (1000, 300, 100, 30 Hz), with and without
 # snap-ahead, for curve2d_snap and thread3d_loop (snapthread-snap-ahead-chart: sessions
-# on a fake clock, so the numbers do not depend on the machine's load). Writes
-# docs/images/snap_ahead.png and docs/snap_ahead.csv.
+# on a fake clock, so the numbers do not depend on the machine's load). thread3d_loop's
+# snaps are reached by turning the grip (45 degrees/s): its ticks of travel are ticks of
+# turning. Writes docs/images/snap_ahead.png and docs/snap_ahead.csv.
 # usage: tools/snap_ahead/chart.sh [BUILD_BIN_DIR] [OUT_DIR]   (gnuplot from gnuplot-nox)
 set -eu
 here=$(cd "$(dirname "$0")/../.." && pwd)
@@ -30,13 +31,13 @@ gnuplot <<GP
 set terminal pngcairo size 900,560 font 'DejaVu Sans,10'
 set termoption noenhanced
 set output '$out/snap_ahead.png'
-set title 'Snap position error vs server rate (sim-path hand, 0.05 m/s; 1 kHz servo)'
+set title 'Snap position error vs server rate (sim-path hand: 0.05 m/s, thread3d_loop turning 45 deg/s; 1 kHz servo)'
 set grid
 set logscale x
 set xrange [20:1500]
 set xtics (30, 100, 300, 1000)
 set xlabel 'server equilibrium updates per second (--max-update-hz)'
-set ylabel 'mean |snap position - true fold| (servo ticks of travel)'
+set ylabel 'mean |felt snap - true fold| (servo ticks of travel or turning)'
 set key top right
 plot 'curve2d_snap_1.dat' using 1:2 with linespoints lw 2 pt 7 title 'curve2d_snap, snap-ahead', \
      'curve2d_snap_0.dat' using 1:2 with linespoints lw 2 pt 6 dt 2 title 'curve2d_snap, --no-snap-ahead', \

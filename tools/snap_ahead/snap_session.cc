@@ -60,6 +60,10 @@ SessionResult RunSession(const Scene& scene, const SessionOptions& options) {
   config.log_period_us = 0;
   config.clock = &FakeClock;
   config.snap_ahead = options.snap_ahead;
+  // As snapthread-device sets them: the sim-path hand senses its orientation and renders
+  // torque (the grip's, thread3d_loop).
+  config.device_has_orientation = hand.capabilities().has_orientation;
+  config.device_torque_output = hand.capabilities().has_torque_output;
   device::DeviceClient client(&hand, &wire, config);
 
   // The server: its scene -> tracker path, started where the hand starts.
@@ -70,7 +74,7 @@ SessionResult RunSession(const Scene& scene, const SessionOptions& options) {
   const Eigen::Vector3d rest = messages::RestGripDirection(scene);
 
   const double duration_s =
-      options.duration_s > 0.0 ? options.duration_s : path.length_m() / options.speed_m_per_s;
+      options.duration_s > 0.0 ? options.duration_s : path.duration_s();
   const int64_t ticks = static_cast<int64_t>(std::llround(duration_s * 1000.0));
   const double period_us = 1e6 / options.server_hz;
   double next_solve_us = static_cast<double>(g_now_us);
@@ -81,10 +85,14 @@ SessionResult RunSession(const Scene& scene, const SessionOptions& options) {
     g_now_us += 1000;
     client.Tick(g_now_us, 0);
     const double* f = hand.last_force_n();
+    const double* tq = hand.last_torque_nm();
     device::DeviceState state;
     hand.Read(&state);
     out.ticks.push_back({Eigen::Vector3d(state.position_m[0], state.position_m[1], state.position_m[2]),
-                         Eigen::Vector3d(f[0], f[1], f[2])});
+                         Eigen::Vector4d(state.orientation[0], state.orientation[1], state.orientation[2],
+                                         state.orientation[3]),
+                         Eigen::Vector3d(f[0], f[1], f[2]),
+                         Eigen::Vector3d(tq[0], tq[1], tq[2])});
     client.Service(g_now_us);  // publishes this tick's pose
     if (wire.newest && static_cast<double>(g_now_us) >= next_solve_us) {
       next_solve_us += period_us;
@@ -98,7 +106,7 @@ SessionResult RunSession(const Scene& scene, const SessionOptions& options) {
       if (fold && fold->TakeSwitch(pose.snap_fold_id, &x_after, &u_after)) tracker->Resume(x_after, u_after);
       const TrackResult& r = tracker->Update(u);
       if (fold) {
-        fold->AfterUpdate(*tracker, u);
+        fold->AfterUpdate(*tracker, u, q);
         fold->WaitForSearch();
       }
       server::ForceModelInputs in;
@@ -107,6 +115,7 @@ SessionResult RunSession(const Scene& scene, const SessionOptions& options) {
       in.u = u;
       in.position_m = p;
       in.result = &r;
+      in.layout = &scene.grasp_layout;
       in.device_seq = pose.seq;
       in.device_utime = pose.utime;
       in.seq = model_seq++;
@@ -126,23 +135,31 @@ SessionResult RunSession(const Scene& scene, const SessionOptions& options) {
 }
 
 std::vector<ForceJump> ForceJumps(const std::vector<TickRow>& ticks, double step_n_per_tick,
-                                  int settle_ticks) {
+                                  double step_nm_per_tick, int settle_ticks) {
   std::vector<ForceJump> jumps;
   bool in_step = false;
   for (size_t i = static_cast<size_t>(std::max(settle_ticks, 1)); i < ticks.size(); ++i) {
-    const bool big = (ticks[i].force_n - ticks[i - 1].force_n).norm() > step_n_per_tick;
-    if (big && !in_step) jumps.push_back({static_cast<int>(i), ticks[i].position_m, 0.0});
-    if (big) jumps.back().size_n = (ticks[i].force_n - ticks[jumps.back().tick - 1].force_n).norm();
+    const bool big = (ticks[i].force_n - ticks[i - 1].force_n).norm() > step_n_per_tick ||
+                     (step_nm_per_tick > 0.0 &&
+                      (ticks[i].torque_nm - ticks[i - 1].torque_nm).norm() > step_nm_per_tick);
+    if (big && !in_step) jumps.push_back({static_cast<int>(i), ticks[i].position_m, 0.0, 0.0});
+    if (big) {
+      const TickRow& before = ticks[jumps.back().tick - 1];
+      jumps.back().size_n = (ticks[i].force_n - before.force_n).norm();
+      jumps.back().size_nm = (ticks[i].torque_nm - before.torque_nm).norm();
+    }
     in_step = big;
   }
   return jumps;
 }
 
-std::vector<Eigen::Vector3d> TrueFolds(const Scene& scene, double step) {
+std::vector<Vec> TrueFolds(const Scene& scene, double step) {
   std::unique_ptr<EquilibriumTracker> tracker = MakeTracker(scene);
   tracker->Reset(scene.grasp_start);
-  std::vector<Eigen::Vector3d> folds;
+  std::vector<Vec> folds;
   Vec u = scene.grasp_start;
+  const GraspLayout& layout = scene.grasp_layout;
+  const int dim = layout.spatial_dimension;
   for (size_t w = 1; w < scene.path.size(); ++w) {
     const Vec a = scene.path[w - 1], b = scene.path[w];
     const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step)));
@@ -157,7 +174,10 @@ std::vector<Eigen::Vector3d> TrueFolds(const Scene& scene, double step) {
       for (int j = 1; j <= 1000; ++j) {
         const Vec fine = before + (u - before) * (j / 1000.0);
         if (tracker->Update(fine).snapped) {
-          folds.push_back(messages::ControlsToPosition(scene.device, scene.grasp_layout, 0.5 * (lo + fine)));
+          Vec fold = 0.5 * (lo + fine);
+          // The model sees a grip direction's direction only (thread3d_model.cc).
+          if (layout.grip_direction && fold.size() >= dim + 3) fold.segment(dim, 3).normalize();
+          folds.push_back(fold);
           break;
         }
         lo = fine;
@@ -166,6 +186,21 @@ std::vector<Eigen::Vector3d> TrueFolds(const Scene& scene, double step) {
     }
   }
   return folds;
+}
+
+Vec TickControls(const Scene& scene, const TickRow& tick) {
+  return messages::PoseToControls(scene.device, scene.grasp_layout, tick.position_m, tick.orientation,
+                                  messages::RestGripDirection(scene));
+}
+
+double SnapErrorTicks(const Scene& scene, const std::vector<TickRow>& ticks, const ForceJump& jump,
+                      const Vec& fold) {
+  if (jump.tick < 1 || static_cast<size_t>(jump.tick) >= ticks.size()) return NAN;
+  const Vec u = TickControls(scene, ticks[jump.tick]);
+  const Vec v = u - TickControls(scene, ticks[jump.tick - 1]);
+  const double v2 = v.squaredNorm();
+  if (!(v2 > 0.0) || u.size() != fold.size()) return NAN;
+  return (u - fold).dot(v) / v2;
 }
 
 }  // namespace snapthread::snap_ahead
