@@ -2,7 +2,7 @@
 # The whole test suite (what CI runs, issue 12 item 7):
 #  1. set-up (packages + Release build: -O3 -DNDEBUG, warnings as errors), then every test;
 #  2. a second build with AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/), then
-#     every test but the multi-process ones under it (what is left out, and why, is below);
+#     every test again under it (the viewer's ones without the leak check: why, below);
 #  3. short libFuzzer runs of the scene loader and the message decoders (build-fuzz/, clang),
 #     FUZZ_SECONDS each (default 30; docs on the long runs in the README's Tests section).
 # Usage: deploy/test.sh [--quick]   (--quick: step 1 only, for a local edit-test loop)
@@ -18,27 +18,31 @@ if [ "${1:-}" != "--quick" ]; then
   echo "test: sanitizer build (ASan + UBSan) in build-asan/"
   # -Werror stays on the Release build: GCC 12 reports false maybe-uninitialized warnings
   # in libstdc++ under the sanitizers.
-  # snapthread-web is left out: its tests are browser tests (process), not run here.
   cmake -S "$here" -B "$here/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSNAPTHREAD_SANITIZE=ON \
-    -DSNAPTHREAD_WERROR=OFF -DSNAPTHREAD_BUILD_WEB=OFF >/dev/null
+    -DSNAPTHREAD_WERROR=OFF >/dev/null
   cmake --build "$here/build-asan" -j"$(nproc)"
   cd "$here/build-asan"
-  # Under the sanitizers: every in-process test of the labels unit, report and service (the
-  # models, linear algebra, solvers, contact, knots, scenes, sweep, stability, auth,
-  # messages, report, the in-process server and device over memq:// and udpm, and the
-  # allocation counters, which count through ASan's malloc hook there). LCM subscriptions
-  # go through messages::Subscribe (common/messages/subscribe.h): liblcm's own
-  # member-function subscriptions trip a GCC 12 UBSan false report (see that header).
-  # SNAPTHREAD_SPEED_SCALE: this build is slower, so wall-clock budgets that are about
-  # speed (time_budget_test's 300 us) are multiplied by it; no safety bound is.
-  # Left out, and why (OPEN, issue 12 item 7): the multi-process, soak and namespace tests
-  # (labels process, soak, netns: they start the sanitized binaries over udpm; their timing
-  # under the slowdown is not measured), the viewer tests (label viewer: Mesa and X11 under
-  # LeakSanitizer not yet run) and DeviceServoLoopTest (it asserts a 1 kHz tick rate, a
-  # speed figure the sanitized build is not meant to meet).
-  SNAPTHREAD_SPEED_SCALE=4 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
-  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --output-on-failure -j2 --timeout 900 -LE 'open|process|soak|netns|viewer' -E 'DeviceServoLoopTest'
+  # Every test again, the same as above, on the sanitized binaries: the in-process ones and
+  # the multi-process, soak, namespace, viewer and browser ones, which start the sanitized
+  # server, device, viewer, logger and web bridge. LCM subscriptions go through
+  # messages::Subscribe (common/messages/subscribe.h): liblcm's own member-function
+  # subscriptions trip a GCC 12 UBSan false report (see that header).
+  # SNAPTHREAD_SPEED_SCALE=16: the rod's sweep takes 14x the CPU time in this build, so
+  # thresholds that are about speed (a time budget, start-up-and-refusal time, models per
+  # servo tick, shapes per second) are divided by it (tests/support/environment.h); no
+  # safety property is.
+  export SNAPTHREAD_SPEED_SCALE=16 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+    ctest --output-on-failure -j2 --timeout 900 -LE 'open|viewer|soak|netns'
+  # The tests that start the viewer (OpenGL under Xvfb: labels viewer, soak, netns) run with
+  # ASan and UBSan but without LeakSanitizer: Mesa's llvmpipe driver (22.3) leaks two 56-byte
+  # blocks that it frees never and whose module it unloads (dlclose) before the exit-time
+  # check, so no suppression can name them (an LSan suppression matches a module or
+  # function name; these frames have neither). The viewer's own code (decoding, the
+  # receiver, the frames, the renderer's geometry) is leak-checked in-process above
+  # (viewer_core_test).
+  ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
+    ctest --output-on-failure -j2 --timeout 900 -L 'viewer|soak|netns' -LE open
 fi
 
 if [ "${1:-}" != "--quick" ]; then

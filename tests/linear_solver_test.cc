@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "allocation_counter.h"
+#include "linear_solver_matrices.h"
 #include "linalg/linear_solver.h"
 #include "models/models.h"
 #include "solvers/solver.h"
@@ -26,79 +27,7 @@ namespace {
 
 // Allocation counting: tests/support/allocation_counter.h.
 using test_support::AllocationCounter;
-
-// ---------------------------------------------------------------------------------
-// Matrices.
-
-// Sparse matrix with the full band |i - j| <= b as its pattern (zeros stored too, so
-// the pattern depends only on n and b), values from `dense`.
-SparseMatrix BandToSparse(const Mat& dense, int b) {
-  const int n = static_cast<int>(dense.rows());
-  std::vector<Eigen::Triplet<double>> t;
-  for (int j = 0; j < n; ++j) {
-    for (int i = std::max(0, j - b); i <= std::min(n - 1, j + b); ++i) {
-      t.emplace_back(i, j, dense(i, j));
-    }
-  }
-  SparseMatrix a(n, n);
-  a.setFromTriplets(t.begin(), t.end());
-  a.makeCompressed();
-  return a;
-}
-
-// Random symmetric band matrix, entries uniform in [-1, 1].
-Mat RandomSymmetricBand(int n, int b, std::mt19937* rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Mat m = Mat::Zero(n, n);
-  for (int j = 0; j < n; ++j) {
-    for (int i = j; i <= std::min(n - 1, j + b); ++i) m(i, j) = m(j, i) = u(*rng);
-  }
-  return m;
-}
-
-// SPD by strict diagonal dominance: a_ii = 1 + sum_j |a_ij| (+ a random scale).
-Mat RandomSpdBand(int n, int b, std::mt19937* rng) {
-  Mat m = RandomSymmetricBand(n, b, rng);
-  for (int i = 0; i < n; ++i) m(i, i) = 1.0 + m.row(i).cwiseAbs().sum() - std::abs(m(i, i));
-  return m;
-}
-
-// Q diag(lambda) Q^T with `negative` eigenvalues in [-3, -0.5], the rest in [0.5, 3].
-Mat RandomWithInertia(int n, int negative, std::mt19937* rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0), mag(0.5, 3.0);
-  Mat g(n, n);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) g(i, j) = u(*rng);
-  }
-  const Mat q = Eigen::HouseholderQR<Mat>(g).householderQ();
-  Vec lambda(n);
-  for (int i = 0; i < n; ++i) lambda[i] = (i < negative ? -1.0 : 1.0) * mag(*rng);
-  Mat a = q * lambda.asDiagonal() * q.transpose();
-  return 0.5 * (a + a.transpose());
-}
-
-Vec RandomVector(int n, std::mt19937* rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Vec v(n);
-  for (int i = 0; i < n; ++i) v[i] = u(*rng);
-  return v;
-}
-
-double RelativeError(const Vec& x, const Vec& reference) {
-  return (x - reference).norm() / reference.norm();
-}
-
-// Path-graph Laplacian (free ends): symmetric, PSD, exactly singular (constant null
-// vector).
-Mat PathLaplacian(int n) {
-  Mat m = Mat::Zero(n, n);
-  for (int i = 0; i + 1 < n; ++i) {
-    m(i, i) += 1.0;
-    m(i + 1, i + 1) += 1.0;
-    m(i, i + 1) = m(i + 1, i) = -1.0;
-  }
-  return m;
-}
+using namespace test_matrices;
 
 // ---------------------------------------------------------------------------------
 // One body per backend.
@@ -548,96 +477,6 @@ INSTANTIATE_TEST_SUITE_P(Backends, LinearSolverTest, ::testing::ValuesIn(Concret
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            return info.param;
                          });
-
-// ---------------------------------------------------------------------------------
-
-// The guard must be able to fail: it sees C++, Eigen and CHOLMOD allocations.
-TEST(AllocationCounterTest, SeesEveryKindOfAllocation) {
-  {
-    AllocationCounter counter;
-    std::vector<int>* v = new std::vector<int>(100);
-    counter.Stop();
-    delete v;
-    EXPECT_GE(counter.news(), 2);
-    EXPECT_GE(counter.mallocs(), 2);
-  }
-  {
-    AllocationCounter counter;
-    Vec* v = new Vec(100);  // the coefficients come from Eigen's aligned_malloc
-    counter.Stop();
-    delete v;
-    EXPECT_GE(counter.mallocs(), 2);
-  }
-  {
-    std::string error;
-    auto solver = MakeLinearSolver("cholmod", 10, 1, &error);
-    ASSERT_NE(solver, nullptr);
-    const SparseMatrix a = BandToSparse(PathLaplacian(10) + Mat::Identity(10, 10), 1);
-    AllocationCounter counter;
-    const LinearSolverStatus s = solver->Analyze(a);
-    counter.Stop();
-    EXPECT_EQ(s, LinearSolverStatus::kSuccess);
-    // cholmod_analyze's own mallocs are counted beyond the std::vectors of Analyze().
-    EXPECT_GT(counter.mallocs(), counter.news());
-  }
-}
-
-TEST(MakeLinearSolverTest, KnownNamesMakeSolversAndUnknownNamesSayWhy) {
-  for (const std::string& name : LinearSolverNames()) {
-    std::string error;
-    EXPECT_NE(MakeLinearSolver(name, 100, 8, &error), nullptr) << name << ": " << error;
-  }
-  std::string error;
-  EXPECT_EQ(MakeLinearSolver("lu", 10, 1, &error), nullptr);
-  EXPECT_NE(error.find("lu"), std::string::npos);
-  EXPECT_NE(error.find("cholmod"), std::string::npos);
-  EXPECT_EQ(MakeLinearSolver("lu", 10, 1, nullptr), nullptr);
-  EXPECT_STREQ(ToString(LinearSolverStatus::kSuccess), "success");
-  EXPECT_STRNE(ToString(LinearSolverStatus::kNumericalIssue),
-               ToString(LinearSolverStatus::kInvalidInput));
-}
-
-// The measured rule documented above MakeLinearSolver: band with 2b <= n -> banded,
-// other small matrices -> dense, the rest (and unknown bandwidth) -> cholmod.
-TEST(MakeLinearSolverTest, AutoFollowsTheDocumentedRule) {
-  const auto picked = [](int n, int bandwidth) {
-    std::string error;
-    auto solver = MakeLinearSolver("auto", n, bandwidth, &error);
-    return solver ? std::string(solver->Name()) : error;
-  };
-  EXPECT_EQ(picked(300, 8), "banded");
-  EXPECT_EQ(picked(3000, 8), "banded");
-  EXPECT_EQ(picked(16, 8), "banded");
-  EXPECT_EQ(picked(10, 8), "dense");
-  EXPECT_EQ(picked(30, 29), "dense");
-  EXPECT_EQ(picked(20, -1), "dense");
-  EXPECT_EQ(picked(100, 99), "cholmod");
-  EXPECT_EQ(picked(1000, -1), "cholmod");
-  EXPECT_EQ(picked(0, -1), "cholmod");
-}
-
-// "auto" hands out a concrete backend, whichever it is, and that backend solves a chain.
-TEST(MakeLinearSolverTest, AutoPicksAWorkingBackendForEverySize) {
-  std::mt19937 rng(11);
-  for (int n : {3, 30, 300, 1500}) {
-    for (int b : {2, 8, 40}) {
-      if (b >= n) continue;
-      std::string error;
-      auto solver = MakeLinearSolver("auto", n, b, &error);
-      ASSERT_NE(solver, nullptr) << error;
-      EXPECT_NE(solver->Name(), "auto");
-      const Mat dense = RandomSpdBand(n, b, &rng);
-      const SparseMatrix a = BandToSparse(dense, b);
-      ASSERT_EQ(solver->Analyze(a), LinearSolverStatus::kSuccess) << solver->message();
-      ASSERT_EQ(solver->Factorize(a), LinearSolverStatus::kSuccess) << solver->message();
-      const Vec rhs = RandomVector(n, &rng);
-      Vec x;
-      ASSERT_EQ(solver->Solve(rhs, &x), LinearSolverStatus::kSuccess);
-      EXPECT_LT((dense * x - rhs).norm() / rhs.norm(), 1e-12)
-          << "n = " << n << ", b = " << b << ", backend " << solver->Name();
-    }
-  }
-}
 
 }  // namespace
 }  // namespace snapthread
