@@ -256,7 +256,8 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   }
 
   // ---- transport ------------------------------------------------------------------------
-  const std::string url = transport::ResolveLcmUrl(o.lcm_url);
+  const std::string url =
+      transport::WithReceiveBuffer(transport::ResolveLcmUrl(o.lcm_url), transport::kServiceBufferBytes);
   LcmDeviceTransport lcm(url, o.session);
   if (!lcm.good()) {
     std::fprintf(stderr, "snapthread-device: LCM could not start with URL '%s'.\n  hint: %s\n",

@@ -95,7 +95,8 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
     lcm_ = lcm;
     lcm_url_ = "(provided)";
   } else {
-    lcm_url_ = transport::ResolveLcmUrl(params_.lcm_url);
+    lcm_url_ = transport::WithReceiveBuffer(transport::ResolveLcmUrl(params_.lcm_url),
+                                             transport::kServiceBufferBytes);
     owned_lcm_ = std::make_unique<lcm::LCM>(lcm_url_);
     if (!owned_lcm_->good()) {
       throw LcmInitError("LCM failed to start on " + lcm_url_ + ": " +

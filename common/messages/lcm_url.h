@@ -17,6 +17,12 @@ std::string ResolveLcmUrl(const std::string& flag_value);
 // per-packet overhead), so a receiver the scheduler leaves off the CPU for a while under
 // load catches up instead of the kernel dropping datagrams.
 inline constexpr int kReceiverBufferBytes = 8 * 1024 * 1024;
+// The buffer the server and the device client ask for. They receive small messages (poses,
+// commands, force models), but a sender may fragment one up to LCM's limit; 1 MiB holds a
+// few such messages whole while a loaded process is off the CPU, so a big bad message is
+// received, counted and refused rather than silently lost in the kernel (the default
+// rmem_default, 212,992 bytes, holds one 200 kB message and nothing else).
+inline constexpr int kServiceBufferBytes = 1024 * 1024;
 
 // `url` with `recv_buf_size=N` added when it is a udpm:// URL without one (other providers
 // and URLs that already set it are returned unchanged). N is `bytes`, but at most
