@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -187,6 +188,42 @@ TEST(RodModel, GraspMapsFollowTheAcceptedFrames) {
   EXPECT_EQ(std::memcmp(g1.data(), g2.data(), sizeof(double) * g1.size()), 0);
 }
 
+
+// A gradient pass keeps its energy, and AcceptState at the state of the last pass over
+// every term takes that pass's frames and reference twists instead of computing them:
+// both give, to the last bit, what a model that computes everything afresh gives.
+TEST(RodModel, KeptPassValuesAreTheComputedOnes) {
+  std::mt19937 rng(23);
+  for (const char* what : {"gradient", "band", "energy"}) {
+    const RodParams p = BentParams(10);
+    RodModel kept(p), fresh(p);
+    const RandomPair pair = RandomBentPair(kept, &rng);
+    Vec g;
+    if (std::string(what) == "gradient") {
+      kept.Gradient(pair.older.x, pair.older.u, &g);
+      const double e_kept = kept.Energy(pair.older.x, pair.older.u);
+      const double e_fresh = fresh.Energy(pair.older.x, pair.older.u);
+      EXPECT_EQ(std::memcmp(&e_kept, &e_fresh, sizeof e_kept), 0) << e_kept << " vs " << e_fresh;
+    } else if (std::string(what) == "band") {
+      const int b = kept.HessianBandwidth();
+      std::vector<double> band(static_cast<size_t>(kept.NumStates()) * (b + 1));
+      double e = 0.0;
+      ASSERT_TRUE(kept.EnergyGradientAndBandHessian(pair.older.x, pair.older.u, &g, band.data(), b, &e));
+    } else {
+      kept.Energy(pair.older.x, pair.older.u);
+    }
+    kept.AcceptState(pair.older.x, pair.older.u);
+    fresh.AcceptState(pair.older.x, pair.older.u);
+    const double e1 = kept.Energy(pair.newer.x, pair.newer.u), e2 = fresh.Energy(pair.newer.x, pair.newer.u);
+    EXPECT_EQ(std::memcmp(&e1, &e2, sizeof e1), 0) << what << ": " << e1 << " vs " << e2;
+    Vec g1, g2;
+    kept.Gradient(pair.newer.x, pair.newer.u, &g1);
+    fresh.Gradient(pair.newer.x, pair.newer.u, &g2);
+    EXPECT_EQ(std::memcmp(g1.data(), g2.data(), sizeof(double) * g1.size()), 0) << what;
+    const Vec twist1 = kept.TwistDensity(pair.newer.x, pair.newer.u), twist2 = fresh.TwistDensity(pair.newer.x, pair.newer.u);
+    EXPECT_EQ(std::memcmp(twist1.data(), twist2.data(), sizeof(double) * twist1.size()), 0) << what;
+  }
+}
 
 }  // namespace
 }  // namespace snapthread

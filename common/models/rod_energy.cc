@@ -79,7 +79,7 @@ double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
 }
 
 double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
-                    const VertexStiffness& k, Vec8* g, Mat8* h) {
+                    const VertexStiffness& k, Vec8* g, Mat8* h, double* reference_twist) {
   const EdgeFrame* f[2] = {&f0, &f1};
   const V3& e0 = f0.e;
   const V3& e1 = f1.e;
@@ -96,6 +96,7 @@ double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
     bend += k.c1 * r1[j] * r1[j] + k.c2 * r2[j] * r2[j];
   }
   const double mref = AngleAbout(f1.t, Transport(f0.t, f1.t, f0.a), f1.a, twist_near);
+  if (reference_twist != nullptr) *reference_twist = mref;
   const double tau = f1.theta - f0.theta + mref;
   // Bending: the mean of the two edges' energies [DER (4)]; twist [DVT (4)].
   const double energy = 0.25 * bend + 0.5 * k.ct * tau * tau;

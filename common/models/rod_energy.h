@@ -79,9 +79,10 @@ void ComputeEdgeFrame(const V3& e, double theta, const FrameSource& s, bool want
 // Returns the vertex energy of the edges f0 = (e0, θ0), f1 = (e1, θ1); g (8) and h (8x8,
 // symmetric: the lower triangle is computed and mirrored) may be null. h needs both
 // frames computed with want_h. The energy does not depend on whether g and h are asked
-// for (the same operations, the same bits).
+// for (the same operations, the same bits). reference_twist (may be null): m, the value
+// ReferenceTwist() gives for these edges.
 double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
-                    const VertexStiffness& k, Vec8* g, Mat8* h);
+                    const VertexStiffness& k, Vec8* g, Mat8* h, double* reference_twist = nullptr);
 
 // The same from the edges themselves (both frames computed here).
 double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,

@@ -38,9 +38,12 @@ void RodModel::InvalidateCaches() {
   grasp_cache_valid_ = false;
   energy_key_.valid = false;
   band_key_.valid = false;
+  frames_key_.valid = false;
 }
 
-void RodModel::PrepareEdges(const Vec& x, const GraspMaps& gm, bool want_h, bool control_terms_only) const {
+void RodModel::PrepareEdges(const Vec& x, const Vec& u, const GraspMaps& gm, bool want_h,
+                            bool control_terms_only) const {
+  if (frames_key_.valid && !frames_key_.Matches(x, u)) frames_key_.valid = false;
   auto edge = [&](int j) {
     rod::ComputeEdgeFrame(Node(j + 1, x, gm) - Node(j, x, gm), Theta(j, x, gm), sources_[j], want_h, &edges_[j]);
   };
@@ -85,7 +88,8 @@ double RodModel::Local(int t, const GraspMaps& gms, bool want_h, F&& f) const {
   } else {
     rod::Vec8 g8;
     rod::Mat8 h8;
-    energy = rod::VertexEnergy(edges_[i - 1], edges_[i], twist_near_[i], stiffness_, &g8, want_h ? &h8 : nullptr);
+    energy = rod::VertexEnergy(edges_[i - 1], edges_[i], twist_near_[i], stiffness_, &g8, want_h ? &h8 : nullptr,
+                               &twist_cache_[i]);
     // (e0, e1) = (x_i - x_{i-1}, x_{i+1} - x_i).
     gy.segment<3>(0) = -g8.segment<3>(0);
     gy.segment<3>(3) = g8.segment<3>(0) - g8.segment<3>(3);
@@ -178,17 +182,101 @@ double RodModel::Local(int t, const GraspMaps& gms, bool want_h, F&& f) const {
   return energy;
 }
 
+double RodModel::AddInteriorTerm(const Term& term, double* g, double* band, int b) const {
+  // The term's state block starts at v = term.first; A(v + r, v + c), r >= c, is at
+  // row[c] with row = band + (v + r)(b + 1) + b - r (linalg/banded_ldlt.h's layout). The
+  // values are Local()'s (Lᵀ H L for a vertex, by the same operations), each added once
+  // to its slot as the assembly adds them: the same bits.
+  const int v = term.first;
+  const int ld = b + 1;
+  auto row = [&](int r) { return band + static_cast<std::ptrdiff_t>(v + r) * ld + b - r; };
+  const int i = term.index;
+  if (!term.vertex) {
+    // Edge i: x_i at v, x_{i+1} at v + 4 (θ_i, at v + 3, is not touched).
+    Eigen::Matrix<double, 6, 1> g6;
+    Eigen::Matrix<double, 6, 6> h6;
+    const double e = StretchEnergy(i, &g6, band != nullptr ? &h6 : nullptr);
+    for (int k = 0; k < 3; ++k) {
+      g[v + k] += g6[k];
+      g[v + 4 + k] += g6[3 + k];
+    }
+    if (band == nullptr) return e;
+    for (int r = 0; r < 3; ++r) {
+      double* d0 = row(r);
+      for (int c = 0; c <= r; ++c) d0[c] += h6(r, c);
+      double* d1 = row(4 + r);
+      for (int c = 0; c < 3; ++c) d1[c] += h6(3 + r, c);
+      for (int c = 0; c <= r; ++c) d1[4 + c] += h6(3 + r, 3 + c);
+    }
+    return e;
+  }
+  // Vertex i: x_{i-1}, θ_{i-1}, x_i, θ_i, x_{i+1} at v, v + 3, v + 4, v + 7, v + 8; the
+  // edges (e0, e1) = (x_i - x_{i-1}, x_{i+1} - x_i) (Local()'s chain rule).
+  rod::Vec8 g8;
+  rod::Mat8 h8;
+  const double e = rod::VertexEnergy(edges_[i - 1], edges_[i], twist_near_[i], stiffness_, &g8,
+                                     band != nullptr ? &h8 : nullptr, &twist_cache_[i]);
+  for (int k = 0; k < 3; ++k) {
+    g[v + k] += -g8[k];
+    g[v + 4 + k] += g8[k] - g8[3 + k];
+    g[v + 8 + k] += g8[3 + k];
+  }
+  g[v + 3] += g8[6];
+  g[v + 7] += g8[7];
+  if (band == nullptr) return e;
+  const M3 h00 = h8.block<3, 3>(0, 0), h10 = h8.block<3, 3>(3, 0), h11 = h8.block<3, 3>(3, 3);
+  // The node blocks below the diagonal and on it (Local()'s expressions).
+  const M3 n10 = h10 - h00, n20 = -h10, n21 = h10 - h11;
+  const M3 n11 = (h00 + h11) - (h10 + h10.transpose());
+  // Node a against θ_{i-1} (k = 0) and θ_i (k = 1): -s0, s0 - s1, s1 (s_e = H8 rows of e, angle columns).
+  const Eigen::Matrix<double, 3, 2> s0 = h8.block<3, 2>(0, 6), s1 = h8.block<3, 2>(3, 6);
+  const Eigen::Matrix<double, 3, 2> a0 = -s0, a1 = s0 - s1;
+  for (int r = 0; r < 3; ++r) {
+    double* d = row(r);  // x_{i-1}
+    for (int c = 0; c <= r; ++c) d[c] += h00(r, c);
+  }
+  {
+    double* d = row(3);  // θ_{i-1}
+    for (int c = 0; c < 3; ++c) d[c] += a0(c, 0);
+    d[3] += h8(6, 6);
+  }
+  for (int r = 0; r < 3; ++r) {
+    double* d = row(4 + r);  // x_i
+    for (int c = 0; c < 3; ++c) d[c] += n10(r, c);
+    d[3] += a1(r, 0);
+    for (int c = 0; c <= r; ++c) d[4 + c] += n11(r, c);
+  }
+  {
+    double* d = row(7);  // θ_i
+    for (int c = 0; c < 3; ++c) d[c] += a0(c, 1);
+    d[3] += h8(7, 6);
+    for (int c = 0; c < 3; ++c) d[4 + c] += a1(c, 1);
+    d[7] += h8(7, 7);
+  }
+  for (int r = 0; r < 3; ++r) {
+    double* d = row(8 + r);  // x_{i+1}
+    for (int c = 0; c < 3; ++c) d[c] += n20(r, c);
+    d[3] += s1(r, 0);
+    for (int c = 0; c < 3; ++c) d[4 + c] += n21(r, c);
+    d[7] += s1(r, 1);
+    for (int c = 0; c <= r; ++c) d[8 + c] += h11(r, c);
+  }
+  return e;
+}
+
 double RodModel::Energy(const Vec& x, const Vec& u) const {
   // The energy of the last state evaluated (the same operations gave it: the same bits).
   if (energy_key_.Matches(x, u)) return energy_cache_;
   const GraspMaps gm = Grasp(u, false);
-  PrepareEdges(x, gm, false, false);
+  PrepareEdges(x, u, gm, false, false);
   double e = 0.0;
   for (const Term& term : terms_) {
     const int i = term.index;
-    e += term.vertex ? rod::VertexEnergy(edges_[i - 1], edges_[i], twist_near_[i], stiffness_, nullptr, nullptr)
+    e += term.vertex ? rod::VertexEnergy(edges_[i - 1], edges_[i], twist_near_[i], stiffness_, nullptr, nullptr,
+                                         &twist_cache_[i])
                      : StretchEnergy(i, nullptr, nullptr);
   }
+  frames_key_.Set(x, u);
   if (contact_.enabled()) e += contact_.Energy(ContactNodes(x, gm));
   energy_key_.Set(x, u);
   energy_cache_ = e;
@@ -199,11 +287,25 @@ void RodModel::Gradient(const Vec& x, const Vec& u, Vec* g) const {
   if (g->size() != nx_) g->resize(nx_);
   g->setZero();
   const GraspMaps& gm = GraspDerivatives(u);
-  PrepareEdges(x, gm, false, false);
+  PrepareEdges(x, u, gm, false, false);
+  // The energy comes with the terms (Energy()'s sum in its order: the same bits) and is
+  // kept: a solver asks for E at the state whose gradient it has just evaluated.
+  double e = 0.0;
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
-    Local(t, gm, false, [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
+    const Term& term = terms_[t];
+    if (term.first >= 0) {
+      e += AddInteriorTerm(term, g->data(), nullptr, 0);
+    } else {
+      e += Local(t, gm, false, [&](const double* lg, const double*, int) { assembly_.AddGradient(t, lg, g->data()); });
+    }
   }
-  if (contact_.enabled()) contact_.AddGradient(ContactNodes(x, gm), g->data());
+  frames_key_.Set(x, u);
+  if (contact_.enabled()) {
+    contact_.AddGradient(ContactNodes(x, gm), g->data());
+    return;  // its energy is a pass of its own: Energy() computes it when asked
+  }
+  energy_key_.Set(x, u);
+  energy_cache_ = e;
 }
 
 void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
@@ -225,10 +327,11 @@ void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
     return;
   }
   const GraspMaps& gm = GraspDerivatives(u);
-  PrepareEdges(x, gm, true, false);
+  PrepareEdges(x, u, gm, true, false);
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     Local(t, gm, true, [&](const double*, const double* lh, int ld) { assembly_.StoreHessian(t, lh, ld, values); });
   }
+  frames_key_.Set(x, u);
   if (contact_.enabled()) contact_.AddHessian(ContactNodes(x, gm), values);
 }
 
@@ -241,7 +344,7 @@ double RodModel::EnergyGradientAndHessian(const Vec& x, const Vec& u, Vec* g, Sp
   g->setZero();
   double* values = assembly_.Values(h, contact_.enabled());
   const GraspMaps& gm = GraspDerivatives(u);
-  PrepareEdges(x, gm, true, false);
+  PrepareEdges(x, u, gm, true, false);
   double e = 0.0;
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
     e += Local(t, gm, true, [&](const double* lg, const double* lh, int ld) {
@@ -249,6 +352,7 @@ double RodModel::EnergyGradientAndHessian(const Vec& x, const Vec& u, Vec* g, Sp
       assembly_.StoreHessian(t, lh, ld, values);
     });
   }
+  frames_key_.Set(x, u);
   if (contact_.enabled()) {
     const Eigen::Matrix3Xd& nodes = ContactNodes(x, gm);
     contact_.AddGradient(nodes, g->data());
@@ -267,14 +371,20 @@ bool RodModel::EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, 
   g->setZero();
   std::fill(band, band + static_cast<std::ptrdiff_t>(nx_) * (bandwidth + 1), 0.0);
   const GraspMaps& gm = GraspDerivatives(u);
-  PrepareEdges(x, gm, true, false);
+  PrepareEdges(x, u, gm, true, false);
   double e = 0.0;
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
+    const Term& term = terms_[t];
+    if (term.first >= 0) {
+      e += AddInteriorTerm(term, g->data(), band, bandwidth);
+      continue;
+    }
     e += Local(t, gm, true, [&](const double* lg, const double* lh, int ld) {
       assembly_.AddGradient(t, lg, g->data());
       assembly_.AddBandHessian(t, lh, ld, band);
     });
   }
+  frames_key_.Set(x, u);
   *energy = e;
   energy_key_.Set(x, u);
   energy_cache_ = e;
@@ -287,7 +397,7 @@ void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
   if (eu->size() != nu_) eu->resize(nu_);
   eu->setZero();
   const GraspMaps& gm = GraspDerivatives(u);
-  PrepareEdges(x, gm, false, true);
+  PrepareEdges(x, u, gm, false, true);
   for (int t : control_terms_) {
     Local(t, gm, false, [&](const double* lg, const double*, int) { assembly_.AddControlGradient(t, lg, eu->data()); });
   }
@@ -299,7 +409,8 @@ bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) 
   // rotation-vector gradient E_φ = J_l(φ)ᵀ E_δ loses the torque where J_l is singular
   // (|φ| = 2π, 4π: two turns of a roll).
   const GraspMaps gm = Grasp(u, true, true);
-  PrepareEdges(x, gm, false, true);
+  frames_key_.valid = false;  // the edges at the grasp from another map (the same values, but not by contract)
+  PrepareEdges(x, u, gm, false, true);
   Eigen::Matrix<double, 12, 1> e = Eigen::Matrix<double, 12, 1>::Zero();
   for (int t : control_terms_) {
     Local(t, gm, false, [&](const double* lg, const double*, int) { assembly_.AddControlGradient(t, lg, e.data()); });
@@ -313,7 +424,7 @@ void RodModel::MixedHessian(const Vec& x, const Vec& u, Mat* exu) const {
   if (exu->rows() != nx_ || exu->cols() != nu_) exu->resize(nx_, nu_);
   exu->setZero();
   const GraspMaps& gm = GraspDerivatives(u);
-  PrepareEdges(x, gm, true, true);
+  PrepareEdges(x, u, gm, true, true);
   for (int t : control_terms_) {
     Local(t, gm, true, [&](const double*, const double* lh, int ld) { assembly_.AddMixedHessian(t, lh, ld, exu); });
   }
@@ -324,7 +435,7 @@ void RodModel::ControlHessian(const Vec& x, const Vec& u, Mat* euu) const {
   if (euu->rows() != nu_ || euu->cols() != nu_) euu->resize(nu_, nu_);
   euu->setZero();
   const GraspMaps& gm = GraspDerivatives(u);
-  PrepareEdges(x, gm, true, true);
+  PrepareEdges(x, u, gm, true, true);
   for (int t : control_terms_) {
     Local(t, gm, true, [&](const double*, const double* lh, int ld) { assembly_.AddControlHessian(t, lh, ld, euu); });
   }
@@ -339,7 +450,7 @@ void RodModel::ControlDerivatives(const Vec& x, const Vec& u, Vec* eu, Mat* exu,
   exu->setZero();
   euu->setZero();
   const GraspMaps& gm = GraspDerivatives(u);
-  PrepareEdges(x, gm, true, true);
+  PrepareEdges(x, u, gm, true, true);
   for (int t : control_terms_) {
     Local(t, gm, true, [&](const double* lg, const double* lh, int ld) {
       assembly_.AddControlGradient(t, lg, eu->data());

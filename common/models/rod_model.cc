@@ -56,7 +56,8 @@ RodModel::RodModel(const RodParams& params) : p_(params) {
   assembly_ = internal::HessianAssembly(nx_, nu_);
   edges_.resize(n_);
   grasp_cache_u_ = Vec::Zero(nu_);
-  for (StateKey* key : {&energy_key_, &band_key_}) {
+  twist_cache_.assign(n_, 0.0);
+  for (StateKey* key : {&energy_key_, &band_key_, &frames_key_}) {
     key->x = Vec::Zero(nx_);
     key->u = Vec::Zero(nu_);
   }
@@ -119,6 +120,18 @@ void RodModel::BuildTerms() {
       // Controls: u = (grasp of edge 0, grasp of edge n-1) without a clamp.
       const int offset = free && !term.at_start ? 6 : 0;
       for (int c = 0; c < 6; ++c) vars[count++] = nx_ + offset + c;
+    }
+    // One block of the state (AddInteriorTerm): a vertex's coordinates in its local
+    // order sit at these offsets from x_{i-1}'s; an edge's x_{j+1} four after x_j.
+    static constexpr int kVertexOffset[11] = {0, 1, 2, 4, 5, 6, 8, 9, 10, 3, 7};
+    static constexpr int kEdgeOffset[6] = {0, 1, 2, 4, 5, 6};
+    if (!term.grasp && term.code[0] >= 0) {
+      bool block = true;
+      for (int r = 0; r < term.nloc; ++r) {
+        const int offset = term.vertex ? kVertexOffset[r] : kEdgeOffset[r];
+        block = block && term.code[r] == term.code[0] + offset;
+      }
+      if (block) term.first = term.code[0];
     }
     assembly_.AddTerm(vars, count);
     terms_.push_back(term);
@@ -236,6 +249,20 @@ V3 RodModel::MaterialDirector(const Vec& x, const Vec& u, int j) const {
 
 void RodModel::AcceptState(const Vec& x, const Vec& u) {
   const GraspMaps gm = Grasp(u, false);
+  if (frames_key_.Matches(x, u)) {
+    // The last pass over every term was at x: its frames and reference twists are the
+    // values computed below (the same operations, the same bits).
+    for (int i = 1; i <= n_ - 1; ++i) twist_near_[i] = twist_cache_[i];
+    grasp_theta_near_ = gm.end.theta;
+    if (p_.free_start) start_theta_near_ = gm.start.theta;
+    for (int j = 0; j < n_; ++j) {
+      const V3& t = edges_[j].t;
+      sources_[j].t = t;
+      sources_[j].a = (edges_[j].a - edges_[j].a.dot(t) * t).normalized();
+    }
+    InvalidateCaches();
+    return;
+  }
   // Continued values first, against the old sources (at the accepted state the new
   // frames equal the old ones carried there, so E(x, u) does not change).
   for (int i = 1; i <= n_ - 1; ++i) {

@@ -151,6 +151,11 @@ class RodModel final : public Model {
     bool at_start = false;  // the grasp it touches holds edge 0
     std::array<int, kMaxLocal> code{};
     std::array<int, kMaxLocal> pos{};  // grasp terms: assembly position of state coordinates
+    // A term whose coordinates are all free states, one block of the state from `first`
+    // (a vertex: x_{i-1}, θ_{i-1}, x_i, θ_i, x_{i+1}; an edge: x_j, θ_j, x_{j+1} with θ_j
+    // not touched): its gradient and lower band are written straight from the term's own
+    // derivatives (AddInteriorTerm), -1 otherwise.
+    int first = -1;
   };
   void BuildTerms();
   // Self-contact (rod_contact.cc): pair terms registered after the elastic ones, node
@@ -170,14 +175,18 @@ class RodModel final : public Model {
   Eigen::Vector3d Node(int k, const Vec& x, const GraspMaps& gm) const;
   double Theta(int j, const Vec& x, const GraspMaps& gm) const;
   // Each edge's frame once per evaluation (both of its vertices use it) into edges_: every
-  // edge, or (control_terms_only) those of the terms that touch the grasp.
-  void PrepareEdges(const Vec& x, const GraspMaps& gm, bool want_h, bool control_terms_only) const;
+  // edge, or (control_terms_only) those of the terms that touch the grasp. Drops
+  // frames_key_ unless (x, u) is its state.
+  void PrepareEdges(const Vec& x, const Vec& u, const GraspMaps& gm, bool want_h, bool control_terms_only) const;
   // The stretching term of edge j from edges_ (g, h may be null).
   double StretchEnergy(int j, Eigen::Matrix<double, 6, 1>* g, Eigen::Matrix<double, 6, 6>* h) const;
   // Calls f(local gradient, local Hessian, leading dimension) for term t in its
   // assembly variables, with its edges in edges_ (PrepareEdges); returns the term's energy.
   template <class F>
   double Local(int t, const GraspMaps& gm, bool want_h, F&& f) const;
+  // An interior term (Term::first >= 0) straight into g and, when band is not null, the
+  // lower band of half-bandwidth b: the values Local() and the assembly give, the same bits.
+  double AddInteriorTerm(const Term& term, double* g, double* band, int b) const;
 
   RodParams p_;
   int n_;
@@ -208,6 +217,12 @@ class RodModel final : public Model {
     void Set(const Vec& x1, const Vec& u1);
   };
   mutable StateKey energy_key_, band_key_;
+  // The state of the last pass over every term (Energy, Gradient, a Hessian or a fused
+  // pass): edges_ holds its frames and twist_cache_ each vertex's reference twist, which
+  // AcceptState takes instead of computing them again.
+  mutable StateKey frames_key_;
+  mutable std::vector<double> twist_cache_;
+
   mutable double energy_cache_ = 0.0;
   mutable std::vector<double> band_cache_;
   void InvalidateCaches();
