@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace snapthread {
 namespace {
@@ -91,7 +92,7 @@ bool FollowedMinimum(const ReducedQuartic& q, double cap, double* s_out) {
 
 HigherOrderSolver::HigherOrderSolver(const Model& model, const SolverOptions& options)
     : SolverBase(model, options) {
-  for (Vec* v : {&delta_, &vt_, &w_, &rhs_, &gp_, &gm_, &xs_}) v->resize(num_states());
+  for (Vec* v : {&delta_, &vt_, &w_, &rhs_, &gp_, &gm_, &xs_, &g_trial_}) v->resize(num_states());
   col_k_rows_.reserve(64);
   col_k_pos_.reserve(64);
   row_k_pos_.reserve(64);
@@ -148,6 +149,7 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
 
   // r = D^3E[v', v'] by central differences of the analytic gradient (2.37), and
   // q = (g+ - g-)/2h = H v' + h^2/6 D^4E[v',v',v'] for the quartic coefficient.
+  const double e0 = model().Energy(*x, u);
   const double h = kDifferenceStep;
   xs_ = *x + h * vt_;
   EvalGradient(xs_, u, &gp_, s);
@@ -189,8 +191,8 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
   if (!FollowedMinimum(q, options().max_reduction_step, &s_star)) return StepResult::kSnap;
 
   // Energy decrease (Armijo-type) on every higher-order step (DESIGN.md #4): backtrack
-  // along the curve; a step that cannot decrease the energy is refused.
-  const double e0 = model().Energy(*x, u);
+  // along the curve; a step that cannot decrease the energy is refused (e0 from before
+  // the differences: a model may keep the energy of the state it evaluated last).
   double alpha = 1.0;
   for (int it = 0; it < 12; ++it) {
     const double ss = alpha * s_star;
@@ -224,6 +226,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   double r = EvalGradientAtStart(xr, u, &s);
   s.termination = Termination::kBudgetSpent;
   bool newton_stalled = false;
+  bool trial_gradient = false;  // g_trial_ holds E_x at xs_ (the Newton trial state)
   int reduction_stalls = 0;
   // Finishes a snap inside this update (DESIGN.md #4) and ends the iteration loop.
   auto snap_and_stop = [&] {
@@ -265,9 +268,16 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       // meet the followed minimum, so this iteration uses the reduction instead.
       const double ref = ReferenceLambda() > 0.0 ? ReferenceLambda() : lambda0;
       bool take_newton = true;
+      trial_gradient = false;
       if (lambda0 < 1.0 * ref) {
+        // E at xr first (a model may keep the energy of the state it evaluated last: the
+        // pass that gave E_xx or E_x here), then E_x at the trial state, which the
+        // iteration needs there if the step is taken, and E with it.
+        const double e_here = model().Energy(xr, u);
         xs_ = xr - NewtonStep();
-        take_newton = model().Energy(xs_, u) <= model().Energy(xr, u);
+        EvalGradient(xs_, u, &g_trial_, &s);
+        take_newton = model().Energy(xs_, u) <= e_here;
+        trial_gradient = true;
       }
       if (!take_newton) {
         degenerate = true;
@@ -277,9 +287,11 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       TakeNewtonStep(u, &xr);
       // Where E_xx is regular Newton converges quadratically; a step that does not
       // even halve |E_x| says the quadratic model has failed (a fold is close): the
-      // next iteration uses the reduction.
+      // next iteration uses the reduction. (The step goes to the trial state, unless a
+      // collision bound shortened it: then its gradient is not the one there.)
       const double r_before = r;
-      r = EvalGradient(xr, u, &s);
+      const bool at_trial = trial_gradient && std::memcmp(xr.data(), xs_.data(), sizeof(double) * xr.size()) == 0;
+      r = at_trial ? AdoptGradient(&g_trial_) : EvalGradient(xr, u, &s);
       newton_stalled = !(r < 0.5 * r_before);
       continue;
     }

@@ -35,7 +35,7 @@ class HigherOrderSolver final : public SolverBase {
   bool FinishSnap(const Vec& u, Vec* x, SolverSummary* s);
 
   std::vector<int> col_k_rows_, col_k_pos_, row_k_pos_;
-  Vec delta_, vt_, w_, rhs_, gp_, gm_, xs_;
+  Vec delta_, vt_, w_, rhs_, gp_, gm_, xs_, g_trial_;
 };
 
 }  // namespace snapthread

@@ -60,6 +60,12 @@ class SolverBase : public EquilibriumSolver {
   // evaluates both in one pass, and the next FactorAt() at this x uses that E_xx.
   double EvalGradientAtStart(const Vec& x, const Vec& u, SolverSummary* s);
   const Vec& Gradient() const { return ws_.g; }
+  // A method's own E_x(x, u) becomes the workspace gradient (swapped with *g, which gets
+  // the old one); returns its norm. For a trial state that became the iterate.
+  double AdoptGradient(Vec* g) {
+    ws_.g.swap(*g);
+    return ws_.g.norm();
+  }
 
   // --- Hessian and its factorisations ------------------------------------------------
   // Assembles E_xx at x and factorises it (HessianFactor()).
