@@ -291,7 +291,13 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       // collision bound shortened it: then its gradient is not the one there.)
       const double r_before = r;
       const bool at_trial = trial_gradient && std::memcmp(xr.data(), xs_.data(), sizeof(double) * xr.size()) == 0;
-      r = at_trial ? AdoptGradient(&g_trial_) : EvalGradient(xr, u, &s);
+      if (at_trial) {
+        r = AdoptGradient(&g_trial_);
+      } else {
+        // After a step that was not tiny E_xx is needed here next (the next iteration
+        // or Finish()): one pass gives it with E_x.
+        r = LastStepTiny() ? EvalGradient(xr, u, &s) : EvalGradientAndHessian(xr, u, &s);
+      }
       newton_stalled = !(r < 0.5 * r_before);
       continue;
     }
@@ -322,8 +328,10 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
       // the minimum is gone — finish the snap now rather than over the next updates.
       // A reduction step that raises |E_x| (the energy fell, the force grew) says the
       // same at once.
+      // E_xx is needed at the new state next (the next iteration, Finish() or the snap
+      // minimiser's first step): one pass gives it with E_x.
       const double r_before = r;
-      r = EvalGradient(xr, u, &s);
+      r = EvalGradientAndHessian(xr, u, &s);
       reduction_stalls = (r < 0.5 * r_before) ? 0 : reduction_stalls + 1;
       if (reduction_stalls >= 2 || r > r_before) {
         snap_and_stop();

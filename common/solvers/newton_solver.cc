@@ -34,7 +34,7 @@ SolverBase::SolverBase(const Model& model, const SolverOptions& options)
   }
   w.eig.Resize(n_);
   w.orbits = std::make_unique<SymmetryOrbits>(model_);
-  for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch, &w.h_state}) v->resize(n_);
+  for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch, &w.h_state, &w.g_band}) v->resize(n_);
   w.h_u.resize(model_.NumControls());
 }
 
@@ -186,7 +186,9 @@ double SolverBase::EvalGradient(const Vec& x, const Vec& u, SolverSummary* s) {
   return EvalGradient(x, u, &ws_.g, s);
 }
 
-double SolverBase::EvalGradientAtStart(const Vec& x, const Vec& u, SolverSummary* s) {
+double SolverBase::EvalGradientAndHessian(const Vec& x, const Vec& u, SolverSummary* s) {
+  factor_valid_ = false;  // the band below is the factorisation's storage
+  factor_before_tiny_step_ = false;
   // A banded factorisation lends its band: the model writes E_xx there, and FactorAt()
   // factorises it in place (no compressed matrix, no copy; the compressed one is made
   // only if a globalised or reduction step asks for it, EnsureSparseHessian()).
@@ -204,6 +206,19 @@ double SolverBase::EvalGradientAtStart(const Vec& x, const Vec& u, SolverSummary
   ws_.h_u = u;
   energy_ready_ = true;
   return ws_.g.norm();
+}
+
+bool SolverBase::AssembleBandAt(const Vec& x, const Vec& u) {
+  int bandwidth = -1;
+  double* band = ws_.factor->AssemblyBand(&bandwidth);
+  double energy = 0.0;
+  if (band == nullptr || !model_.EnergyGradientAndBandHessian(x, u, &ws_.g_band, band, bandwidth, &energy)) return false;
+  sparse_stale_ = true;
+  ws_.h_state = x;
+  ws_.h_u = u;
+  h_state_energy_ = energy;
+  energy_ready_ = true;
+  return true;
 }
 
 bool SolverBase::AtHessianState(const Vec& x) const {
@@ -224,6 +239,10 @@ LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummar
   LinearSolverStatus st;
   if (in_band) {
     st = ws_.factor->FactorizeAssembled();  // ws_.h stays stale (sparse_stale_)
+  } else if (!have_h && AssembleBandAt(x, u)) {
+    // Elsewhere too E_xx goes straight into the band when the model can (E and E_x come
+    // with it, into scratch): no compressed matrix, no copy.
+    st = ws_.factor->FactorizeAssembled();
   } else {
     if (!have_h) model_.Hessian(x, u, &ws_.h);
     sparse_stale_ = false;
@@ -447,7 +466,9 @@ SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
       }
       TakeNewtonStep(u, x);
     }
-    r = EvalGradient(*x, u, &s);
+    // After any step but a tiny Newton one E_xx is needed at x next (the next iteration
+    // or Finish()): one pass gives it with E_x.
+    r = !line_search_ && LastStepTiny() ? EvalGradient(*x, u, &s) : EvalGradientAndHessian(*x, u, &s);
   }
   // Plain Newton (2.18) is kept as the seed's baseline: it may sit on a maximum or a
   // saddle (Fig 2.5). The globalised variant may not.

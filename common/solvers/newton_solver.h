@@ -58,7 +58,13 @@ class SolverBase : public EquilibriumSolver {
   // EvalGradient(x, u, s) at the warm start of a solve, where E_xx is always needed next
   // (by the first iteration, or by Finish() when the warm start has converged): the model
   // evaluates both in one pass, and the next FactorAt() at this x uses that E_xx.
-  double EvalGradientAtStart(const Vec& x, const Vec& u, SolverSummary* s);
+  double EvalGradientAtStart(const Vec& x, const Vec& u, SolverSummary* s) { return EvalGradientAndHessian(x, u, s); }
+  // The same at any iterate whose E_xx is needed next whatever |E_x| turns out to be
+  // (after a step that was not tiny, kReuseStep: by the next iteration or by Finish()).
+  // The factorisation of the last state is gone.
+  double EvalGradientAndHessian(const Vec& x, const Vec& u, SolverSummary* s);
+  // The last TakeNewtonStep() was tiny (kReuseStep): Finish() may keep the factorisation.
+  bool LastStepTiny() const { return factor_before_tiny_step_; }
   const Vec& Gradient() const { return ws_.g; }
   // A method's own E_x(x, u) becomes the workspace gradient (swapped with *g, which gets
   // the old one); returns its norm. For a trial state that became the iterate.
@@ -118,6 +124,7 @@ class SolverBase : public EquilibriumSolver {
     SmallestEigenpair eig;
     std::unique_ptr<SymmetryOrbits> orbits;
     Vec g, dx, trial, last_good, dx_scratch;
+    Vec g_band;   // E_x from a band assembly in FactorAt (not the iterate's gradient)
     Vec h_state;  // the state h was evaluated at by EvalGradientAtStart (hessian_ready_)
     Vec h_u;      // ... and its controls
   };
@@ -125,6 +132,10 @@ class SolverBase : public EquilibriumSolver {
   // ws_.h := E_xx at ws_.h_state when the factorisation there was assembled in band
   // storage (sparse_stale_): the rare steps that edit or read E_xx entry by entry.
   void EnsureSparseHessian();
+  // E_xx at x written into the factorisation's band by the model (E and E_x with it, the
+  // energy kept as at the warm start): ws_.h_state = x, the compressed matrix stale.
+  // false, nothing written, where the factorisation or the model cannot.
+  bool AssembleBandAt(const Vec& x, const Vec& u);
   // x is bit for bit the state of EvalGradientAtStart's E_xx (ws_.h_state).
   bool AtHessianState(const Vec& x) const;
   bool BudgetLeft(const SolverSummary& s) const;
