@@ -18,10 +18,10 @@ namespace {
 
 // Lower-triangle accumulation into a symmetric 8x8 (mirrored at the end): a sum's lower
 // triangle is the sum of its pieces' lower triangles, symmetric pieces or not.
-// M into block (j, c) of the edge coordinates (j >= c; a diagonal block's lower part).
-inline void LowerBlock(int j, int c, const M3& m, Mat8* h) {
+// s M into block (j, c) of the edge coordinates (j >= c; a diagonal block's lower part).
+inline void LowerBlock(int j, int c, double s, const M3& m, Mat8* h) {
   for (int cc = 0; cc < 3; ++cc) {
-    for (int rr = (j == c ? cc : 0); rr < 3; ++rr) (*h)(3 * j + rr, 3 * c + cc) += m(rr, cc);
+    for (int rr = (j == c ? cc : 0); rr < 3; ++rr) (*h)(3 * j + rr, 3 * c + cc) += s * m(rr, cc);
   }
 }
 
@@ -117,71 +117,110 @@ double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
   if (h == nullptr) return energy;
 
   // The lower triangle of every piece (rod_energy.cc's header for the derivation), then
-  // the mirror. First the outer products, all of them in one pass over each column (its
-  // rows from the even row at or above the diagonal: whole, aligned packets; what lands
-  // above the diagonal is overwritten by the mirror):
-  //   GJ gτ gτᵀ + Σ_j [½B1 gq_j gq_jᵀ + ½B2 gp_j gp_jᵀ + dφ_j v_jᵀ + v_j dφ_jᵀ]
-  //   - (gχ gfᵀ + gf gχᵀ)/χ,
-  // the last from W·d²κb (below).
+  // the mirror.
   Mat8& hh = *h;
+  hh.setZero();
   const double ct = k.ct * tau;
   V3 w = V3::Zero();
   Vec8 v[2];
-  double wq[2], wp[2];
-  for (int j = 0; j < 2; ++j) {
-    wq[j] = 0.5 * k.c1 * r1[j];   // weight of d²q_j in E
-    wp[j] = -0.5 * k.c2 * r2[j];  // weight of d²p_j in E
-    w += wq[j] * f[j]->m2 + wp[j] * f[j]->m1;
-    // -(wq q + wp p) dφ dφᵀ + dφ sideᵀ + side dφᵀ = dφ vᵀ + v dφᵀ, v = side - ½(wq q + wp p) dφ.
-    v[j] = wp[j] * jm2[j] - wq[j] * jm1[j] - (0.5 * (wq[j] * q[j] + wp[j] * p[j])) * dphi[j];
-  }
-  // W·d²κb for W = w: the Hessian of W·κb = W·(2 e0 × e1)/χ as a quotient,
-  // (hn - f hchi - gχ gfᵀ - gf gχᵀ)/χ with f = W·κb, gf = (gn - f gχ)/χ.
-  const double fw = w.dot(kb);
-  Vec8 gc, gf;
-  gc << gchi[0], gchi[1], 0.0, 0.0;
-  gf << 2.0 * e1.cross(w), 2.0 * w.cross(e0), 0.0, 0.0;
-  gf = (gf - fw * gc) * inv_chi;
-  const Vec8 gcn = -inv_chi * gc;
-  const double b1 = 0.5 * k.c1, b2 = 0.5 * k.c2;
-  auto column = [&]<int N>(int c) __attribute__((always_inline)) {
-    hh.col(c).template tail<N>() =
-        (k.ct * gtau[c]) * gtau.template tail<N>() + (b1 * gq[0][c]) * gq[0].template tail<N>() +
-        (b2 * gp[0][c]) * gp[0].template tail<N>() + (b1 * gq[1][c]) * gq[1].template tail<N>() +
-        (b2 * gp[1][c]) * gp[1].template tail<N>() + v[0][c] * dphi[0].template tail<N>() +
-        dphi[0][c] * v[0].template tail<N>() + v[1][c] * dphi[1].template tail<N>() +
-        dphi[1][c] * v[1].template tail<N>() + gf[c] * gcn.template tail<N>() + gcn[c] * gf.template tail<N>();
-  };
-  column.template operator()<8>(0);
-  column.template operator()<8>(1);
-  column.template operator()<6>(2);
-  column.template operator()<6>(3);
-  column.template operator()<4>(4);
-  column.template operator()<4>(5);
-  column.template operator()<2>(6);
-  column.template operator()<2>(7);
-  // The 3x3 edge blocks (0, 0), (1, 0), (1, 1), each summed whole and then added once:
-  //  * block (j, j): the twist-rate derivative (bending and twist) and the
-  //    (κb·de)(m·de)/|e|² terms with the twist's -ct κb tᵀ/(2|e|²);
-  //  * twist: ct ∂(κb/(2|e_j|))/∂e_c;
-  //  * W·d²κb: hn, block (1, 0) = 2[W]×, and -f hchi, the diagonal blocks
-  //    (|e_o|/|e_j|)(I - t tᵀ) and (1, 0) = I + t1 t0ᵀ.
-  const double s = fw * inv_chi;
-  const M3 jk0 = (-2.0 * Cross(e1) - kb * gchi[0].transpose()) * inv_chi;
-  const M3 jk1 = (2.0 * Cross(e0) - kb * gchi[1].transpose()) * inv_chi;
   M3 blk[2];
   for (int j = 0; j < 2; ++j) {
     const EdgeFrame& fj = *f[j];
+    const double wq = 0.5 * k.c1 * r1[j];   // weight of d²q_j in E
+    const double wp = -0.5 * k.c2 * r2[j];  // weight of d²p_j in E
+    w += wq * fj.m2 + wp * fj.m1;
+    // -(wq q + wp p) dφ dφᵀ + dφ sideᵀ + side dφᵀ = dφ vᵀ + v dφᵀ, v = side - ½(wq q + wp p) dφ.
+    v[j] = wp * jm2[j] - wq * jm1[j] - (0.5 * (wq * q[j] + wp * p[j])) * dphi[j];
+    // Block (j, j): the twist-rate derivative (bending and twist) and the (κb·de)(m·de)/|e|²
+    // terms with the twist's -ct κb tᵀ/(2|e|²).
     const double inv_l2 = 1.0 / (fj.l * fj.l);
-    blk[j] = (wp[j] * q[j] - wq[j] * p[j] + (j == 0 ? -ct : ct)) * fj.dalpha +
-             inv_l2 * kb * (wq[j] * fj.m2 + wp[j] * fj.m1 - (0.5 * ct) * fj.t).transpose();
+    blk[j] = (wp * q[j] - wq * p[j] + (j == 0 ? -ct : ct)) * fj.dalpha +
+             inv_l2 * kb * (wq * fj.m2 + wp * fj.m1 - (0.5 * ct) * fj.t).transpose();
   }
-  const M3 b00 = blk[0] + (ct / (2.0 * f0.l)) * jk0 - (s * f1.l / f0.l) * (M3::Identity() - f0.t * f0.t.transpose());
-  const M3 b10 = (ct / (2.0 * f1.l)) * jk0 + (2.0 * inv_chi) * Cross(w) - s * (M3::Identity() + f1.t * f0.t.transpose());
-  const M3 b11 = blk[1] + (ct / (2.0 * f1.l)) * jk1 - (s * f0.l / f1.l) * (M3::Identity() - f1.t * f1.t.transpose());
-  LowerBlock(0, 0, b00, &hh);
-  LowerBlock(1, 0, b10, &hh);
-  LowerBlock(1, 1, b11, &hh);
+  // The outer products GJ gτ gτᵀ + Σ_j [½B1 gq_j gq_jᵀ + ½B2 gp_j gp_jᵀ + dφ_j v_jᵀ + v_j dφ_jᵀ]
+  // in one pass over each column, from the even row at or above the diagonal (whole,
+  // aligned packets; what lands above it is overwritten by the mirror). Each entry is
+  // summed in the order of the terms (j = 0's, block (0, 0) of j = 0, j = 1's, block
+  // (1, 1) of j = 1, then the rest): the sums of the terms added one at a time, to the bit.
+  const double b1 = 0.5 * k.c1, b2 = 0.5 * k.c2;
+  auto edge0 = [&]<int R, int N>(int c) __attribute__((always_inline)) {  // j = 0's terms
+    auto x = hh.col(c).template segment<N>(R);
+    x = x + (k.ct * gtau[c]) * gtau.template segment<N>(R) + (b1 * gq[0][c]) * gq[0].template segment<N>(R) +
+        (b2 * gp[0][c]) * gp[0].template segment<N>(R) +
+        (v[0][c] * dphi[0].template segment<N>(R) + dphi[0][c] * v[0].template segment<N>(R));
+  };
+  auto edge1 = [&]<int R, int N>(int c) __attribute__((always_inline)) {  // j = 1's terms
+    auto x = hh.col(c).template segment<N>(R);
+    x = x + (b1 * gq[1][c]) * gq[1].template segment<N>(R) + (b2 * gp[1][c]) * gp[1].template segment<N>(R) +
+        (v[1][c] * dphi[1].template segment<N>(R) + dphi[1][c] * v[1].template segment<N>(R));
+  };
+  auto both = [&]<int R, int N>(int c) __attribute__((always_inline)) {
+    auto x = hh.col(c).template segment<N>(R);
+    x = x + (k.ct * gtau[c]) * gtau.template segment<N>(R) + (b1 * gq[0][c]) * gq[0].template segment<N>(R) +
+        (b2 * gp[0][c]) * gp[0].template segment<N>(R) +
+        (v[0][c] * dphi[0].template segment<N>(R) + dphi[0][c] * v[0].template segment<N>(R)) +
+        (b1 * gq[1][c]) * gq[1].template segment<N>(R) + (b2 * gp[1][c]) * gp[1].template segment<N>(R) +
+        (v[1][c] * dphi[1].template segment<N>(R) + dphi[1][c] * v[1].template segment<N>(R));
+  };
+  // Columns 0..2: block (0, 0) (rows 0..2, and row 3 with them) takes blk[0] between.
+  edge0.template operator()<0, 4>(0);
+  edge0.template operator()<0, 4>(1);
+  edge0.template operator()<2, 2>(2);
+  LowerBlock(0, 0, 1.0, blk[0], &hh);
+  edge1.template operator()<0, 4>(0);
+  edge1.template operator()<0, 4>(1);
+  edge1.template operator()<2, 2>(2);
+  both.template operator()<4, 4>(0);
+  both.template operator()<4, 4>(1);
+  both.template operator()<4, 4>(2);
+  both.template operator()<2, 6>(3);
+  both.template operator()<4, 4>(4);
+  both.template operator()<4, 4>(5);
+  both.template operator()<6, 2>(6);
+  both.template operator()<6, 2>(7);
+  LowerBlock(1, 1, 1.0, blk[1], &hh);
+  // The 3x3 edge blocks (0, 0), (1, 0), (1, 1), entry by entry in the order of the terms:
+  //  * twist: ct ∂(κb/(2|e_j|))/∂e_c;
+  //  * W·d²κb for W = w: the Hessian of W·κb = W·(2 e0 × e1)/χ as a quotient,
+  //    (hn - f hchi - gχ gfᵀ - gf gχᵀ)/χ with f = W·κb, gf = (gn - f gχ)/χ: first
+  //    -(gχ gfᵀ + gf gχᵀ)/χ, then hn, block (1, 0) = 2[W]×, and -f hchi, the diagonal
+  //    blocks (|e_o|/|e_j|)(I - t tᵀ) and (1, 0) = I + t1 t0ᵀ.
+  const M3 jk0 = (-2.0 * Cross(e1) - kb * gchi[0].transpose()) * inv_chi;
+  const M3 jk1 = (2.0 * Cross(e0) - kb * gchi[1].transpose()) * inv_chi;
+  const double fw = w.dot(kb);
+  Eigen::Matrix<double, 6, 1> gc, gf;
+  gc << gchi[0], gchi[1];
+  gf << 2.0 * e1.cross(w), 2.0 * w.cross(e0);
+  gf = (gf - fw * gc) * inv_chi;
+  const double s = fw * inv_chi;
+  const M3 cw = Cross(w);
+  const M3 p10 = M3::Identity() + f1.t * f0.t.transpose();
+  const M3 p00 = M3::Identity() - f0.t * f0.t.transpose();
+  const M3 p11 = M3::Identity() - f1.t * f1.t.transpose();
+  const double t00 = ct / (2.0 * f0.l), t10 = ct / (2.0 * f1.l), t11 = ct / (2.0 * f1.l);
+  const double c10 = 2.0 * inv_chi, s10 = -s, s00 = -s * f1.l / f0.l, s11 = -s * f0.l / f1.l;
+  auto quotient = [&](int r, int c) __attribute__((always_inline)) { return (gc[r] * gf[c] + gf[r] * gc[c]) * inv_chi; };
+  for (int cc = 0; cc < 3; ++cc) {
+    for (int rr = cc; rr < 3; ++rr) {
+      double& x = hh(rr, cc);
+      x += t00 * jk0(rr, cc);
+      x -= quotient(rr, cc);
+      x += s00 * p00(rr, cc);
+    }
+    for (int rr = 0; rr < 3; ++rr) {
+      double& x = hh(3 + rr, cc);
+      x += t10 * jk0(rr, cc);
+      x -= quotient(3 + rr, cc);
+      x += c10 * cw(rr, cc);
+      x += s10 * p10(rr, cc);
+    }
+    for (int rr = cc; rr < 3; ++rr) {
+      double& x = hh(3 + rr, 3 + cc);
+      x += t11 * jk1(rr, cc);
+      x -= quotient(3 + rr, 3 + cc);
+      x += s11 * p11(rr, cc);
+    }
+  }
   for (int c = 0; c < 8; ++c) {
     for (int r = c + 1; r < 8; ++r) hh(c, r) = hh(r, c);
   }
