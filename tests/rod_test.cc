@@ -10,6 +10,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
@@ -260,6 +261,21 @@ TEST(RodModel, HessianRefillDoesNotAllocate) {
   const double e = model.Energy(s.x, s.u);
   counter.Stop();
   EXPECT_EQ(counter.mallocs(), 0);
+  // The fused passes, the band assembly and AcceptState, both with the frames of the
+  // last pass (at its state) and computing them (right after another AcceptState).
+  const int b = model.HessianBandwidth();
+  std::vector<double> band(static_cast<size_t>(model.NumStates()) * (b + 1));
+  double e_band = 0.0;
+  test_support::AllocationCounter fused;
+  model.ControlDerivatives(s.x, s.u, &eu, &exu, &euu);
+  const bool banded = model.EnergyGradientAndBandHessian(s.x, s.u, &g, band.data(), b, &e_band);
+  model.AcceptState(s.x, s.u);
+  model.Gradient(s.x, s.u, &g);
+  model.AcceptState(s.x, s.u);
+  model.AcceptState(s.x, s.u);
+  fused.Stop();
+  EXPECT_TRUE(banded);
+  EXPECT_EQ(fused.mallocs(), 0);
   EXPECT_TRUE(std::isfinite(e));
   EXPECT_EQ((Mat(h) - first).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(model.HessianBandwidth(), 10);  // a vertex spans nodes i-1 .. i+1
