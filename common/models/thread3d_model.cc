@@ -58,6 +58,7 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
         grip_(params.Bool("grip_direction")),
         contact_params_(internal::ReadContactParams(params)) {
     AddChainTerms();
+    segments_.resize(n_ + 1);
   }
 
   std::string_view Name() const override { return kName; }
@@ -95,6 +96,17 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
     if (grip_) x[nx_ - 1] = length / n_;
     return x;
   }
+
+  // E, E_x and E_xx in band storage in one pass, as ChainModel's (the same terms in the
+  // same order, each term's derivatives by the same operations, so the same bits as
+  // Energy(), Gradient() and Hessian(); direct_assembly_test), faster: each segment's
+  // length and direction are computed once instead of in three terms (a stretching term
+  // and two bending terms: the square roots and divisions were most of BendTerm's time),
+  // and a term away from the clamp and the grasp, whose variables are consecutive states,
+  // writes the lower triangle of its blocks straight into the band, without the full
+  // local Hessian. The few terms at the ends, a grip and self-contact take ChainModel's path.
+  bool EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, double* band, int bandwidth,
+                                    double* energy) const override;
 
   void NodePositions(const Vec& x, const Vec& u, Eigen::Matrix3Xd* nodes) const override {
     if (nodes->cols() != n_ + 1) nodes->resize(3, n_ + 1);
@@ -313,6 +325,19 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   const double energy_shift_;  // -N β B / 2
   const bool grip_;
   std::vector<Term> terms_;
+  // EnergyGradientAndBandHessian's segment cache (segments 1 .. N; sized once).
+  struct Segment {
+    V3 w;        // v / l
+    double l;    // |v|, v = p_s - p_{s-1}
+    double inv;  // 1 / l
+  };
+  mutable std::vector<Segment> segments_;
+  // The first state of a term whose variables are the consecutive states v0, v0 + 1, ...
+  // (its nodes are all free: not node 0 or 1, not the grasp, no grip), else -1.
+  int ContiguousStart(const Term& term) const {
+    const int last = term.first_node + (term.bend ? 2 : 1);
+    return (!grip_ && term.first_node >= 2 && last <= n_ - 1) ? NodeVar(term.first_node, 0) : -1;
+  }
 
   // Self-contact (issue 15; models/contact_terms.h): p_0 and y_1, z_1 fixed, x_1 and
   // p_2 .. p_{N-1} state variables, p_N = u. Not with a grip (the scene check says so).
@@ -381,6 +406,114 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   mutable Eigen::Matrix3Xd contact_nodes_, contact_to_;
   mutable Vec contact_trial_;
 };
+
+// The lower triangle (kLower) or all of a 3 x 3 block m added to band rows i0 .. i0 + 2,
+// columns j0 .. j0 + 2 (banded_ldlt.h's layout: A(i, j), i >= j, at i (b + 1) + j - i + b).
+template <bool kLower>
+inline void AddBandBlock(double* band, int ld, int b, int i0, int j0, const Eigen::Matrix3d& m) {
+  for (int r = 0; r < 3; ++r) {
+    double* row = band + static_cast<std::ptrdiff_t>(i0 + r) * ld + b - (i0 + r);  // row[j]: A(i0 + r, j)
+    for (int c = 0; c < (kLower ? r + 1 : 3); ++c) row[j0 + c] += m(r, c);
+  }
+}
+
+bool Thread3dModel::EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, double* band, int bandwidth,
+                                                 double* energy) const {
+  if (grip_ || contact_.enabled()) return ChainModel::EnergyGradientAndBandHessian(x, u, g, band, bandwidth, energy);
+  if (bandwidth != assembly_.Bandwidth()) return false;
+  using M = Eigen::Matrix3d;
+  const int ld = bandwidth + 1;
+  if (g->size() != nx_) g->resize(nx_);
+  g->setZero();
+  double* gd = g->data();
+  std::fill(band, band + static_cast<std::ptrdiff_t>(nx_) * ld, 0.0);
+  // Segment s from p_{s-1} to p_s, as StretchTerm and BendTerm compute it (v, |v|, 1/|v|, v/|v|).
+  for (int s = 1; s <= n_; ++s) {
+    const V3 v = Node(s, x, u) - Node(s - 1, x, u);
+    Segment& seg = segments_[s];
+    seg.l = v.norm();
+    seg.inv = 1.0 / seg.l;
+    seg.w = v * seg.inv;
+  }
+  double e = energy_shift_;
+  for (int t = 0; t < chain_terms_; ++t) {
+    const Term& term = terms_[t];
+    const int v0 = ContiguousStart(term);
+    if (v0 < 0) {
+      e += Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int lhd) {
+        assembly_.AddGradient(t, lg, gd);
+        assembly_.AddBandHessian(t, lh, lhd, band);
+      });
+      continue;
+    }
+    if (!term.bend) {
+      // StretchTerm<3> (hessian_assembly.h), (3.7): blocks [[H, -H], [-H, H]].
+      const Segment& sg = segments_[term.first_node + 1];
+      const double c = half_gamma_;
+      const double dl = sg.l - rest_;
+      const V3 gv = (2.0 * c * dl) * sg.w;
+      for (int k = 0; k < 3; ++k) {
+        gd[v0 + k] += -gv[k];
+        gd[v0 + 3 + k] += gv[k];
+      }
+      const double ratio = rest_ * sg.inv;
+      M hv = (2.0 * c * ratio) * (sg.w * sg.w.transpose());
+      hv.diagonal().array() += 2.0 * c * (1.0 - ratio);
+      const M minus_hv = -hv;
+      AddBandBlock<true>(band, ld, bandwidth, v0, v0, hv);
+      AddBandBlock<false>(band, ld, bandwidth, v0 + 3, v0, minus_hv);
+      AddBandBlock<true>(band, ld, bandwidth, v0 + 3, v0 + 3, hv);
+      e += c * dl * dl;
+      continue;
+    }
+    // BendTerm<3> (hessian_assembly.h), (3.6): the same expressions, the blocks on and
+    // below the diagonal only.
+    const Segment& s1 = segments_[term.first_node + 1];
+    const Segment& s2 = segments_[term.first_node + 2];
+    const double c = half_beta_;
+    const double inv1 = s1.inv, inv2 = s2.inv;
+    const V3& w1 = s1.w;
+    const V3& w2 = s2.w;
+    const double cth = w1.dot(w2);
+    const V3 a = (w2 - cth * w1) * inv1;
+    const V3 b = (w1 - cth * w2) * inv2;
+    const V3 g0 = c * a;
+    const V3 g1 = -c * a + c * b;
+    const V3 g2 = -c * b;
+    for (int k = 0; k < 3; ++k) {
+      gd[v0 + k] += g0[k];
+      gd[v0 + 3 + k] += g1[k];
+      gd[v0 + 6 + k] += g2[k];
+    }
+    const M w1w1 = w1 * w1.transpose();
+    const M w2w2 = w2 * w2.transpose();
+    const M wa = w1 * a.transpose();
+    const M wb = w2 * b.transpose();
+    const double c11 = c * cth * inv1 * inv1;
+    const double c22 = c * cth * inv2 * inv2;
+    M h11 = (c * inv1) * (wa + wa.transpose()) - c11 * w1w1;
+    h11.diagonal().array() += c11;
+    M h22 = (c * inv2) * (wb + wb.transpose()) - c22 * w2w2;
+    h22.diagonal().array() += c22;
+    const double s12 = -c * inv1 * inv2;
+    M h12 = s12 * (cth * (w1 * w2.transpose()) - w1w1 - w2w2);
+    h12.diagonal().array() += s12;
+    const M h21 = h12.transpose();
+    const M b10 = h21 - h11;
+    const M b20 = -h21;
+    const M b11 = h11 - h12 - h21 + h22;
+    const M b21 = h21 - h22;
+    AddBandBlock<true>(band, ld, bandwidth, v0, v0, h11);
+    AddBandBlock<false>(band, ld, bandwidth, v0 + 3, v0, b10);
+    AddBandBlock<true>(band, ld, bandwidth, v0 + 3, v0 + 3, b11);
+    AddBandBlock<false>(band, ld, bandwidth, v0 + 6, v0, b20);
+    AddBandBlock<false>(band, ld, bandwidth, v0 + 6, v0 + 3, b21);
+    AddBandBlock<true>(band, ld, bandwidth, v0 + 6, v0 + 6, h22);
+    e += c * (1.0 - cth);
+  }
+  *energy = e;
+  return true;
+}
 
 }  // namespace
 
