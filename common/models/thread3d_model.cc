@@ -407,26 +407,17 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   mutable Vec contact_trial_;
 };
 
-// The lower triangle (kLower) or all of a 3 x 3 block m added to band rows i0 .. i0 + 2,
-// columns j0 .. j0 + 2 (banded_ldlt.h's layout: A(i, j), i >= j, at i (b + 1) + j - i + b).
-template <bool kLower>
-inline void AddBandBlock(double* band, int ld, int b, int i0, int j0, const Eigen::Matrix3d& m) {
-  for (int r = 0; r < 3; ++r) {
-    double* row = band + static_cast<std::ptrdiff_t>(i0 + r) * ld + b - (i0 + r);  // row[j]: A(i0 + r, j)
-    for (int c = 0; c < (kLower ? r + 1 : 3); ++c) row[j0 + c] += m(r, c);
-  }
-}
-
 bool Thread3dModel::EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, double* band, int bandwidth,
                                                  double* energy) const {
   if (grip_ || contact_.enabled()) return ChainModel::EnergyGradientAndBandHessian(x, u, g, band, bandwidth, energy);
   if (bandwidth != assembly_.Bandwidth()) return false;
-  using M = Eigen::Matrix3d;
   const int ld = bandwidth + 1;
   if (g->size() != nx_) g->resize(nx_);
   g->setZero();
   double* gd = g->data();
   std::fill(band, band + static_cast<std::ptrdiff_t>(nx_) * ld, 0.0);
+  // Row i of the band: row(i)[j] is A(i, j), j = i - b .. i (banded_ldlt.h's layout).
+  auto row = [&](int i) { return band + static_cast<std::ptrdiff_t>(i) * ld + bandwidth - i; };
   // Segment s from p_{s-1} to p_s, as StretchTerm and BendTerm compute it (v, |v|, 1/|v|, v/|v|).
   for (int s = 1; s <= n_; ++s) {
     const V3 v = Node(s, x, u) - Node(s - 1, x, u);
@@ -435,6 +426,9 @@ bool Thread3dModel::EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec
     seg.inv = 1.0 / seg.l;
     seg.w = v * seg.inv;
   }
+  // Below, each entry is computed by the operations Eigen performs for StretchTerm's and
+  // BendTerm's expressions (hessian_assembly.h), in their order: Eigen evaluates a scalar
+  // times an outer product, k (p q^T), as (k p) q^T, so such an entry is (k p_r) q_c.
   double e = energy_shift_;
   for (int t = 0; t < chain_terms_; ++t) {
     const Term& term = terms_[t];
@@ -447,68 +441,86 @@ bool Thread3dModel::EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec
       continue;
     }
     if (!term.bend) {
-      // StretchTerm<3> (hessian_assembly.h), (3.7): blocks [[H, -H], [-H, H]].
+      // StretchTerm<3>, (3.7): H = 2c [(L/l) w w^T + (1 - L/l) I], node blocks [[H, -H], [-H, H]].
       const Segment& sg = segments_[term.first_node + 1];
+      const double* w = sg.w.data();
       const double c = half_gamma_;
       const double dl = sg.l - rest_;
-      const V3 gv = (2.0 * c * dl) * sg.w;
+      const double kg = 2.0 * c * dl;
       for (int k = 0; k < 3; ++k) {
-        gd[v0 + k] += -gv[k];
-        gd[v0 + 3 + k] += gv[k];
+        const double gv = kg * w[k];
+        gd[v0 + k] += -gv;
+        gd[v0 + 3 + k] += gv;
       }
       const double ratio = rest_ * sg.inv;
-      M hv = (2.0 * c * ratio) * (sg.w * sg.w.transpose());
-      hv.diagonal().array() += 2.0 * c * (1.0 - ratio);
-      const M minus_hv = -hv;
-      AddBandBlock<true>(band, ld, bandwidth, v0, v0, hv);
-      AddBandBlock<false>(band, ld, bandwidth, v0 + 3, v0, minus_hv);
-      AddBandBlock<true>(band, ld, bandwidth, v0 + 3, v0 + 3, hv);
+      const double kh = 2.0 * c * ratio;
+      const double kd = 2.0 * c * (1.0 - ratio);
+      double hv[3][3];  // hv[r][q] = H(r, q)
+      for (int r = 0; r < 3; ++r) {
+        for (int q = 0; q < 3; ++q) hv[r][q] = (kh * w[r]) * w[q];
+        hv[r][r] += kd;
+      }
+      for (int r = 0; r < 3; ++r) {
+        double* top = row(v0 + r);
+        double* bottom = row(v0 + 3 + r);
+        for (int q = 0; q <= r; ++q) {
+          top[v0 + q] += hv[r][q];
+          bottom[v0 + 3 + q] += hv[r][q];
+        }
+        for (int q = 0; q < 3; ++q) bottom[v0 + q] -= hv[r][q];  // += -H: the same bits
+      }
       e += c * dl * dl;
       continue;
     }
-    // BendTerm<3> (hessian_assembly.h), (3.6): the same expressions, the blocks on and
-    // below the diagonal only.
+    // BendTerm<3>, (3.6), with v1, v2 the segments before and after the joint: the blocks
+    // h11, h12 (h21 = h12^T), h22 of its comment, then node blocks on and below the
+    // diagonal: (0,0) h11, (1,0) h21 - h11, (1,1) h11 - h12 - h21 + h22, (2,0) -h21,
+    // (2,1) h21 - h22, (2,2) h22.
     const Segment& s1 = segments_[term.first_node + 1];
     const Segment& s2 = segments_[term.first_node + 2];
     const double c = half_beta_;
     const double inv1 = s1.inv, inv2 = s2.inv;
-    const V3& w1 = s1.w;
-    const V3& w2 = s2.w;
-    const double cth = w1.dot(w2);
-    const V3 a = (w2 - cth * w1) * inv1;
-    const V3 b = (w1 - cth * w2) * inv2;
-    const V3 g0 = c * a;
-    const V3 g1 = -c * a + c * b;
-    const V3 g2 = -c * b;
+    const double* w1 = s1.w.data();
+    const double* w2 = s2.w.data();
+    const double cth = s1.w.dot(s2.w);
+    double a[3], b[3];
     for (int k = 0; k < 3; ++k) {
-      gd[v0 + k] += g0[k];
-      gd[v0 + 3 + k] += g1[k];
-      gd[v0 + 6 + k] += g2[k];
+      a[k] = (w2[k] - cth * w1[k]) * inv1;
+      b[k] = (w1[k] - cth * w2[k]) * inv2;
+      gd[v0 + k] += c * a[k];
+      gd[v0 + 3 + k] += -c * a[k] + c * b[k];
+      gd[v0 + 6 + k] += -c * b[k];
     }
-    const M w1w1 = w1 * w1.transpose();
-    const M w2w2 = w2 * w2.transpose();
-    const M wa = w1 * a.transpose();
-    const M wb = w2 * b.transpose();
     const double c11 = c * cth * inv1 * inv1;
     const double c22 = c * cth * inv2 * inv2;
-    M h11 = (c * inv1) * (wa + wa.transpose()) - c11 * w1w1;
-    h11.diagonal().array() += c11;
-    M h22 = (c * inv2) * (wb + wb.transpose()) - c22 * w2w2;
-    h22.diagonal().array() += c22;
+    const double k11 = c * inv1, k22 = c * inv2;
     const double s12 = -c * inv1 * inv2;
-    M h12 = s12 * (cth * (w1 * w2.transpose()) - w1w1 - w2w2);
-    h12.diagonal().array() += s12;
-    const M h21 = h12.transpose();
-    const M b10 = h21 - h11;
-    const M b20 = -h21;
-    const M b11 = h11 - h12 - h21 + h22;
-    const M b21 = h21 - h22;
-    AddBandBlock<true>(band, ld, bandwidth, v0, v0, h11);
-    AddBandBlock<false>(band, ld, bandwidth, v0 + 3, v0, b10);
-    AddBandBlock<true>(band, ld, bandwidth, v0 + 3, v0 + 3, b11);
-    AddBandBlock<false>(band, ld, bandwidth, v0 + 6, v0, b20);
-    AddBandBlock<false>(band, ld, bandwidth, v0 + 6, v0 + 3, b21);
-    AddBandBlock<true>(band, ld, bandwidth, v0 + 6, v0 + 6, h22);
+    double h11[3][3], h22[3][3], h12[3][3];
+    for (int r = 0; r < 3; ++r) {
+      for (int q = 0; q < 3; ++q) {
+        h11[r][q] = k11 * (w1[r] * a[q] + w1[q] * a[r]) - c11 * (w1[r] * w1[q]);
+        h22[r][q] = k22 * (w2[r] * b[q] + w2[q] * b[r]) - c22 * (w2[r] * w2[q]);
+        h12[r][q] = s12 * ((cth * w1[r]) * w2[q] - w1[r] * w1[q] - w2[r] * w2[q]);
+      }
+      h11[r][r] += c11;
+      h22[r][r] += c22;
+      h12[r][r] += s12;
+    }
+    for (int r = 0; r < 3; ++r) {
+      double* r0 = row(v0 + r);
+      double* r1 = row(v0 + 3 + r);
+      double* r2 = row(v0 + 6 + r);
+      for (int q = 0; q <= r; ++q) {
+        r0[v0 + q] += h11[r][q];
+        r1[v0 + 3 + q] += h11[r][q] - h12[r][q] - h12[q][r] + h22[r][q];
+        r2[v0 + 6 + q] += h22[r][q];
+      }
+      for (int q = 0; q < 3; ++q) {
+        r1[v0 + q] += h12[q][r] - h11[r][q];
+        r2[v0 + q] -= h12[q][r];  // += -h21: the same bits
+        r2[v0 + 3 + q] += h12[q][r] - h22[r][q];
+      }
+    }
     e += c * (1.0 - cth);
   }
   *energy = e;
