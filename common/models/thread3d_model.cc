@@ -326,7 +326,8 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   const double energy_shift_;  // -N β B / 2
   const bool grip_;
   std::vector<Term> terms_;
-  // EnergyGradientAndBandHessian's segment cache (segments 1 .. N; sized once).
+  // EnergyGradientAndBandHessian's segment cache (segments 1 .. N; sized once). Scratch,
+  // like the contact scratch below: one evaluation at a time per model instance.
   struct Segment {
     V3 w;        // v / l
     double l;    // |v|, v = p_s - p_{s-1}
@@ -439,8 +440,8 @@ bool Thread3dModel::EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec
     } else {
       const Segment& s1 = segments_[term.first_node + 1];
       const Segment& s2 = segments_[term.first_node + 2];
-      e += internal::BendIntoBand(s1.w.data(), s1.inv, s2.w.data(), s2.inv, s1.w.dot(s2.w), half_beta_, v0, gd, band,
-                        bandwidth);
+      e += internal::BendIntoBand(s1.w.data(), s1.inv, s2.w.data(), s2.inv, s1.w.dot(s2.w), half_beta_, v0, gd,
+                                  band, bandwidth);
     }
   }
   *energy = e;
