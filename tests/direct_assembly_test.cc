@@ -142,7 +142,9 @@ TEST(ModelBandAssembly, ChainsWriteHessiansValuesIntoTheBand) {
     bool contact;
     bool banded;
   };
+  // thread3d n = 40: mostly interior terms, which thread3d writes into the band itself.
   const std::vector<Case> cases = {{"thread3d", 7, false, false, true}, {"thread3d", 7, true, false, true},
+                                   {"thread3d", 40, false, false, true}, {"thread3d", 3, false, false, true},
                                    {"curve2d", 9, false, false, true},  {"thread3d", 7, false, true, false},
                                    {"zeeman", 0, false, false, false}};
   std::mt19937 rng(5);

@@ -22,6 +22,7 @@
 
 #include <Eigen/Geometry>
 
+#include "models/chain_band_terms.h"
 #include "models/chain_model.h"
 #include "models/contact_terms.h"
 #include "models/registry.h"
@@ -58,6 +59,7 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
         grip_(params.Bool("grip_direction")),
         contact_params_(internal::ReadContactParams(params)) {
     AddChainTerms();
+    segments_.resize(n_ + 1);
   }
 
   std::string_view Name() const override { return kName; }
@@ -95,6 +97,17 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
     if (grip_) x[nx_ - 1] = length / n_;
     return x;
   }
+
+  // E, E_x and E_xx in band storage in one pass, as ChainModel's (the same terms in the
+  // same order, each term's derivatives by the same operations, so the same bits as
+  // Energy(), Gradient() and Hessian(); direct_assembly_test), faster: each segment's
+  // length and direction are computed once instead of in three terms (a stretching term
+  // and two bending terms: the square roots and divisions were most of BendTerm's time),
+  // and a term away from the clamp and the grasp, whose variables are consecutive states,
+  // writes the lower triangle of its blocks straight into the band, without the full
+  // local Hessian. The few terms at the ends, a grip and self-contact take ChainModel's path.
+  bool EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, double* band, int bandwidth,
+                                    double* energy) const override;
 
   void NodePositions(const Vec& x, const Vec& u, Eigen::Matrix3Xd* nodes) const override {
     if (nodes->cols() != n_ + 1) nodes->resize(3, n_ + 1);
@@ -313,6 +326,20 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   const double energy_shift_;  // -N β B / 2
   const bool grip_;
   std::vector<Term> terms_;
+  // EnergyGradientAndBandHessian's segment cache (segments 1 .. N; sized once). Scratch,
+  // like the contact scratch below: one evaluation at a time per model instance.
+  struct Segment {
+    V3 w;        // v / l
+    double l;    // |v|, v = p_s - p_{s-1}
+    double inv;  // 1 / l
+  };
+  mutable std::vector<Segment> segments_;
+  // The first state of a term whose variables are the consecutive states v0, v0 + 1, ...
+  // (its nodes are all free: not node 0 or 1, not the grasp, no grip), else -1.
+  int ContiguousStart(const Term& term) const {
+    const int last = term.first_node + (term.bend ? 2 : 1);
+    return (!grip_ && term.first_node >= 2 && last <= n_ - 1) ? NodeVar(term.first_node, 0) : -1;
+  }
 
   // Self-contact (issue 15; models/contact_terms.h): p_0 and y_1, z_1 fixed, x_1 and
   // p_2 .. p_{N-1} state variables, p_N = u. Not with a grip (the scene check says so).
@@ -381,6 +408,45 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   mutable Eigen::Matrix3Xd contact_nodes_, contact_to_;
   mutable Vec contact_trial_;
 };
+
+bool Thread3dModel::EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, double* band, int bandwidth,
+                                                 double* energy) const {
+  if (grip_ || contact_.enabled()) return ChainModel::EnergyGradientAndBandHessian(x, u, g, band, bandwidth, energy);
+  if (bandwidth != assembly_.Bandwidth()) return false;
+  if (g->size() != nx_) g->resize(nx_);
+  g->setZero();
+  double* gd = g->data();
+  std::fill(band, band + static_cast<std::ptrdiff_t>(nx_) * (bandwidth + 1), 0.0);
+  // Segment s from p_{s-1} to p_s, as StretchTerm and BendTerm compute it (v, |v|, 1/|v|, v/|v|).
+  for (int s = 1; s <= n_; ++s) {
+    const V3 v = Node(s, x, u) - Node(s - 1, x, u);
+    Segment& seg = segments_[s];
+    seg.l = v.norm();
+    seg.inv = 1.0 / seg.l;
+    seg.w = v * seg.inv;
+  }
+  double e = energy_shift_;
+  for (int t = 0; t < chain_terms_; ++t) {
+    const Term& term = terms_[t];
+    const int v0 = ContiguousStart(term);
+    if (v0 < 0) {
+      e += Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int lhd) {
+        assembly_.AddGradient(t, lg, gd);
+        assembly_.AddBandHessian(t, lh, lhd, band);
+      });
+    } else if (!term.bend) {
+      const Segment& sg = segments_[term.first_node + 1];
+      e += internal::StretchIntoBand(sg.w.data(), sg.l, sg.inv, half_gamma_, rest_, v0, gd, band, bandwidth);
+    } else {
+      const Segment& s1 = segments_[term.first_node + 1];
+      const Segment& s2 = segments_[term.first_node + 2];
+      e += internal::BendIntoBand(s1.w.data(), s1.inv, s2.w.data(), s2.inv, s1.w.dot(s2.w), half_beta_, v0, gd,
+                                  band, bandwidth);
+    }
+  }
+  *energy = e;
+  return true;
+}
 
 }  // namespace
 

@@ -206,10 +206,30 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
         backend->Factorize(h);
         backend->Solve(rhs, &x);
       });
+      // The update's pieces, at the same state.
+      int b = -1;
+      double* band = backend->AssemblyBand(&b);
+      Vec g(row.unknowns);
+      double e = 0.0;
+      if (band != nullptr &&
+          model.EnergyGradientAndBandHessian(tracker->state(), tracker->control(), &g, band, b, &e)) {
+        row.assembly_us = TimeSamples(o.floor_samples, [&] {
+          model.EnergyGradientAndBandHessian(tracker->state(), tracker->control(), &g, band, b, &e);
+        });
+        row.factor_us = TimeSamples(o.floor_samples, [&] {
+          model.EnergyGradientAndBandHessian(tracker->state(), tracker->control(), &g, band, b, &e);
+          backend->FactorizeAssembled();
+        });
+        // FactorizeAssembled() alone: the pair less the assembly.
+        row.factor_us.median = std::max(0.0, row.factor_us.median - row.assembly_us.median);
+        row.solve_us = TimeSamples(o.floor_samples, [&] { backend->Solve(rhs, &x); });
+      }
     }
     if (progress)
       *progress << "bench path: n=" << n << ": " << std::fixed << std::setprecision(2) << row.update_us.median
-                << " us/update (floor " << row.floor_us.median << " us, ratio " << row.FloorRatio() << ")\n"
+                << " us/update (floor " << row.floor_us.median << " us, ratio " << row.FloorRatio()
+                << "; E, E_x, E_xx into the band " << row.assembly_us.median << " us, its factorisation "
+                << row.factor_us.median << " us, a solve " << row.solve_us.median << " us)\n"
                 << std::defaultfloat << std::flush;
     if (!o.ceres) {
       row.ceres.note = "not run (--no-ceres)";
@@ -228,7 +248,7 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
   out << "n,unknowns,bandwidth,rows,update_us_median,update_us_min,update_us_max,iterations_per_update,snaps,"
          "floor_us_median,lapack_us_median,backend_us_median,floor_ratio,ceres_us_median,ceres_iterations_per_update,"
          "ceres_force_error_max,ceres_state_distance_max,ceres_rows_other_equilibrium,ceres_rows_saddle,"
-         "ceres_rows_not_converged,ceres_start_on_saddle\n";
+         "ceres_rows_not_converged,ceres_start_on_saddle,assembly_us_median,factor_us_median,solve_us_median\n";
   out << std::setprecision(6);
   for (const auto& r : rows) {
     const auto& c = r.ceres;
@@ -237,7 +257,8 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
         << r.floor_us.median << ',' << r.lapack_us.median << ',' << r.backend_us.median << ',' << r.FloorRatio() << ','
         << (c.ran ? c.update_us.median : 0.0) << ',' << c.iterations_per_update << ',' << c.force_error_max << ','
         << c.state_distance_max << ',' << c.rows_other_equilibrium << ',' << c.rows_saddle << ','
-        << c.rows_not_converged << ',' << (c.start_on_saddle ? 1 : 0) << '\n';
+        << c.rows_not_converged << ',' << (c.start_on_saddle ? 1 : 0) << ',' << r.assembly_us.median << ','
+        << r.factor_us.median << ',' << r.solve_us.median << '\n';
   }
 }
 

@@ -53,6 +53,11 @@ struct PathRow {
   Spread floor_us;                    // plain banded LDL^T factor + solve
   Spread lapack_us;                   // LAPACK dpbtrf + dpbtrs (count 0: not built)
   Spread backend_us;                  // the project's own backend: Factorize + Solve
+  // Where an update's time goes, timed at the last row's state with the update's own
+  // pieces: the model's E, E_x and E_xx written into the banded backend's band
+  // (Model::EnergyGradientAndBandHessian), FactorizeAssembled() of that band, one Solve().
+  // (count 0: the backend has no band, or the model does not write one)
+  Spread assembly_us, factor_us, solve_us;
   CeresPathResult ceres;
   double FloorRatio() const { return floor_us.median > 0 ? update_us.median / floor_us.median : 0.0; }
 };
