@@ -132,46 +132,78 @@ double CeresEnergy(const Scene& scene, const Vec& x, const Vec& u) {
   return thread.Energy();
 }
 
+std::vector<std::string> CeresSolverNames(int n) {
+  if (n <= 30) return {"lm-dense-qr", "lm-dense-cholesky", "dogleg-dense-qr"};
+  return {"lm-sparse-cholmod", "lm-sparse-eigen", "dogleg-sparse-cholmod"};
+}
+
 CeresPathResult RunCeresPath(const Scene& scene, const std::vector<Vec>& controls, const std::vector<Vec>& states,
-                             const std::vector<Vec>& forces, double cutoff) {
+                             const std::vector<Vec>& forces, const CeresSetting& setting) {
   CeresPathResult result;
+  result.solver = setting.solver;
+  result.cutoff = setting.cutoff;
   if (controls.empty() || states.size() != controls.size() || forces.size() != controls.size()) {
     result.note = "no rows";
     return result;
   }
   const auto model = MakeModel(scene.params);
-  const int n = ChainSegments(scene.params);
   const double snap_distance = 0.1 * ChainSegmentLength(scene.params);
   CeresThread thread(scene.params);
   ceres::Solver::Options options;
   options.minimizer_type = ceres::TRUST_REGION;
-  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  // Ceres' own advice: dense QR for small problems, sparse normal Cholesky (SuiteSparse)
-  // for large sparse ones.
-  options.linear_solver_type = n <= 30 ? ceres::DENSE_QR : ceres::SPARSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = 400;
+  // The settings: lm-* Levenberg-Marquardt, dogleg-* Powell's dogleg; *-dense-qr,
+  // *-dense-cholesky dense QR / normal Cholesky (Ceres' advice for small problems),
+  // *-sparse-cholmod / *-sparse-eigen sparse normal Cholesky through SuiteSparse or
+  // Eigen (Ceres' advice for large sparse ones).
+  const std::string& name = setting.solver;
+  auto ends_with = [&](const std::string& tail) {
+    return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  if (name.rfind("lm-", 0) == 0) {
+    options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  } else if (name.rfind("dogleg-", 0) == 0) {
+    options.trust_region_strategy_type = ceres::DOGLEG;
+  } else {
+    result.note = "unknown Ceres setting '" + name + "'";
+    return result;
+  }
+  if (ends_with("-dense-qr")) {
+    options.linear_solver_type = ceres::DENSE_QR;
+  } else if (ends_with("-dense-cholesky")) {
+    options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  } else if (ends_with("-sparse-cholmod")) {
+    options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  } else if (ends_with("-sparse-eigen")) {
+    options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
+  } else {
+    result.note = "unknown Ceres setting '" + name + "'";
+    return result;
+  }
+  options.max_num_iterations = setting.max_iterations;
   // Only the gradient-norm callback stops a converging solve.
   options.function_tolerance = 0.0;
   options.parameter_tolerance = 0.0;
   options.gradient_tolerance = 0.0;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
-  GradientNormStop stop(cutoff);
+  GradientNormStop stop(setting.cutoff);
   options.callbacks.push_back(&stop);
   std::string why;
   if (!options.IsValid(&why)) {
     result.note = "invalid Ceres options: " + why;
     return result;
   }
-  result.note = n <= 30 ? "LM, DENSE_QR" : "LM, SPARSE_NORMAL_CHOLESKY";
 
   std::string error;
   auto factor = MakeLinearSolver("auto", model->NumStates(), model->HessianBandwidth(), &error);
   SparseMatrix h = model->HessianPattern();
   factor->Analyze(h);
-  Vec x = model->InitialState(controls[0]), g, eu;
-  std::vector<double> us;
+  Vec x = model->InitialState(controls[0]), eu;
+  std::vector<double> us, force_errors;
   long iterations = 0;
+  double total_us = 0.0;
   for (size_t row = 0; row < controls.size(); ++row) {
     const Vec& u = controls[row];
     thread.Set(x, u);
@@ -179,14 +211,15 @@ CeresPathResult RunCeresPath(const Scene& scene, const std::vector<Vec>& control
     const auto t0 = std::chrono::steady_clock::now();
     ceres::Solve(options, &thread.problem(), &summary);
     const double t = Microseconds(t0, std::chrono::steady_clock::now());
+    total_us += t;
     thread.Get(&x);
+    const bool converged = summary.termination_type == ceres::USER_SUCCESS;
     if (row > 0) {
       us.push_back(t);
       iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
+      if (!converged) ++result.rows_not_converged;
     }
     // The equilibrium Ceres found, judged with the project's model (not timed).
-    model->Gradient(x, u, &g);
-    if (!(g.norm() < cutoff)) ++result.rows_not_converged;
     model->ControlGradient(x, u, &eu);
     const double force_error = (-eu - forces[row]).lpNorm<Eigen::Infinity>() / model->ForceScale();
     const double distance = (x - states[row]).lpNorm<Eigen::Infinity>();
@@ -199,13 +232,21 @@ CeresPathResult RunCeresPath(const Scene& scene, const std::vector<Vec>& control
       result.start_negative_pivots = factored ? factor->NegativePivots() : -1;
       continue;  // row 0 starts cold for both; the path rows follow
     }
-    result.force_error_max = std::max(result.force_error_max, force_error);
+    force_errors.push_back(force_error);
     result.state_distance_max = std::max(result.state_distance_max, distance);
     if (distance > snap_distance) ++result.rows_other_equilibrium;
     if (saddle) ++result.rows_saddle;
+    if (setting.time_limit_s > 0 && total_us > 1e6 * setting.time_limit_s && row + 1 < controls.size()) {
+      result.stopped_at_row = static_cast<int>(row);
+      break;
+    }
   }
+  const Spread errors = Summarize(force_errors);
+  result.force_error_max = errors.max;
+  result.force_error_median = errors.median;
   result.update_us = Summarize(us);
   result.iterations_per_update = us.empty() ? 0.0 : static_cast<double>(iterations) / us.size();
+  result.note = name;
   result.ran = true;
   return result;
 }

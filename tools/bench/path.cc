@@ -156,8 +156,9 @@ Spread TimeLapackFloor(const SparseMatrix& h, int b, int samples) {
 
 #ifndef SNAPTHREAD_HAVE_CERES
 bool CeresBuilt() { return false; }
+std::vector<std::string> CeresSolverNames(int) { return {}; }
 CeresPathResult RunCeresPath(const Scene&, const std::vector<Vec>&, const std::vector<Vec>&, const std::vector<Vec>&,
-                             double) {
+                             const CeresSetting&) {
   CeresPathResult r;
   r.note = "built without Ceres (deploy/setup.sh installs libceres-dev)";
   return r;
@@ -233,11 +234,10 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
                 << std::defaultfloat << std::flush;
     if (!o.ceres) {
       row.ceres.note = "not run (--no-ceres)";
+    } else if (!CeresBuilt()) {
+      row.ceres = RunCeresPath(scene, controls, states, forces, CeresSetting{});
     } else {
-      row.ceres = RunCeresPath(scene, controls, states, forces, o.cutoff);
-      if (progress && row.ceres.ran)
-        *progress << "bench path: n=" << n << " Ceres: " << row.ceres.update_us.median << " us/update, "
-                  << row.ceres.iterations_per_update << " it/update\n" << std::flush;
+      RunCeresAccuracy(scene, controls, states, forces, o, &row, progress);
     }
     rows.push_back(row);
   }
@@ -307,7 +307,8 @@ void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out) {
     out << "Ceres: " << (rows.empty() ? std::string("-") : rows.front().ceres.note) << '\n';
     return;
   }
-  out << "Ceres Solver side by side (same path, warm-started each row, stopped at ||E_x|| < cutoff):\n";
+  out << "Ceres Solver side by side (same path, warm-started each row, stopped at ||E_x|| < cutoff; judged\n"
+         "against the reference trace below):\n";
   std::snprintf(buf, sizeof buf, "%6s %11s %11s %8s %8s %9s %11s %8s %7s %7s %s\n", "n", "us/update", "Ceres us",
                 "ratio", "it/upd", "|dF|/Fs", "max |dx|", "branch", "saddle", "unconv", "row 0");
   out << buf;
@@ -320,12 +321,15 @@ void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out) {
                   c.rows_saddle, c.rows_not_converged, c.start_on_saddle ? "saddle" : "minimum", c.note.c_str());
     out << buf;
   }
+  PrintCeresAccuracy(rows, out);
 }
 
 std::string PathGnuplot(const std::vector<PathRow>& rows, const std::string& dir, const std::string& png) {
   {
     std::ofstream csv(dir + "/path.csv");
     WritePathCsv(rows, csv);
+    std::ofstream ceres_csv(dir + "/ceres.csv");
+    WriteCeresCsv(rows, ceres_csv);
   }
   const std::string file = dir + "/path.csv";
   bool lapack = false, ceres = false;
