@@ -418,6 +418,42 @@ TEST(BenchPath, CeresResidualsGiveTheModelsEnergy) {
     }
   }
 }
+
+// Every Ceres setting of the ladder runs, stays on the project's equilibria of a short
+// n = 10 path (after row 0), and a tighter cutoff brings its forces closer to the
+// project's: the accuracy ladder can only decide anything if this holds.
+TEST(BenchPath, CeresSettingsFollowTheProjectAndTightenWithTheCutoff) {
+  const Scene base = LoadScene(std::string(SNAPTHREAD_TEST_SOURCE_DIR) + "/scenes/thread3d_loop.yaml");
+  PathOptions o;
+  o.cutoff = 1e-10;  // the project's rows as the judge: far below both Ceres cutoffs
+  const Scene scene = Thread3dPathScene(base, 10, o);
+  const std::vector<Vec> controls = Thread3dPathControls(scene, 20);
+  auto tracker = MakeTracker(scene);
+  tracker->Reset(controls[0]);
+  std::vector<Vec> states{tracker->state()}, forces{tracker->last().force};
+  for (size_t i = 1; i < controls.size(); ++i) {
+    forces.push_back(tracker->Update(controls[i]).force);
+    states.push_back(tracker->state());
+  }
+  ASSERT_FALSE(CeresSolverNames(10).empty());
+  for (const std::string& solver : CeresSolverNames(10)) {
+    CeresSetting loose, tight;
+    loose.solver = tight.solver = solver;
+    loose.cutoff = 1e-6;
+    tight.cutoff = 1e-8;
+    const CeresPathResult a = RunCeresPath(scene, controls, states, forces, loose);
+    const CeresPathResult b = RunCeresPath(scene, controls, states, forces, tight);
+    ASSERT_TRUE(a.ran && b.ran) << solver << ": " << a.note << " / " << b.note;
+    EXPECT_EQ(b.rows_not_converged, 0) << solver;
+    EXPECT_EQ(b.rows_other_equilibrium, 0) << solver;
+    EXPECT_EQ(b.rows_saddle, 0) << solver;
+    EXPECT_LT(b.force_error_max, a.force_error_max) << solver;
+    EXPECT_LE(b.force_error_median, b.force_error_max) << solver;
+  }
+  CeresSetting bad;
+  bad.solver = "lm-no-such-solver";
+  EXPECT_FALSE(RunCeresPath(scene, controls, states, forces, bad).ran);
+}
 #endif
 
 }  // namespace

@@ -248,7 +248,8 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
   out << "n,unknowns,bandwidth,rows,update_us_median,update_us_min,update_us_max,iterations_per_update,snaps,"
          "floor_us_median,lapack_us_median,backend_us_median,floor_ratio,ceres_us_median,ceres_iterations_per_update,"
          "ceres_force_error_max,ceres_state_distance_max,ceres_rows_other_equilibrium,ceres_rows_saddle,"
-         "ceres_rows_not_converged,ceres_start_on_saddle,assembly_us_median,factor_us_median,solve_us_median\n";
+         "ceres_rows_not_converged,ceres_start_on_saddle,assembly_us_median,factor_us_median,solve_us_median,"
+         "ceres_equal_us_median,project_force_error_max,project_force_error_median\n";
   out << std::setprecision(6);
   for (const auto& r : rows) {
     const auto& c = r.ceres;
@@ -258,7 +259,9 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
         << (c.ran ? c.update_us.median : 0.0) << ',' << c.iterations_per_update << ',' << c.force_error_max << ','
         << c.state_distance_max << ',' << c.rows_other_equilibrium << ',' << c.rows_saddle << ','
         << c.rows_not_converged << ',' << (c.start_on_saddle ? 1 : 0) << ',' << r.assembly_us.median << ','
-        << r.factor_us.median << ',' << r.solve_us.median << '\n';
+        << r.factor_us.median << ',' << r.solve_us.median << ','
+        << (r.ceres_equal >= 0 ? r.ceres_ladder[r.ceres_equal].update_us.median : 0.0) << ','
+        << r.project_force_error_max << ',' << r.project_force_error_median << '\n';
   }
 }
 
@@ -332,10 +335,11 @@ std::string PathGnuplot(const std::vector<PathRow>& rows, const std::string& dir
     WriteCeresCsv(rows, ceres_csv);
   }
   const std::string file = dir + "/path.csv";
-  bool lapack = false, ceres = false;
+  bool lapack = false, ceres = false, ceres_equal = false;
   for (const auto& r : rows) {
     lapack = lapack || r.lapack_us.count > 0;
     ceres = ceres || r.ceres.ran;
+    ceres_equal = ceres_equal || r.ceres_equal >= 0;
   }
   std::ostringstream gp;
   gp << "set terminal pngcairo size 760,560 font 'DejaVu Sans,10'\n"
@@ -346,7 +350,10 @@ std::string PathGnuplot(const std::vector<PathRow>& rows, const std::string& dir
         "banded LDL^T floor'\n"
      << "plot '" << file << "' every ::1 using 1:5 with linespoints pt 7 lc rgb '#2ca02c' title 'snapthread "
      << (rows.empty() ? "" : "higher-order") << " (update)'";
-  if (ceres) gp << ", '" << file << "' every ::1 using 1:14 with linespoints pt 5 lc rgb '#d62728' title 'Ceres LM'";
+  if (ceres) gp << ", '" << file << "' every ::1 using 1:14 with linespoints pt 5 lc rgb '#d62728' title 'Ceres LM, cutoff 1e-6'";
+  if (ceres_equal)
+    gp << ", '" << file << "' every ::1 using 1:($25 > 0 ? $25 : 1/0) with linespoints pt 4 lc rgb '#ff7f0e' "
+       << "title 'Ceres, cheapest setting at the project force accuracy'";
   gp << ", '" << file << "' every ::1 using 1:10 with linespoints pt 9 dt 2 lc rgb '#1f77b4' title 'floor: plain banded LDL^T factor + solve'";
   if (lapack)
     gp << ", '" << file << "' every ::1 using 1:11 with linespoints pt 11 dt 3 lc rgb '#9467bd' title 'LAPACK dpbtrf + dpbtrs'";

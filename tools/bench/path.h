@@ -30,7 +30,7 @@ struct PathOptions {
   // k = 0 .. ceres_ladder - 1, with each of CeresSolverNames(n), until its force error
   // against the reference (max and median over the rows) is <= the project's.
   int ceres_ladder = 6;
-  double ceres_time_limit_s = 90.0;  // per Ceres setting and n (a cut-off path is not "equal")
+  double ceres_time_limit_s = 60.0;  // per Ceres setting and n (a cut-off path is not "equal")
 };
 
 // One Ceres run: a trust-region strategy and linear solver (CeresSolverNames) and the
@@ -119,7 +119,7 @@ CeresPathResult RunCeresPath(const Scene& scene, const std::vector<Vec>& control
                              const std::vector<Vec>& forces, const CeresSetting& setting);
 // The Ceres settings tried at n segments, the first the default (Ceres' own advice).
 std::vector<std::string> CeresSolverNames(int n);
-// Whether a Ceres run reached the project's force accuracy on every row.
+// Whether a whole Ceres run's force error (max and median over the rows) is <= the project's.
 bool CeresMatchesAccuracy(const PathRow& row, const CeresPathResult& c);
 void WriteCeresCsv(const std::vector<PathRow>& rows, std::ostream& out);
 // ceres_accuracy.cc: the reference trace, the project's force error against it (forces:
