@@ -134,6 +134,10 @@ double CeresEnergy(const Scene& scene, const Vec& x, const Vec& u) {
 
 std::vector<std::string> CeresSolverNames(int n) {
   if (n <= 30) return {"lm-dense-qr", "lm-dense-cholesky", "dogleg-dense-qr"};
+  // CGNR (conjugate gradients on the normal equations, Jacobi preconditioner) only
+  // where a path finishes in minutes: with lambda_min ~1e-11 it needs hundreds of
+  // iterations per solve.
+  if (n <= 300) return {"lm-sparse-cholmod", "lm-sparse-eigen", "dogleg-sparse-cholmod", "lm-cgnr"};
   return {"lm-sparse-cholmod", "lm-sparse-eigen", "dogleg-sparse-cholmod"};
 }
 
@@ -154,7 +158,7 @@ CeresPathResult RunCeresPath(const Scene& scene, const std::vector<Vec>& control
   // The settings: lm-* Levenberg-Marquardt, dogleg-* Powell's dogleg; *-dense-qr,
   // *-dense-cholesky dense QR / normal Cholesky (Ceres' advice for small problems),
   // *-sparse-cholmod / *-sparse-eigen sparse normal Cholesky through SuiteSparse or
-  // Eigen (Ceres' advice for large sparse ones).
+  // Eigen (Ceres' advice for large sparse ones), *-cgnr Ceres' iterative solver.
   const std::string& name = setting.solver;
   auto ends_with = [&](const std::string& tail) {
     return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
@@ -174,6 +178,9 @@ CeresPathResult RunCeresPath(const Scene& scene, const std::vector<Vec>& control
   } else if (ends_with("-sparse-cholmod")) {
     options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  } else if (ends_with("-cgnr")) {
+    options.linear_solver_type = ceres::CGNR;
+    options.preconditioner_type = ceres::JACOBI;
   } else if (ends_with("-sparse-eigen")) {
     options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
