@@ -106,8 +106,9 @@ void RunCeresAccuracy(const Scene& scene, const std::vector<Vec>& controls, cons
   row->project_force_error_median = e.median;
   if (progress)
     *progress << "bench path: n=" << row->n << " reference (the project's rows Newton-polished): ||E_x|| max "
-              << ref.gradient_max << ", median " << ref.gradient_median << ", moved <= " << ref.moved_max << "; project's force error max " << e.max << ", median " << e.median
-              << " of the force scale\n" << std::flush;
+              << ref.gradient_max << ", median " << ref.gradient_median << ", moved <= " << ref.moved_max
+              << "; project's force error max " << e.max << ", median " << e.median << " of the force scale\n"
+              << std::flush;
   int first_equal_k = -1;
   const std::vector<std::string> solvers = CeresSolverNames(row->n);
   for (size_t s = 0; s < solvers.size(); ++s) {
@@ -215,15 +216,16 @@ void PrintCeresAccuracy(const std::vector<PathRow>& rows, std::ostream& out) {
     const double p = std::max(r.update_us.median, 1e-9);
     if (r.ceres_equal >= 0) {
       const auto& c = r.ceres_ladder[r.ceres_equal];
-      std::snprintf(buf, sizeof buf, "  n = %d: cheapest equal setting %s at cutoff %.0e: %.1f us / %.2f us = %.1fx -> %s",
-                    r.n, c.solver.c_str(), c.cutoff, c.update_us.median, r.update_us.median, c.update_us.median / p,
+      std::snprintf(buf, sizeof buf,
+                    "  n = %d: cheapest equal setting %s at cutoff %.0e: %.1f us / %.2f us = %.1fx -> %s", r.n,
+                    c.solver.c_str(), c.cutoff, c.update_us.median, r.update_us.median, c.update_us.median / p,
                     c.update_us.median / p >= 10.0 ? "met" : "NOT met");
     } else {
       std::snprintf(buf, sizeof buf,
                     "  n = %d: no Ceres setting reaches the project's accuracy (closest in max: %s at %.0e, err max "
                     "%.2e, median %.2e, %.1f us = %.1fx) -> met",
-                    r.n, closest->solver.c_str(), closest->cutoff, closest->force_error_max, closest->force_error_median,
-                    closest->update_us.median, closest->update_us.median / p);
+                    r.n, closest->solver.c_str(), closest->cutoff, closest->force_error_max,
+                    closest->force_error_median, closest->update_us.median, closest->update_us.median / p);
     }
     out << buf;
     if (max_only) {

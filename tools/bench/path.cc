@@ -350,7 +350,8 @@ std::string PathGnuplot(const std::vector<PathRow>& rows, const std::string& dir
         "banded LDL^T floor'\n"
      << "plot '" << file << "' every ::1 using 1:5 with linespoints pt 7 lc rgb '#2ca02c' title 'snapthread "
      << (rows.empty() ? "" : "higher-order") << " (update)'";
-  if (ceres) gp << ", '" << file << "' every ::1 using 1:14 with linespoints pt 5 lc rgb '#d62728' title 'Ceres LM, cutoff 1e-6'";
+  if (ceres)
+    gp << ", '" << file << "' every ::1 using 1:14 with linespoints pt 5 lc rgb '#d62728' title 'Ceres LM, cutoff 1e-6'";
   if (ceres_equal)
     gp << ", '" << file << "' every ::1 using 1:($25 > 0 ? $25 : 1/0) with linespoints pt 4 lc rgb '#ff7f0e' "
        << "title 'Ceres, cheapest setting at the project force accuracy'";

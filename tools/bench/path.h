@@ -3,9 +3,10 @@
 // direction, higher-order, cutoff 1e-6) and the same path at n = 10 and 100, timed per
 // update; the floor (a plain banded LDL^T factor + solve of the same size and band,
 // and LAPACK's dpbtrf/dpbtrs where LAPACK is found) timed in the same run; and, where
-// Ceres is found, Ceres Solver's Levenberg-Marquardt on the same energy written as
-// stretching and bending residuals, warm-started each row and stopped at the same
-// gradient norm.
+// Ceres is found, Ceres Solver on the same energy written as stretching and bending
+// residuals, warm-started each row and stopped at a gradient norm: at the project's
+// cutoff, and down a ladder of tighter ones until its forces are as accurate as the
+// project's against a Newton-polished reference (ceres_accuracy.cc).
 #pragma once
 
 #include <ostream>
@@ -81,9 +82,10 @@ struct PathRow {
   Spread assembly_us, factor_us, solve_us;
   CeresPathResult ceres;  // the first Ceres setting at the project's cutoff
   // Equal force accuracy: the reference trace's ||E_x||_2 (max, median over rows
-  // 1..steps), how far polishing moved the project's states, and the project's force error against it (over rows 1..steps, |F - F_ref|_inf / ForceScale); every
-  // Ceres setting run, judged against the reference; the index of the fastest one
-  // whose max and median force errors are both <= the project's (-1: none).
+  // 1..steps), how far polishing moved the project's states, and the project's force
+  // error against it (over rows 1..steps, |F - F_ref|_inf / ForceScale); every Ceres
+  // setting run, judged against the reference; the index of the fastest one whose max
+  // and median force errors are both <= the project's (-1: none).
   double reference_gradient_max = 0.0, reference_gradient_median = 0.0, reference_moved_max = 0.0;
   double project_force_error_max = 0.0, project_force_error_median = 0.0;
   std::vector<CeresPathResult> ceres_ladder;
@@ -114,7 +116,7 @@ std::string PathGnuplot(const std::vector<PathRow>& rows, const std::string& csv
 // Ceres (ceres_path.cc; without Ceres, CeresBuilt() is false and RunCeresPath says so).
 bool CeresBuilt();
 // Ceres along `controls` (row 0 from the model's InitialState), compared row by row with
-// the project's equilibria `states` and forces `forces` on the same rows.
+// the given equilibria `states` and forces `forces` on the same rows.
 CeresPathResult RunCeresPath(const Scene& scene, const std::vector<Vec>& controls, const std::vector<Vec>& states,
                              const std::vector<Vec>& forces, const CeresSetting& setting);
 // The Ceres settings tried at n segments, the first the default (Ceres' own advice).
@@ -122,8 +124,9 @@ std::vector<std::string> CeresSolverNames(int n);
 // Whether a whole Ceres run's force error (max and median over the rows) is <= the project's.
 bool CeresMatchesAccuracy(const PathRow& row, const CeresPathResult& c);
 void WriteCeresCsv(const std::vector<PathRow>& rows, std::ostream& out);
-// ceres_accuracy.cc: the reference trace, the project's force error against it (forces:
-// the project's rows' equilibria and forces) and the Ceres ladder into *row; the table and verdict for them.
+// ceres_accuracy.cc: from the project's equilibria `states` and forces `forces`, the
+// reference trace, the project's force error against it and the Ceres ladder into *row;
+// the table and verdict for them.
 void RunCeresAccuracy(const Scene& scene, const std::vector<Vec>& controls, const std::vector<Vec>& states,
                       const std::vector<Vec>& forces,
                       const PathOptions& o, PathRow* row, std::ostream* progress);
