@@ -51,6 +51,17 @@ double SelfContact::Energy(const Eigen::Matrix3Xd& nodes) const {
   return e;
 }
 
+void SelfContact::PairsWithin(const Eigen::Matrix3Xd& nodes, double distance,
+                              std::vector<std::pair<int, int>>* out) const {
+  FindPairs(nodes, nullptr, distance);
+  out->clear();
+  const double limit = distance * distance;
+  for (const auto& [i, j] : pairs_) {
+    if (ClosestPoints(nodes.col(i), nodes.col(i + 1), nodes.col(j), nodes.col(j + 1)).distance_sq < limit)
+      out->emplace_back(i, j);
+  }
+}
+
 double SelfContact::MaxStepFraction(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const {
   // Pairs whose swept boxes come within the activation distance: any other pair stays
   // farther apart than 2r + d̂ (so it keeps its gap above d̂ > 0).

@@ -81,6 +81,9 @@ class SelfContact {
   // every pair keeps its gap above kKeep of its starting gap.
   double MaxStepFraction(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const;
   static constexpr double kKeep = 0.1;
+  // The included pairs whose centrelines come closer than `distance`, sorted (broad
+  // phase with that reach, then the exact distance). Uses the scratch above.
+  void PairsWithin(const Eigen::Matrix3Xd& nodes, double distance, std::vector<std::pair<int, int>>* out) const;
   // How many included pairs the last call's broad phase passed to the narrow phase (the
   // work that must stay O(n + contacts)).
   int CandidatePairs() const { return static_cast<int>(pairs_.size()); }

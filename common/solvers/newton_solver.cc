@@ -32,6 +32,7 @@ SolverBase::SolverBase(const Model& model, const SolverOptions& options)
     }
     if (w.diag_index[j] < 0) throw std::logic_error("Hessian pattern lacks a diagonal entry");
   }
+  pattern_version_ = model_.HessianPatternVersion();
   w.eig.Resize(n_);
   w.orbits = std::make_unique<SymmetryOrbits>(model_);
   for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch, &w.h_state}) v->resize(n_);
@@ -197,6 +198,7 @@ double SolverBase::EvalGradientAtStart(const Vec& x, const Vec& u, SolverSummary
     sparse_stale_ = true;
   } else {
     h_state_energy_ = model_.EnergyGradientAndHessian(x, u, &ws_.g, &ws_.h);
+    SyncPattern();
     hessian_ready_ = true;
   }
   ++s->gradient_evaluations;
@@ -226,6 +228,7 @@ LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummar
     st = ws_.factor->FactorizeAssembled();  // ws_.h stays stale (sparse_stale_)
   } else {
     if (!have_h) model_.Hessian(x, u, &ws_.h);
+    SyncPattern();
     sparse_stale_ = false;
     st = ws_.factor->Factorize(ws_.h);
   }
@@ -237,7 +240,39 @@ LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummar
 void SolverBase::EnsureSparseHessian() {
   if (!sparse_stale_) return;
   model_.Hessian(ws_.h_state, ws_.h_u, &ws_.h);
+  SyncPattern();
   sparse_stale_ = false;
+}
+
+void SolverBase::SyncPattern() {
+  // Self-contact changes E_xx's pattern now and then (model.h, models/contact_terms.h):
+  // ws_.h has just been given the new structure; the second matrix, the diagonal's
+  // positions and both symbolic analyses follow it. The factorisations are discarded.
+  const int version = model_.HessianPatternVersion();
+  if (version == pattern_version_) return;
+  Workspace& w = ws_;
+  const SparseMatrix& p = model_.HessianPattern();
+  const auto same = [](const SparseMatrix& a, const SparseMatrix& b) {
+    return a.nonZeros() == b.nonZeros() &&
+           std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1, b.outerIndexPtr()) &&
+           std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr());
+  };
+  if (!same(w.h, p)) return;  // ws_.h not evaluated since the change
+  pattern_version_ = version;
+  if (same(w.h, w.h_mod)) return;
+  w.h_mod = w.h;
+  for (int j = 0; j < n_; ++j) {
+    w.diag_index[j] = -1;
+    for (int q = w.h.outerIndexPtr()[j]; q < w.h.outerIndexPtr()[j + 1]; ++q) {
+      if (w.h.innerIndexPtr()[q] == j) w.diag_index[j] = q;
+    }
+  }
+  // A failed analysis leaves the factorisations unanalysed: Factorize() then reports it.
+  w.factor->Analyze(w.h);
+  w.alt_factor->Analyze(w.h);
+  factor_valid_ = false;
+  factor_before_tiny_step_ = false;
+  ++pattern_changes_;
 }
 
 double SolverBase::UpdateEigenpair(int iterations) {

@@ -23,6 +23,8 @@ class SolverBase : public EquilibriumSolver {
   const std::string& method() const override { return options_.method; }
   void Reset() override;
   const SymmetricLinearSolver* Factorization() const override;
+  // How many times E_xx's pattern changed under this solver (self-contact; SyncPattern).
+  int PatternChanges() const { return pattern_changes_; }
   const Vec& LowestEigenvector() const override { return ws_.eig.vector(); }
 
  protected:
@@ -119,6 +121,9 @@ class SolverBase : public EquilibriumSolver {
   // ws_.h := E_xx at ws_.h_state when the factorisation there was assembled in band
   // storage (sparse_stale_): the rare steps that edit or read E_xx entry by entry.
   void EnsureSparseHessian();
+  // After the model wrote ws_.h: when its pattern changed (self-contact, model.h), the
+  // rest of the workspace follows it and both factorisations are analysed again.
+  void SyncPattern();
   // x is bit for bit the state of EvalGradientAtStart's E_xx (ws_.h_state).
   bool AtHessianState(const Vec& x) const;
   bool BudgetLeft(const SolverSummary& s) const;
@@ -156,6 +161,8 @@ class SolverBase : public EquilibriumSolver {
   // h_state_energy_ is E at ws_.h_state (from EvalGradientAtStart, this solve).
   bool energy_ready_ = false;
   double h_state_energy_ = 0.0;
+  int pattern_version_ = 0;  // the model's HessianPatternVersion() that ws_ follows
+  int pattern_changes_ = 0;  // re-analyses so far (SyncPattern)
   double lambda_ref_ = -1.0;     // lambda_0 at the last regular converged state
   // MinimizeFully stopped at the time budget: the snap goes on at the next update.
   bool snap_in_progress_ = false;
