@@ -35,10 +35,20 @@ void SelfContact::FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3X
     lo->col(i) = l.array() - half;
     hi->col(i) = h.array() + half;
   }
-  broad->Overlaps(*lo, *hi, pairs);
-  pairs->erase(std::remove_if(pairs->begin(), pairs->end(),
-                              [&](const std::pair<int, int>& p) { return !Included(p.first, p.second); }),
-               pairs->end());
+  broad->Overlaps(*lo, *hi, pairs, min_gap_);  // included pairs only: j - i >= min_gap_
+}
+
+void SelfContact::FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to, double reach) const {
+  if (to == nullptr && cache_valid_ && reach == cached_reach_ && cached_nodes_.cols() == nodes.cols() &&
+      std::equal(nodes.data(), nodes.data() + nodes.size(), cached_nodes_.data())) {
+    return;
+  }
+  FindPairs(nodes, to, reach, &broad_, &lo_, &hi_, &pairs_);
+  cache_valid_ = to == nullptr;
+  if (cache_valid_) {
+    cached_nodes_ = nodes;  // no allocation once sized
+    cached_reach_ = reach;
+  }
 }
 
 double SelfContact::Energy(const Eigen::Matrix3Xd& nodes) const {

@@ -57,7 +57,7 @@ bool ContactTerms::CoverActive(const Eigen::Matrix3Xd& nodes) const {
   // activation distance plus the margin, so that the next few steps find theirs in it.
   self_.PairsWithin(nodes, (1.0 + kMargin) * reach, &scratch_pairs_);
   for (const auto& [i, j] : set_) pair_term_[i * segments_ + j] = -1;
-  set_.swap(scratch_pairs_);
+  set_ = scratch_pairs_;  // a copy: the scratch keeps its capacity (no allocation when warm)
   term_vars_.clear();
   term_begin_.assign(1, 0);
   for (const auto& [i, j] : set_) {
