@@ -267,9 +267,11 @@ void SolverBase::SyncPattern() {
       if (w.h.innerIndexPtr()[q] == j) w.diag_index[j] = q;
     }
   }
-  // A failed analysis leaves the factorisations unanalysed: Factorize() then reports it.
+  // A failed analysis leaves the factorisation unanalysed: Factorize() then reports it.
+  // The second factorisation (shifted or restricted matrices, rare) is analysed when it
+  // is next used (FactorModified).
   w.factor->Analyze(w.h);
-  w.alt_factor->Analyze(w.h);
+  alt_stale_ = true;
   factor_valid_ = false;
   factor_before_tiny_step_ = false;
   ++pattern_changes_;
@@ -289,6 +291,10 @@ SparseMatrix& SolverBase::ModifiedHessian() {
 
 LinearSolverStatus SolverBase::FactorModified(SolverSummary* s) {
   ++s->factorizations;
+  if (alt_stale_) {  // the pattern changed since its analysis (SyncPattern)
+    ws_.alt_factor->Analyze(ws_.h_mod);
+    alt_stale_ = false;
+  }
   return ws_.alt_factor->Factorize(ws_.h_mod);
 }
 

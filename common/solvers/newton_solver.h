@@ -163,6 +163,7 @@ class SolverBase : public EquilibriumSolver {
   double h_state_energy_ = 0.0;
   int pattern_version_ = 0;  // the model's HessianPatternVersion() that ws_ follows
   int pattern_changes_ = 0;  // re-analyses so far (SyncPattern)
+  bool alt_stale_ = false;   // alt_factor not analysed for the current pattern
   double lambda_ref_ = -1.0;     // lambda_0 at the last regular converged state
   // MinimizeFully stopped at the time budget: the snap goes on at the next update.
   bool snap_in_progress_ = false;

@@ -295,7 +295,8 @@ struct ContactScalingRow {
 };
 std::vector<ContactScalingRow> RunContactScaling(const std::vector<int>& ns, int repetitions, double min_sample_s);
 void WriteContactScalingCsv(const std::vector<ContactScalingRow>& rows, std::ostream& out);
-PowerLawFit FitContactScaling(const std::vector<ContactScalingRow>& rows);
+// Over the rows with n >= min_n (small n: no pair near contact, nothing to fit).
+PowerLawFit FitContactScaling(const std::vector<ContactScalingRow>& rows, int min_n = 100);
 
 // ---------------------------------------------------------------- machine / charts
 

@@ -71,9 +71,10 @@ void WriteContactScalingCsv(const std::vector<ContactScalingRow>& rows, std::ost
   }
 }
 
-PowerLawFit FitContactScaling(const std::vector<ContactScalingRow>& rows) {
+PowerLawFit FitContactScaling(const std::vector<ContactScalingRow>& rows, int min_n) {
   std::vector<double> x, y;
   for (const auto& r : rows) {
+    if (r.n < min_n) continue;
     x.push_back(r.n);
     y.push_back(r.rate_hz.median);
   }

@@ -219,8 +219,8 @@ int main(int argc, char** argv) {
         table << "  n = " << r.n << ": " << r.rate_hz.median << " /s (" << r.active_pairs << " active of "
               << r.candidate_pairs << " candidate pairs)\n";
       }
-      table << "  slope of the rate against n: " << FitContactScaling(contact).slope
-            << " (-1: cost linear in n)\n";
+      table << "  slope of the rate against n, n >= 100: " << FitContactScaling(contact).slope
+            << " (-1: cost linear in n); n >= 20: " << FitContactScaling(contact, 20).slope << "\n";
       std::cout << table.str();
       summary << table.str() << '\n';
       if (!no_plot) {
