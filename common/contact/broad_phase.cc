@@ -101,7 +101,25 @@ void BroadPhase::Overlaps(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi
       }
     }
   }
-  std::sort(pairs->begin(), pairs->end());
+  // Sorted by (i, j) in O(m + pairs): a counting sort by i (stable), then each i's few
+  // partners by j (insertion sort; a box overlaps O(1) others).
+  const int count_pairs = static_cast<int>(pairs->size());
+  pair_start_.assign(m + 1, 0);
+  for (const auto& pr : *pairs) ++pair_start_[pr.first + 1];
+  for (int i = 0; i < m; ++i) pair_start_[i + 1] += pair_start_[i];
+  sorted_pairs_.resize(count_pairs);
+  for (const auto& pr : *pairs) sorted_pairs_[pair_start_[pr.first]++] = pr;
+  pairs->swap(sorted_pairs_);  // both keep their capacity
+  for (int i = m; i > 0; --i) pair_start_[i] = pair_start_[i - 1];
+  pair_start_[0] = 0;
+  for (int i = 0; i < m; ++i) {
+    for (int p = pair_start_[i] + 1; p < pair_start_[i + 1]; ++p) {
+      const std::pair<int, int> key = (*pairs)[p];
+      int q = p - 1;
+      for (; q >= pair_start_[i] && (*pairs)[q].second > key.second; --q) (*pairs)[q + 1] = (*pairs)[q];
+      (*pairs)[q + 1] = key;
+    }
+  }
 }
 
 }  // namespace snapthread::contact

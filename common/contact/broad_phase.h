@@ -35,6 +35,8 @@ class BroadPhase {
   std::vector<Entry> sorted_;
   std::vector<int> bucket_start_;
   std::vector<std::int64_t> low_cell_;  // 3 per box: the cell of its lower corner
+  std::vector<int> pair_start_;         // the pairs' counting sort by i
+  std::vector<std::pair<int, int>> sorted_pairs_;
 };
 
 }  // namespace snapthread::contact
