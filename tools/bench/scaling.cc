@@ -350,8 +350,7 @@ std::string ScalingGnuplot(const std::vector<ScalingRow>& rows, const std::vecto
     }
     if (!contact.empty()) {
       gp << (first ? "" : ", ") << "'" << dir << "/contact_scaling.csv' every ::1 using 1:2:3:4 with yerrorlines "
-         << "pt 5 ps 0.6 lc rgb '#000000' title 'self-contact E, E_x, E_xx on a helix, evaluations/s (slope "
-         << contact_slope << " for n >= 100)'";
+         << "pt 5 ps 0.6 lc rgb '#000000' title 'contact E,E_x,E_xx /s (slope " << contact_slope << ", n>=100)'";
       first = false;
     }
     if (anchor_n > 0) {
