@@ -36,9 +36,9 @@ class HessianAssembly {
   // Most variables one term can touch (thread3d's bending term next to the grip touches
   // 3 + 3 + 7 = 13: two free nodes, then s, (X, Y, Z) and (dx, dy, dz)).
   static constexpr int kMaxTermVars = 16;
-  // A self-contact pair term (contact_terms.h) may touch more: the 12 coordinates of its
-  // two segments and, when one is grasped, every control (a free rod's 12). AddTerm
-  // accepts up to this many; the local buffers of the elastic terms stay kMaxTermVars.
+  // AddTerm accepts up to this many (a term over two segments' 12 coordinates and a free
+  // rod's 12 controls); the local buffers of the elastic terms stay kMaxTermVars. The
+  // self-contact pairs are dynamic terms over their state coordinates only (at most 12).
   static constexpr int kMaxPairTermVars = 24;
 
   HessianAssembly() = default;
