@@ -68,7 +68,7 @@ class ContactTerms {
   // The set's reach beyond the activation distance, as a multiple of it. Measured on the
   // knot path (docs/benchmarks.md): a wide margin re-analyses seldom but factorises the
   // blocks of many idle pairs each step (margin 1: median 1.34 ms an update at n = 100);
-  // 0.05 to 0.2 were alike (0.67 to 0.79 ms), a re-analysis every few updates.
+  // 0 to 0.2 were alike (0.67 to 0.79 ms), a re-analysis every few updates.
   static constexpr double kMargin = 0.1;
 
   bool enabled() const { return self_.enabled(); }
