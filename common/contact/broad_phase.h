@@ -3,9 +3,12 @@
 //
 // The cell size is the mean box extent (at least 1e-12 of the scene), every box goes
 // into each cell it covers, and a pair is reported once: in the cell that holds the
-// lower corner of the two boxes' intersection. When boxes span very many cells (one
-// long swept box), the cell size doubles until the entries stay below 16 m. The scratch
-// vectors keep their capacity, so a warm broad phase does not allocate.
+// lower corner of the two boxes' intersection (floor is monotone, so that cell is the
+// larger of the two boxes' lower cells on each axis: integer comparisons only). When
+// boxes span very many cells (one long swept box), the cell size doubles until the
+// entries stay below 16 m. Boxes of a chain overlap their neighbours along it: pairs
+// closer in index than `min_index_gap` are dropped before any test. The scratch vectors
+// keep their capacity, so a warm broad phase does not allocate.
 #pragma once
 
 #include <cstdint>
@@ -18,10 +21,10 @@ namespace snapthread::contact {
 
 class BroadPhase {
  public:
-  // Pairs (i < j) of boxes [lo_i, hi_i] (columns of 3 x m matrices) that overlap,
-  // written to *pairs (cleared first), sorted by (i, j).
+  // Pairs (i < j, j - i >= min_index_gap) of boxes [lo_i, hi_i] (columns of 3 x m
+  // matrices) that overlap, written to *pairs (cleared first), sorted by (i, j).
   void Overlaps(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi,
-                std::vector<std::pair<int, int>>* pairs);
+                std::vector<std::pair<int, int>>* pairs, int min_index_gap = 1);
 
  private:
   struct Entry {
@@ -31,6 +34,9 @@ class BroadPhase {
   std::vector<Entry> entries_;
   std::vector<Entry> sorted_;
   std::vector<int> bucket_start_;
+  std::vector<std::int64_t> low_cell_;  // 3 per box: the cell of its lower corner
+  std::vector<int> pair_start_;         // the pairs' counting sort by i
+  std::vector<std::pair<int, int>> sorted_pairs_;
 };
 
 }  // namespace snapthread::contact

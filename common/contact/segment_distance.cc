@@ -60,7 +60,12 @@ double SegmentDistanceSq(const V3& a0, const V3& a1, const V3& b0, const V3& b1,
                          Mat12* h, SegmentClosest* closest) {
   const SegmentClosest c = ClosestPoints(a0, a1, b0, b1);
   if (closest != nullptr) *closest = c;
-  if (g == nullptr && h == nullptr) return c.distance_sq;
+  if (g != nullptr || h != nullptr) SegmentDistanceDerivatives(a0, a1, b0, b1, c, g, h);
+  return c.distance_sq;
+}
+
+void SegmentDistanceDerivatives(const V3& a0, const V3& a1, const V3& b0, const V3& b1,
+                                const SegmentClosest& c, Vec12* g, Mat12* h) {
   const V3 ea = a1 - a0, eb = b1 - b0;
   const V3 r = a0 + c.s * ea - b0 - c.t * eb;
   // r = J x with J = [(1-s) I, s I, -(1-t) I, -t I]: coefficient of each endpoint.
@@ -68,7 +73,7 @@ double SegmentDistanceSq(const V3& a0, const V3& a1, const V3& b0, const V3& b1,
   if (g != nullptr) {
     for (int k = 0; k < 4; ++k) g->segment<3>(3 * k) = (2.0 * coef[k]) * r;  // f_x = 2 Jᵀ r
   }
-  if (h == nullptr) return c.distance_sq;
+  if (h == nullptr) return;
   // f_xx = 2 JᵀJ.
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
@@ -98,7 +103,6 @@ double SegmentDistanceSq(const V3& a0, const V3& a1, const V3& b0, const V3& b1,
   } else if (c.t_free) {
     h->noalias() -= (1.0 / ftt) * fxt * fxt.transpose();
   }
-  return c.distance_sq;
 }
 
 }  // namespace snapthread::contact

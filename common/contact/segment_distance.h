@@ -44,5 +44,9 @@ SegmentClosest ClosestPoints(const V3& a0, const V3& a1, const V3& b0, const V3&
 // (a0, a1, b0, b1).
 double SegmentDistanceSq(const V3& a0, const V3& a1, const V3& b0, const V3& b1, Vec12* g,
                          Mat12* h, SegmentClosest* closest = nullptr);
+// The same derivatives from the closest points ClosestPoints() found for these segments
+// (a narrow phase that tests the distance first differentiates only the pairs it keeps).
+void SegmentDistanceDerivatives(const V3& a0, const V3& a1, const V3& b0, const V3& b1,
+                                const SegmentClosest& c, Vec12* g, Mat12* h);
 
 }  // namespace snapthread::contact

@@ -35,10 +35,20 @@ void SelfContact::FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3X
     lo->col(i) = l.array() - half;
     hi->col(i) = h.array() + half;
   }
-  broad->Overlaps(*lo, *hi, pairs);
-  pairs->erase(std::remove_if(pairs->begin(), pairs->end(),
-                              [&](const std::pair<int, int>& p) { return !Included(p.first, p.second); }),
-               pairs->end());
+  broad->Overlaps(*lo, *hi, pairs, min_gap_);  // included pairs only: j - i >= min_gap_
+}
+
+void SelfContact::FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to, double reach) const {
+  if (to == nullptr && cache_valid_ && reach == cached_reach_ && cached_nodes_.cols() == nodes.cols() &&
+      std::equal(nodes.data(), nodes.data() + nodes.size(), cached_nodes_.data())) {
+    return;
+  }
+  FindPairs(nodes, to, reach, &broad_, &lo_, &hi_, &pairs_);
+  cache_valid_ = to == nullptr;
+  if (cache_valid_) {
+    cached_nodes_ = nodes;  // no allocation once sized
+    cached_reach_ = reach;
+  }
 }
 
 double SelfContact::Energy(const Eigen::Matrix3Xd& nodes) const {
@@ -49,6 +59,17 @@ double SelfContact::Energy(const Eigen::Matrix3Xd& nodes) const {
     e += barrier_.Value(dsq, nullptr, nullptr);
   }
   return e;
+}
+
+void SelfContact::PairsWithin(const Eigen::Matrix3Xd& nodes, double distance,
+                              std::vector<std::pair<int, int>>* out) const {
+  FindPairs(nodes, nullptr, distance);
+  out->clear();
+  const double limit = distance * distance;
+  for (const auto& [i, j] : pairs_) {
+    if (ClosestPoints(nodes.col(i), nodes.col(i + 1), nodes.col(j), nodes.col(j + 1)).distance_sq < limit)
+      out->emplace_back(i, j);
+  }
 }
 
 double SelfContact::MaxStepFraction(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const {

@@ -59,9 +59,11 @@ class SelfContact {
     Vec12 g, dg;
     Mat12 h;
     for (const auto& [i, j] : pairs_) {
-      const double dsq = SegmentDistanceSq(nodes.col(i), nodes.col(i + 1), nodes.col(j),
-                                           nodes.col(j + 1), &dg, want_h ? &h : nullptr);
+      const SegmentClosest c = ClosestPoints(nodes.col(i), nodes.col(i + 1), nodes.col(j), nodes.col(j + 1));
+      const double dsq = c.distance_sq;
       if (dsq >= barrier_.ActivationSq()) continue;
+      SegmentDistanceDerivatives(nodes.col(i), nodes.col(i + 1), nodes.col(j), nodes.col(j + 1), c, &dg,
+                                 want_h ? &h : nullptr);
       double d1 = 0.0, d2 = 0.0;
       barrier_.Value(dsq, &d1, &d2);
       if (!(dsq > barrier_.ContactSq())) {
@@ -81,6 +83,9 @@ class SelfContact {
   // every pair keeps its gap above kKeep of its starting gap.
   double MaxStepFraction(const Eigen::Matrix3Xd& from, const Eigen::Matrix3Xd& to) const;
   static constexpr double kKeep = 0.1;
+  // The included pairs whose centrelines come closer than `distance`, sorted (broad
+  // phase with that reach, then the exact distance). Uses the scratch above.
+  void PairsWithin(const Eigen::Matrix3Xd& nodes, double distance, std::vector<std::pair<int, int>>* out) const;
   // How many included pairs the last call's broad phase passed to the narrow phase (the
   // work that must stay O(n + contacts)).
   int CandidatePairs() const { return static_cast<int>(pairs_.size()); }
@@ -95,9 +100,9 @@ class SelfContact {
  private:
   // pairs_ = included pairs whose boxes (segment boxes, or swept boxes over `to` when
   // given) inflated by half of `reach` overlap.
-  void FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to, double reach) const {
-    FindPairs(nodes, to, reach, &broad_, &lo_, &hi_, &pairs_);
-  }
+  // Without `to`, the last call's pairs when the nodes and the reach are the same (the
+  // energy, gradient and Hessian of one state ask for the same pairs).
+  void FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to, double reach) const;
   void FindPairs(const Eigen::Matrix3Xd& nodes, const Eigen::Matrix3Xd* to, double reach, BroadPhase* broad,
                  Eigen::Matrix3Xd* lo, Eigen::Matrix3Xd* hi, std::vector<std::pair<int, int>>* pairs) const;
 
@@ -108,6 +113,10 @@ class SelfContact {
   mutable BroadPhase broad_;
   mutable Eigen::Matrix3Xd lo_, hi_;
   mutable std::vector<std::pair<int, int>> pairs_;
+  // The nodes and reach pairs_ was found for (no `to`); cache_valid_ false after a swept call.
+  mutable Eigen::Matrix3Xd cached_nodes_;
+  mutable double cached_reach_ = -1.0;
+  mutable bool cache_valid_ = false;
 };
 
 }  // namespace snapthread::contact

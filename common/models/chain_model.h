@@ -39,11 +39,13 @@ class ChainModel : public Model {
   }
 
   const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
+  int HessianPatternVersion() const override { return assembly_.PatternVersion(); }
 
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override {
     // StoreHessian: every chain slot is reached by a chain term first, so no clearing pass;
     // slots only a contact pair reaches are cleared when the model has contact.
-    double* values = assembly_.Values(h, chain_terms_ < assembly_.NumTerms());
+    Self().CoverContacts(x, u);
+    double* values = assembly_.Values(h, assembly_.DynamicTerms());
     for (int t = 0; t < chain_terms_; ++t) {
       Self().Local(t, x, u, /*want_h=*/true, [&](const double*, const double* lh, int ld) {
         assembly_.StoreHessian(t, lh, ld, values);
@@ -58,7 +60,8 @@ class ChainModel : public Model {
   void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override {
     if (g->size() != NumStates()) g->resize(NumStates());
     g->setZero();
-    double* values = assembly_.Values(h, chain_terms_ < assembly_.NumTerms());
+    Self().CoverContacts(x, u);
+    double* values = assembly_.Values(h, assembly_.DynamicTerms());
     for (int t = 0; t < chain_terms_; ++t) {
       Self().Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int ld) {
         assembly_.AddGradient(t, lg, g->data());
@@ -74,7 +77,8 @@ class ChainModel : public Model {
   double EnergyGradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override {
     if (g->size() != NumStates()) g->resize(NumStates());
     g->setZero();
-    double* values = assembly_.Values(h, chain_terms_ < assembly_.NumTerms());
+    Self().CoverContacts(x, u);
+    double* values = assembly_.Values(h, assembly_.DynamicTerms());
     double e = Self().EnergyShift();
     for (int t = 0; t < chain_terms_; ++t) {
       e += Self().Local(t, x, u, /*want_h=*/true, [&](const double* lg, const double* lh, int ld) {
@@ -90,7 +94,7 @@ class ChainModel : public Model {
   bool EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, double* band, int bandwidth,
                                     double* energy) const override {
     // Self-contact adds its pairs through the compressed matrix only.
-    if (chain_terms_ < assembly_.NumTerms() || bandwidth != assembly_.Bandwidth()) return false;
+    if (assembly_.DynamicTerms() || bandwidth != assembly_.Bandwidth()) return false;
     if (g->size() != NumStates()) g->resize(NumStates());
     g->setZero();
     std::fill(band, band + static_cast<std::ptrdiff_t>(NumStates()) * (bandwidth + 1), 0.0);
@@ -212,6 +216,7 @@ class ChainModel : public Model {
 
   // Self-contact hooks (thread3d defines them; a chain without contact has none).
   void RegisterContact() {}
+  void CoverContacts(const Vec&, const Vec&) const {}  // before E_xx is written (contact_terms.h)
   void AddContactGradient(const Vec&, const Vec&, Vec*) const {}
   void AddContactHessian(const Vec&, const Vec&, double*) const {}
   void AddContactControlGradient(const Vec&, const Vec&, Vec*) const {}

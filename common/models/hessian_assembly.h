@@ -12,6 +12,12 @@
 // The full symmetric pattern of E_xx is built once (Finalize), together with, for every
 // term, the index into SparseMatrix::valuePtr() of each (local i, local j) pair, so that
 // adding a term's Hessian is a table look-up without search or allocation.
+//
+// Dynamic terms (self-contact, contact_terms.h): after Finalize() a model may replace a
+// set of extra terms (SetDynamicTerms) — the segment pairs near contact — and the pattern
+// becomes the fixed terms' plus theirs. That allocates and re-indexes the fixed terms'
+// tables (O(nnz + runs)), so a model does it only when its set changes; PatternVersion()
+// counts the changes, and a solver re-analyses its factorisation when it moves.
 #pragma once
 
 #include <algorithm>
@@ -30,9 +36,9 @@ class HessianAssembly {
   // Most variables one term can touch (thread3d's bending term next to the grip touches
   // 3 + 3 + 7 = 13: two free nodes, then s, (X, Y, Z) and (dx, dy, dz)).
   static constexpr int kMaxTermVars = 16;
-  // A self-contact pair term (contact_terms.h) may touch more: the 12 coordinates of its
-  // two segments and, when one is grasped, every control (a free rod's 12). AddTerm
-  // accepts up to this many; the local buffers of the elastic terms stay kMaxTermVars.
+  // AddTerm accepts up to this many (a term over two segments' 12 coordinates and a free
+  // rod's 12 controls); the local buffers of the elastic terms stay kMaxTermVars. The
+  // self-contact pairs are dynamic terms over their state coordinates only (at most 12).
   static constexpr int kMaxPairTermVars = 24;
 
   HessianAssembly() = default;
@@ -43,6 +49,19 @@ class HessianAssembly {
   int AddTerm(const int* vars, int count);
   // Builds the pattern and the scatter tables. Call once, after the last AddTerm.
   void Finalize();
+
+  // Before Finalize(): the model will call SetDynamicTerms, so the pattern may change
+  // and Bandwidth() is not known (-1).
+  void EnableDynamicTerms() { dynamic_ = true; }
+  bool DynamicTerms() const { return dynamic_; }
+  // Replaces the dynamic terms (after Finalize(), EnableDynamicTerms() before it): term
+  // FixedTerms() + k has the variables vars[begin[k] .. begin[k + 1]) (begin[0] = 0).
+  // Only AddHessian, AddGradient, AddControlGradient, AddMixedHessian and
+  // AddControlHessian serve them (not StoreHessian nor the band). Allocates.
+  void SetDynamicTerms(const std::vector<int>& vars, const std::vector<int>& begin);
+  int FixedTerms() const { return fixed_terms_; }
+  // Bumped by every SetDynamicTerms that changes the pattern.
+  int PatternVersion() const { return version_; }
 
   int NumStates() const { return num_states_; }
   int NumControls() const { return num_controls_; }
@@ -58,15 +77,17 @@ class HessianAssembly {
   // stored, zeroed first when `clear` (slots no StoreHessian term reaches, e.g. contact).
   double* Values(SparseMatrix* h, bool clear) const {
     const Eigen::Index n = pattern_.rows();
-    if (h->rows() != n || h->cols() != n || h->nonZeros() != pattern_.nonZeros() || !h->isCompressed()) {
+    if (h->rows() != n || h->cols() != n || h->nonZeros() != pattern_.nonZeros() || !h->isCompressed() ||
+        (dynamic_ && !SameStructure(*h))) {
       *h = pattern_;
     }
     double* values = h->valuePtr();
     if (clear) std::fill(values, values + pattern_.nonZeros(), 0.0);
     return values;
   }
-  // max |i - j| over the pattern: the half-bandwidth of E_xx.
-  int Bandwidth() const { return bandwidth_; }
+  // max |i - j| over the fixed terms' pattern: the half-bandwidth of E_xx; -1 (not
+  // known) with dynamic terms, whose pairs may couple any two nodes.
+  int Bandwidth() const { return dynamic_ ? -1 : bandwidth_; }
 
   // The Add* functions accumulate (+=) one term's local derivatives. `local_h` is the
   // term's full symmetric local Hessian, column-major with leading dimension `ld`.
@@ -92,6 +113,8 @@ class HessianAssembly {
  private:
   // The band runs (AddBandHessian), after the pattern and its bandwidth.
   void FinalizeBand();
+  // h's compressed structure is the pattern's (same size and non-zero count assumed).
+  bool SameStructure(const SparseMatrix& h) const;
 
   int num_states_ = 0;
   int num_controls_ = 0;
@@ -128,6 +151,13 @@ class HessianAssembly {
   std::vector<char> touches_controls_;
   SparseMatrix pattern_;
   int bandwidth_ = 0;
+  // Dynamic terms: the fixed terms' pattern and runs (values indexing base_pattern_),
+  // re-indexed into pattern_ by each SetDynamicTerms.
+  bool dynamic_ = false;
+  int fixed_terms_ = 0;
+  int version_ = 0;
+  SparseMatrix base_pattern_;
+  std::vector<Run> base_runs_, base_store_runs_;
 };
 
 // ---------------------------------------------------------------------------------

@@ -6,9 +6,10 @@
 //  * All derivatives are analytic and are checked against finite differences in
 //    tests/model_derivative_test.cc.
 //  * The Hessian E_xx is stored as a full symmetric sparse matrix (both triangles)
-//    with a pattern fixed at construction (HessianPattern()). Hessian() overwrites the
-//    values of a matrix that already has that pattern and must not allocate then:
-//    the solvers reuse one matrix and one symbolic factorisation for every step.
+//    with a pattern fixed at construction (HessianPattern()), but for self-contact's
+//    pair blocks (HessianPatternVersion()). Hessian() overwrites the values of a matrix
+//    that already has that pattern and must not allocate then: the solvers reuse one
+//    matrix and one symbolic factorisation for every step while the pattern holds.
 //  * Output vectors/matrices passed by pointer are resized by the callee only when
 //    their size is wrong (so a caller that keeps them allocated pays nothing).
 #pragma once
@@ -52,8 +53,12 @@ class Model {
   virtual double Energy(const Vec& x, const Vec& u) const = 0;
   // E_x, size NumStates().
   virtual void Gradient(const Vec& x, const Vec& u, Vec* g) const = 0;
-  // E_xx with the fixed pattern of HessianPattern().
+  // E_xx with the pattern of HessianPattern(). A model with self-contact changes that
+  // pattern (the blocks of the segment pairs near contact, models/contact_terms.h) inside
+  // a Hessian evaluation, rarely; HessianPatternVersion() then moves, Hessian() gives
+  // *h the new structure, and a solver analyses its factorisation again. 0 for the rest.
   virtual const SparseMatrix& HessianPattern() const = 0;
+  virtual int HessianPatternVersion() const { return 0; }
   virtual void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const = 0;
   // E_x and E_xx at one state, the same values as Gradient() and Hessian(); a model may
   // fuse the two passes over its terms (the solvers call this where both are needed).
@@ -111,7 +116,8 @@ class Model {
   virtual double Probe(const Vec& x, const Vec& u) const = 0;
   // A characteristic magnitude of grasp forces in model units, for relative tolerances.
   virtual double ForceScale() const = 0;
-  // Half-bandwidth of E_xx in the variable ordering (for banded factorisations).
+  // Half-bandwidth of E_xx in the variable ordering (for banded factorisations); -1 when
+  // not known (a pattern that changes: self-contact).
   virtual int HessianBandwidth() const = 0;
 
   // Called by the tracker after it accepted the equilibrium x at controls u (after the

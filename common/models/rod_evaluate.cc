@@ -310,7 +310,9 @@ void RodModel::Gradient(const Vec& x, const Vec& u, Vec* g) const {
 
 void RodModel::Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const {
   // StoreHessian: every elastic slot is reached by an elastic term first, so no clearing
-  // pass; slots only a contact pair reaches are cleared when contact is on.
+  // pass; slots only a contact pair reaches are cleared when contact is on. The pattern
+  // first covers the pairs active here (contact_terms.h).
+  if (contact_.enabled()) contact_.CoverActive(ContactNodes(x, GraspDerivatives(u)));
   double* values = assembly_.Values(h, contact_.enabled());
   if (band_key_.Matches(x, u)) {
     // At the state of the last band (a solver that factorised it in place asks for the
@@ -342,8 +344,9 @@ void RodModel::GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatr
 double RodModel::EnergyGradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
   if (g->size() != nx_) g->resize(nx_);
   g->setZero();
-  double* values = assembly_.Values(h, contact_.enabled());
   const GraspMaps& gm = GraspDerivatives(u);
+  if (contact_.enabled()) contact_.CoverActive(ContactNodes(x, gm));
+  double* values = assembly_.Values(h, contact_.enabled());
   PrepareEdges(x, u, gm, true, false);
   double e = 0.0;
   for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {

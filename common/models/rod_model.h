@@ -69,6 +69,7 @@ class RodModel final : public Model {
   double Energy(const Vec& x, const Vec& u) const override;
   void Gradient(const Vec& x, const Vec& u, Vec* g) const override;
   const SparseMatrix& HessianPattern() const override { return assembly_.Pattern(); }
+  int HessianPatternVersion() const override { return assembly_.PatternVersion(); }
   void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const override;
   // One pass over the terms for both (the same operations as the two, the same bits).
   void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const override;

@@ -369,6 +369,9 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   void AddContactGradient(const Vec& x, const Vec& u, Vec* g) const {
     if (contact_.enabled()) contact_.AddGradient(ContactNodes(x, u), g->data());
   }
+  void CoverContacts(const Vec& x, const Vec& u) const {
+    if (contact_.enabled()) contact_.CoverActive(ContactNodes(x, u));
+  }
   void AddContactHessian(const Vec& x, const Vec& u, double* values) const {
     if (contact_.enabled()) contact_.AddHessian(ContactNodes(x, u), values);
   }

@@ -32,6 +32,7 @@ SolverBase::SolverBase(const Model& model, const SolverOptions& options)
     }
     if (w.diag_index[j] < 0) throw std::logic_error("Hessian pattern lacks a diagonal entry");
   }
+  pattern_version_ = model_.HessianPatternVersion();
   w.eig.Resize(n_);
   w.orbits = std::make_unique<SymmetryOrbits>(model_);
   for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch, &w.h_state, &w.g_band}) v->resize(n_);
@@ -199,6 +200,7 @@ double SolverBase::EvalGradientAndHessian(const Vec& x, const Vec& u, SolverSumm
     sparse_stale_ = true;
   } else {
     h_state_energy_ = model_.EnergyGradientAndHessian(x, u, &ws_.g, &ws_.h);
+    SyncPattern();
     hessian_ready_ = true;
   }
   ++s->gradient_evaluations;
@@ -245,6 +247,7 @@ LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummar
     st = ws_.factor->FactorizeAssembled();
   } else {
     if (!have_h) model_.Hessian(x, u, &ws_.h);
+    SyncPattern();
     sparse_stale_ = false;
     st = ws_.factor->Factorize(ws_.h);
   }
@@ -256,7 +259,41 @@ LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummar
 void SolverBase::EnsureSparseHessian() {
   if (!sparse_stale_) return;
   model_.Hessian(ws_.h_state, ws_.h_u, &ws_.h);
+  SyncPattern();
   sparse_stale_ = false;
+}
+
+void SolverBase::SyncPattern() {
+  // Self-contact changes E_xx's pattern now and then (model.h, models/contact_terms.h):
+  // ws_.h has just been given the new structure; the second matrix, the diagonal's
+  // positions and both symbolic analyses follow it. The factorisations are discarded.
+  const int version = model_.HessianPatternVersion();
+  if (version == pattern_version_) return;
+  Workspace& w = ws_;
+  const SparseMatrix& p = model_.HessianPattern();
+  const auto same = [](const SparseMatrix& a, const SparseMatrix& b) {
+    return a.nonZeros() == b.nonZeros() &&
+           std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1, b.outerIndexPtr()) &&
+           std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr());
+  };
+  if (!same(w.h, p)) return;  // ws_.h not evaluated since the change
+  pattern_version_ = version;
+  if (same(w.h, w.h_mod)) return;
+  w.h_mod = w.h;
+  for (int j = 0; j < n_; ++j) {
+    w.diag_index[j] = -1;
+    for (int q = w.h.outerIndexPtr()[j]; q < w.h.outerIndexPtr()[j + 1]; ++q) {
+      if (w.h.innerIndexPtr()[q] == j) w.diag_index[j] = q;
+    }
+  }
+  // A failed analysis leaves the factorisation unanalysed: Factorize() then reports it.
+  // The second factorisation (shifted or restricted matrices, rare) is analysed when it
+  // is next used (FactorModified).
+  w.factor->Analyze(w.h);
+  alt_stale_ = true;
+  factor_valid_ = false;
+  factor_before_tiny_step_ = false;
+  ++pattern_changes_;
 }
 
 double SolverBase::UpdateEigenpair(int iterations) {
@@ -273,6 +310,10 @@ SparseMatrix& SolverBase::ModifiedHessian() {
 
 LinearSolverStatus SolverBase::FactorModified(SolverSummary* s) {
   ++s->factorizations;
+  if (alt_stale_) {  // the pattern changed since its analysis (SyncPattern)
+    ws_.alt_factor->Analyze(ws_.h_mod);
+    alt_stale_ = false;
+  }
   return ws_.alt_factor->Factorize(ws_.h_mod);
 }
 

@@ -23,6 +23,8 @@ class SolverBase : public EquilibriumSolver {
   const std::string& method() const override { return options_.method; }
   void Reset() override;
   const SymmetricLinearSolver* Factorization() const override;
+  // How many times E_xx's pattern changed under this solver (self-contact; SyncPattern).
+  int PatternChanges() const { return pattern_changes_; }
   const Vec& LowestEigenvector() const override { return ws_.eig.vector(); }
 
  protected:
@@ -136,6 +138,9 @@ class SolverBase : public EquilibriumSolver {
   // energy kept as at the warm start): ws_.h_state = x, the compressed matrix stale.
   // false, nothing written, where the factorisation or the model cannot.
   bool AssembleBandAt(const Vec& x, const Vec& u);
+  // After the model wrote ws_.h: when its pattern changed (self-contact, model.h), the
+  // rest of the workspace follows it and both factorisations are analysed again.
+  void SyncPattern();
   // x is bit for bit the state of EvalGradientAtStart's E_xx (ws_.h_state).
   bool AtHessianState(const Vec& x) const;
   bool BudgetLeft(const SolverSummary& s) const;
@@ -173,6 +178,9 @@ class SolverBase : public EquilibriumSolver {
   // h_state_energy_ is E at ws_.h_state (from EvalGradientAtStart, this solve).
   bool energy_ready_ = false;
   double h_state_energy_ = 0.0;
+  int pattern_version_ = 0;  // the model's HessianPatternVersion() that ws_ follows
+  int pattern_changes_ = 0;  // re-analyses so far (SyncPattern)
+  bool alt_stale_ = false;   // alt_factor not analysed for the current pattern
   double lambda_ref_ = -1.0;     // lambda_0 at the last regular converged state
   // MinimizeFully stopped at the time budget: the snap goes on at the next update.
   bool snap_in_progress_ = false;

@@ -282,6 +282,22 @@ int SelectCheapest(const std::vector<AdviceCandidate>& candidates, double target
 Advice Advise(const Scene& scene, const AdvisorOptions& options, std::ostream* progress);
 void PrintAdvice(const Advice& advice, std::ostream& out);
 
+// ---------------------------------------------------------------- contact scaling
+
+// Issue 15 item 8, on the scaling chart: self-contact's E + E_x + E_xx (broad and narrow
+// phase) on a close helix of n segments, whose active pairs grow like n
+// (contact_scaling.cc). Evaluations per second, median over repetitions.
+struct ContactScalingRow {
+  int n = 0;
+  Spread rate_hz;
+  int active_pairs = 0;
+  int candidate_pairs = 0;  // what the broad phase handed to the narrow phase
+};
+std::vector<ContactScalingRow> RunContactScaling(const std::vector<int>& ns, int repetitions, double min_sample_s);
+void WriteContactScalingCsv(const std::vector<ContactScalingRow>& rows, std::ostream& out);
+// Over the rows with n >= min_n (small n: no pair near contact, nothing to fit).
+PowerLawFit FitContactScaling(const std::vector<ContactScalingRow>& rows, int min_n = 100);
+
 // ---------------------------------------------------------------- machine / charts
 
 // "nproc N, CPU <model>, <UTC date>".
@@ -291,7 +307,10 @@ bool RunGnuplot(const std::string& script_path);
 // gnuplot scripts (pngcairo, noenhanced) for the charts; they read the CSVs written
 // next to them.
 std::string ParetoGnuplot(const std::vector<AccuracyRow>& rows, const std::string& csv_dir, const std::string& png);
+// With contact rows, each panel also draws self-contact's evaluation rate (its CSV,
+// contact_scaling.csv, written next to the others).
 std::string ScalingGnuplot(const std::vector<ScalingRow>& rows, const std::vector<ScalingFit>& fits,
-                           const std::string& csv_dir, const std::string& png, bool fixed_length = false);
+                           const std::string& csv_dir, const std::string& png, bool fixed_length = false,
+                           const std::vector<ContactScalingRow>& contact = {});
 
 }  // namespace snapthread

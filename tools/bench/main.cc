@@ -211,11 +211,22 @@ int main(int argc, char** argv) {
             << (fixed_length ? "fixed total length" : "n segments of length L") << ")\n";
       PrintScalingTable(rows, fits, table);
       PrintScalingTargets(rows, fits, table);
+      // Issue 15 item 8: self-contact's cost against n, on the same chart.
+      const auto contact = RunContactScaling(o.ns, o.repetitions, o.min_sample_s);
+      table << "== scaling: self-contact E + E_x + E_xx on a close helix (evaluations/s, median of "
+            << o.repetitions << ")\n";
+      for (const auto& r : contact) {
+        table << "  n = " << r.n << ": " << r.rate_hz.median << " /s (" << r.active_pairs << " active of "
+              << r.candidate_pairs << " candidate pairs)\n";
+      }
+      table << "  slope of the rate against n, n >= 100: " << FitContactScaling(contact).slope
+            << " (-1: cost linear in n); n >= 20: " << FitContactScaling(contact, 20).slope << "\n";
       std::cout << table.str();
       summary << table.str() << '\n';
       if (!no_plot) {
         const std::string script = (fs::path(out_dir) / "bench_scaling.gp").string();
-        std::ofstream(script) << ScalingGnuplot(rows, fits, out_abs, out_abs + "/bench_scaling.png", fixed_length);
+        std::ofstream(script) << ScalingGnuplot(rows, fits, out_abs, out_abs + "/bench_scaling.png", fixed_length,
+                                                  contact);
         plots_ok = RunGnuplot(script) && plots_ok;
       }
     }

@@ -296,7 +296,15 @@ void PrintScalingTargets(const std::vector<ScalingRow>& rows, const std::vector<
 }
 
 std::string ScalingGnuplot(const std::vector<ScalingRow>& rows, const std::vector<ScalingFit>& fits,
-                           const std::string& dir, const std::string& png, bool fixed_length) {
+                           const std::string& dir, const std::string& png, bool fixed_length,
+                           const std::vector<ContactScalingRow>& contact) {
+  char contact_slope[64] = "";
+  if (!contact.empty()) {
+    std::ofstream out(dir + "/contact_scaling.csv");
+    out << std::setprecision(6);
+    WriteContactScalingCsv(contact, out);
+    std::snprintf(contact_slope, sizeof contact_slope, "%.2f", FitContactScaling(contact).slope);
+  }
   std::vector<std::string> methods;
   for (const auto& r : rows)
     if (std::find(methods.begin(), methods.end(), r.method) == methods.end()) methods.push_back(r.method);
@@ -339,6 +347,11 @@ std::string ScalingGnuplot(const std::vector<ScalingRow>& rows, const std::vecto
             anchor_n = r.n;
             anchor_rate = r.rate_hz.median;
           }
+    }
+    if (!contact.empty()) {
+      gp << (first ? "" : ", ") << "'" << dir << "/contact_scaling.csv' every ::1 using 1:2:3:4 with yerrorlines "
+         << "pt 5 ps 0.6 lc rgb '#000000' title 'contact E,E_x,E_xx /s (slope " << contact_slope << ", n>=100)'";
+      first = false;
     }
     if (anchor_n > 0) {
       // The seed's measured cost, n^-1.9, through the first auto point.
