@@ -174,6 +174,20 @@ TEST(SceneGrasps, RefusesGraspsThatDoNotMatchTheModel) {
   ExpectSceneError(head + "grasps: [{name: a, node: 0, start: [0, 0, 0]}, {name: b, edge: 11, start: [1, 0, 0]}]\n",
                    "expected the edge 0");
   ExpectSceneError("model: rod\nparams: {n: 4, clamp: false}\n", "params.n");
+  ExpectSceneError(head + "grasps: [{name: a, edge: -13, start: [0, 0, 0]}, {name: b, edge: -1, start: [1, 0, 0]}]\n",
+                   "grasps[0].edge: -13 counts from the end past the first of 12 edges");
+}
+
+// edge: -1 is the last edge, whatever params.n is: the knot scene runs at another n with
+// `--set params.n=...` alone.
+TEST(SceneGrasps, NegativeEdgeCountsFromTheEnd) {
+  const std::string two = "model: rod\nparams: {n: 12, clamp: false}\n"
+                          "grasps: [{name: a, edge: 0, start: [0, 0, 0]}, {name: b, edge: -1, start: [1, 0, 0]}]\n";
+  EXPECT_EQ(ParseScene(two, "two.yaml").grasps[1].holds, "edge 11");
+  const Scene knot = testing::SceneFile("knot_overhand.yaml", {{"params.n", "100"}});
+  ASSERT_EQ(knot.grasps.size(), 2u);
+  EXPECT_EQ(knot.grasps[1].holds, "edge 99");
+  EXPECT_EQ(testing::SceneFile("knot_overhand.yaml").grasps[1].holds, "edge 59");
 }
 
 // No clamp, no gravity: the rod is in equilibrium under the two hands alone, so their

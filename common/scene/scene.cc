@@ -264,7 +264,16 @@ void ReadGrasps(const YAML::Node& list, const ModelRegistration& model, const Re
     if (g["edge"] && g["node"]) rd.Fail(key, "give edge or node, not both");
     if (!g["edge"] && !g["node"]) rd.Fail(key + ".edge", "missing (expected the edge or node the grasp holds)");
     const char* kind = g["edge"] ? "edge" : "node";
-    const int index = rd.Get<int>(g[kind], key + "." + kind, "an integer");
+    int index = rd.Get<int>(g[kind], key + "." + kind, "an integer");
+    // A negative index counts from the end (-1: the last edge or node of a model with
+    // params.n edges), so a scene's grasps follow `--set params.n=...`.
+    if (index < 0 && sc->params.Has("n")) {
+      const int count = sc->params.Integer("n") + (std::string(kind) == "node" ? 1 : 0);
+      if (index < -count)
+        rd.Fail(key + "." + kind, std::to_string(index) + " counts from the end past the first of " +
+                                      std::to_string(count) + " " + kind + "s");
+      index += count;
+    }
     sg.holds = std::string(kind) + " " + std::to_string(index);
     const std::string expected = sites.empty() ? sg.holds : sites[i];
     if (sg.holds != expected)
