@@ -29,7 +29,7 @@ if [ "${1:-}" != "--quick" ]; then
   # subscriptions trip a GCC 12 UBSan false report (see that header).
   # SNAPTHREAD_SPEED_SCALE=16: the rod's sweep takes 14x the CPU time in this build, so
   # thresholds that are about speed (a time budget, start-up-and-refusal time, models per
-  # servo tick, shapes per second) are divided by it (tests/support/environment.h); no
+  # servo tick, shapes and frames per second) are divided by it (tests/support/environment.h); no
   # safety property is.
   export SNAPTHREAD_SPEED_SCALE=16 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \

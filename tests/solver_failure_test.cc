@@ -28,6 +28,11 @@ TEST(SolverFailure, NoShippedSceneAlongItsPath) {
     if (scene.path.size() < 2) continue;
     ++scenes;
     for (const std::string& method : SolverRegistry::Global().Names()) {
+      // Plain Newton on the knot path is not held to anything (below) and is not run: it
+      // diverges from the first row, and the diverged tangle's pairs near contact change at
+      // every iteration, so each one re-analyses the pattern (measured: 14.6 s of this
+      // test's 19.6 s in Release, over its 300 s limit under the sanitizers).
+      if (entry.path().filename() == "knot_overhand.yaml" && method == "newton") continue;
       Scene sc = scene;
       sc.solver.method = method;
       const int failed = FailedRows(sc, PathControls(sc, 200));
@@ -47,12 +52,11 @@ TEST(SolverFailure, NoShippedSceneAlongItsPath) {
       }
       if (entry.path().filename() == "knot_overhand.yaml") {
         // The free rod's knot path, contact on (issue 15): newton-ls and higher-order fail
-        // no row here (200 steps a leg). Plain Newton is not held to it: with no line
-        // search it diverges from the first row (measured: the mean edge at 2.2 times its
-        // rest length at row 0, 1126 of 1601 rows with the linear solver failing).
-        if (method != "newton") {
-          EXPECT_EQ(failed, 0) << "knot_overhand.yaml, " << method;
-        }
+        // no row here (200 steps a leg). Plain Newton is not held to it (not run, above):
+        // with no line search it diverges from the first row (measured: the mean edge at
+        // 2.2 times its rest length at row 0, 1126 of 1601 rows with the linear solver
+        // failing).
+        EXPECT_EQ(failed, 0) << "knot_overhand.yaml, " << method;
         continue;
       }
       EXPECT_EQ(failed, 0) << entry.path().filename() << ", " << method;

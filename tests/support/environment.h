@@ -24,7 +24,7 @@ std::string UniqueSession(const std::string& prefix);
 // build this build runs; deploy/test.sh sets it for the sanitizer run (16: the rod's
 // sweep takes 14x the CPU time under ASan + UBSan). Only thresholds that are about speed
 // are scaled by it (a time budget, a start-up-and-refusal time, models per servo tick,
-// shapes per second), never a safety property (|F| limits, finiteness, ordering,
+// shapes and frames per second), never a safety property (|F| limits, finiteness, ordering,
 // rejection counts, the servo's own tick rate).
 double SpeedScale();
 

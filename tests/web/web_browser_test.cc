@@ -134,7 +134,9 @@ class WebBrowserTest : public ::testing::Test {
       // Shapes reach the page at the sanitized server's and bridge's speed in that build.
       EXPECT_GE(Field(live, "shapes_per_s", at), 30.0 / test_support::SpeedScale());
       EXPECT_LE(Field(live, "shapes_per_server_s", at), 61.0) << "a page gets at most 60 shapes/s";
-      EXPECT_GE(Field(live, "frames_per_s", at), 10.0);
+      // The page draws a frame only for a new shape, so its frame rate follows the shapes'
+      // (and the browser's share of a loaded machine): a speed threshold, like theirs.
+      EXPECT_GE(Field(live, "frames_per_s", at), 10.0 / test_support::SpeedScale());
       EXPECT_NE(live.find("\"webgl\":\"WebGL 2.0", at), std::string::npos) << "no WebGL 2 context";
       ExpectTubeOnScreenshot(dir_.path() + "/page" + std::to_string(page) + ".png",
                              static_cast<int>(Field(live, "status", at)));
