@@ -443,5 +443,42 @@ TEST(ReportInjectionCliTest, AHostileLogFileNameReachesNoScript) {
   }
 }
 
+// The viewer's live rates print channel names from the network: escaped, one printable
+// line each, so a name cannot forge lines or send terminal escape sequences.
+TEST(ReportInjectionViewerTest, PrintRatesShowsHostileChannelNamesEscaped) {
+  ScopedTempDir root("attack-viewer-rates");
+  const std::string dir = root.path();
+  SessionKeyFile key;  // the viewer checks shapes and statuses with it
+  const std::string url = PrivateUrl();
+  lcm::LCM lcm(url);
+  ASSERT_TRUE(lcm.good());
+  std::vector<std::string> hostile;
+  for (const Hostile& h : HostileChannels()) {
+    if (h.over_network) hostile.push_back(h.channel);
+  }
+  hostile.push_back("LAB1_\x1b]0;owned\x07\x1b[2J_SHAPE");  // retitles and clears a terminal
+  ChildProcess viewer({BinDir() + "/snapthread-viewer", "--print-rates", "--session", "LAB1",
+                       "--lcm-url", url, "--duration-s", "3"},
+                      OutputFiles(dir + "/viewer.out", dir + "/viewer.err"));
+  ASSERT_TRUE(viewer.WaitForOutput("channel rates", 20.0)) << viewer.Err();
+  const std::vector<uint8_t> forged = Encode(Model(7));
+  const auto t0 = std::chrono::steady_clock::now();
+  while (viewer.running() && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
+    for (const std::string& channel : hostile) lcm.publish(channel, forged.data(), int(forged.size()));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const ProcessResult r = viewer.Finish(20.0);
+  ASSERT_TRUE(r.exited);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(PrintableLines(r.out)) << r.out;
+  for (const std::string& channel : hostile) {
+    SCOPED_TRACE(transport::EscapeForDisplay(channel));
+    EXPECT_NE(r.out.find("TOTAL " + transport::EscapeForDisplay(channel) + " "), std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find(channel), std::string::npos) << "raw name printed";
+  }
+  EXPECT_TRUE(Markers(dir).empty());
+}
+
 }  // namespace
 }  // namespace snapthread::attack_test
