@@ -480,5 +480,32 @@ TEST(ReportInjectionViewerTest, PrintRatesShowsHostileChannelNamesEscaped) {
   EXPECT_TRUE(Markers(dir).empty());
 }
 
+// The grammar and the escaping the report and the viewer rely on (common/messages/channels.h).
+TEST(ChannelGrammarTest, AcceptsTheProjectsNamesAndRefusesEverythingElse) {
+  for (const std::string& ok : std::vector<std::string>{"LAB1_FORCE_MODEL", "SNAPTHREAD_DEVICE_STATUS", "LCM_SELF_TEST",
+                               "a.b:c/d-e", std::string(63, 'S')}) {
+    EXPECT_TRUE(transport::IsValidChannelName(ok)) << ok;
+    EXPECT_EQ(transport::EscapeForDisplay(ok), ok);
+  }
+  for (const Hostile& h : HostileChannels()) EXPECT_FALSE(transport::IsValidChannelName(h.channel));
+  for (const std::string& bad : std::vector<std::string>{"", std::string(64, 'S'), "A B", "A\tB", "\xc3\xa4", "A\\B"}) {
+    EXPECT_FALSE(transport::IsValidChannelName(bad)) << transport::EscapeForDisplay(bad);
+  }
+}
+
+TEST(ChannelGrammarTest, EscapingIsPrintableOneLineAndKeepsBytesApart) {
+  std::set<std::string> seen;
+  for (int b = 0; b < 256; ++b) {
+    const std::string one(1, char(b));
+    const std::string shown = transport::EscapeForDisplay("x" + one + "y");
+    EXPECT_TRUE(PrintableLines(shown) && shown.find('\n') == std::string::npos) << b;
+    for (char c : std::string("'\"`$;|# ,")) EXPECT_EQ(shown.find(c), std::string::npos) << b;
+    EXPECT_TRUE(seen.insert(shown).second) << "two bytes escape alike: " << shown;
+  }
+  EXPECT_EQ(transport::EscapeForDisplay("\\x41"), "\\x5cx41");  // a backslash is escaped too
+  const std::string shown = transport::EscapeForDisplay(std::string(900, 'B'));
+  EXPECT_EQ(shown, std::string(128, 'B') + "...[900 bytes]");
+}
+
 }  // namespace
 }  // namespace snapthread::attack_test
