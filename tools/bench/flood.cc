@@ -193,12 +193,14 @@ std::vector<FloodRun> RunFloodBench(const FloodBenchOptions& o, std::ostream* pr
 }
 
 void WriteFloodCsv(const std::vector<FloodRun>& runs, std::ostream& out) {
-  out << "repetition,flood,ok,flood_rate_per_channel_hz,window_tick_rate_hz,tick_rate_hz,model_age_ms_p50,model_age_ms_p99,"
+  out << "repetition,flood,ok,flood_rate_per_channel_hz,window_tick_rate_hz,tick_rate_hz,model_age_ms_p50,"
+         "model_age_ms_p99,"
          "model_age_ms_max,fading_fraction,server_update_rate_hz,server_updates,models_received,models_rejected,"
          "server_rejected,max_force_n,max_abs_fz_n,realtime,error\n";
   for (const auto& r : runs)
     out << r.repetition << ',' << (r.flood ? 1 : 0) << ',' << (r.ok ? 1 : 0) << ',' << r.flood_rate_per_channel_hz
-        << ',' << r.window_tick_rate_hz << ',' << r.tick_rate_hz << ',' << r.model_age_ms_p50 << ',' << r.model_age_ms_p99 << ','
+        << ',' << r.window_tick_rate_hz << ',' << r.tick_rate_hz << ',' << r.model_age_ms_p50 << ','
+        << r.model_age_ms_p99 << ','
         << r.model_age_ms_max << ',' << r.fading_fraction << ',' << r.server_update_rate_hz << ','
         << r.server_updates << ',' << r.models_received << ',' << r.models_rejected << ',' << r.server_rejected
         << ',' << r.max_force_n << ',' << r.max_abs_fz_n << ',' << (r.realtime ? 1 : 0) << ",\"" << r.error
@@ -252,8 +254,8 @@ void PrintFloodSummary(const std::vector<FloodRun>& runs, std::ostream& out) {
   char buf[512];
   auto row = [&](const char* name, const Medians& m) {
     std::snprintf(buf, sizeof buf,
-                  "%-14s %2d/%-2d %8.0f %12.1f [%.1f..%.1f] %8.2f %8.2f [%.2f..%.2f] %10.0f [%.0f..%.0f] %10.0f %10.0f %9.4f "
-                  "%8.3f\n",
+                  "%-14s %2d/%-2d %8.0f %12.1f [%.1f..%.1f] %8.2f %8.2f [%.2f..%.2f] "
+                  "%10.0f [%.0f..%.0f] %10.0f %10.0f %9.4f %8.3f\n",
                   name, m.ok, m.total, m.flood_rate.median, m.tick.median, m.tick.min, m.tick.max, m.age50.median,
                   m.age99.median, m.age99.min, m.age99.max, m.server.median, m.server.min, m.server.max,
                   m.rejected.median, m.server_rejected.median, m.fading.median, m.fz.median);
