@@ -22,6 +22,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <regex>
@@ -174,7 +175,8 @@ TEST(LcmFragmentsTest, EveryReceivingBinarySurvivesAndCountsMalformedDatagrams) 
   ASSERT_TRUE(attack.Wait(30.0, &code));
   ASSERT_EQ(code, 0) << attack.Out();
   const int64_t attack_end_us = WallMicros();
-  ASSERT_TRUE(std::regex_search(attack.Out(), m, std::regex(R"(sent (\d+) malformed)"))) << attack.Out();
+  const std::string attack_out = attack.Out();
+  ASSERT_TRUE(std::regex_search(attack_out, m, std::regex(R"(sent (\d+) malformed)"))) << attack_out;
   const long sent = std::stol(m[1]);
   ASSERT_GT(sent, 100);
 
@@ -233,9 +235,16 @@ TEST(LcmFragmentsTest, EveryReceivingBinarySurvivesAndCountsMalformedDatagrams) 
       {"snapthread-web", ReadFile(dir + "/web.txt")},
       {"snapthread-logger", ReadFile(dir + "/logger.txt")}};
   for (const auto& [name, text] : outputs) {
-    EXPECT_GE(DroppedSinceStart(text), sent) << name << " did not count the " << sent
-                                             << " malformed datagrams:\n" << text;
+    const long counted = DroppedSinceStart(text);
+    std::printf("%s: counted %ld of the %ld malformed datagrams\n", name, counted, sent);
+    EXPECT_GE(counted, sent) << name << " did not count the " << sent << " malformed datagrams:\n"
+                             << text;
   }
+  std::printf("recorded after the attack: %ld force models, %ld poses, %ld shapes, %ld statuses; "
+              "device models_received %lld before, %lld after\n",
+              after(channels.force_model), after(channels.device_state), after(channels.shape),
+              after(channels.solver_status), static_cast<long long>(rec.models_before),
+              static_cast<long long>(rec.models_after));
 }
 
 }  // namespace
