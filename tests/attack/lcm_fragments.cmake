@@ -17,3 +17,10 @@ add_dependencies(lcm_fragments_test snapthread-fragment-sender snapthread-server
 add_test(NAME lcm_fragments_test COMMAND lcm_fragments_test)
 set_tests_properties(lcm_fragments_test PROPERTIES LABELS "attack;viewer" TIMEOUT 300 RUN_SERIAL TRUE
   ENVIRONMENT "SNAPTHREAD_SOURCE_DIR=${PROJECT_SOURCE_DIR};SNAPTHREAD_BIN_DIR=${PROJECT_BINARY_DIR}/bin")
+
+# The handler list of the patched liblcm: unsubscribing during a dispatch, in-process over
+# memq:// (lcm-proj/lcm#619; deploy/lcm/0002-handler-list-race.patch).
+snapthread_add_test(lcm_handler_list_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/lcm_handler_list_test.cc
+  LIBS PkgConfig::LCM
+  LABELS service)
