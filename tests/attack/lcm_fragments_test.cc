@@ -133,11 +133,11 @@ TEST(LcmFragmentsTest, EveryReceivingBinarySurvivesAndCountsMalformedDatagrams) 
   ChildProcess logger({bin + "/snapthread-logger", "-c", session + "_.*", "--lcm-url", kAttackUrl, log},
                       OneLog(dir + "/logger.txt", true));
   ChildProcess server({bin + "/snapthread-server", "--scene", scene, "--session", session, "--lcm-url",
-                       kAttackUrl, "--duration", "30", "--summary", dir + "/server.json", "--log-level",
+                       kAttackUrl, "--duration", "120", "--summary", dir + "/server.json", "--log-level",
                        "warn"},
                       OneLog(dir + "/server.txt", true));
   ChildProcess web({bin + "/snapthread-web", "--port", "0", "--session", session, "--lcm-url", kAttackUrl,
-                    "--duration-s", "30"},
+                    "--duration-s", "120"},
                    OneLog(dir + "/web.txt", true));
   ASSERT_TRUE(logger.started() && server.started() && web.started());
   ASSERT_TRUE(web.WaitForOutput(" at http://", 30)) << web.Out();
