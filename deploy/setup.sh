@@ -19,6 +19,8 @@ packages=(
   # Chromium and Firefox ESR for its browser tests (driven by playwright-core and
   # puppeteer-core from the page's npm install; Firefox's WebGL runs on the tests' Xvfb).
   libboost-dev chromium firefox-esr
+  # liblcm is built from Debian's LCM source with the project's patch (deploy/lcm/).
+  autoconf automake libtool autopoint dpkg-dev
 )
 
 missing=()
@@ -36,6 +38,9 @@ else
 fi
 
 "$here/deploy/multicast-route.sh" || true
+
+# LCM's source (Debian's orig tarball, SHA-256 checked) for the patched liblcm the build makes.
+"$here/deploy/lcm/fetch.sh"
 
 # snapthread-web's page is bundled at build time: the build runs `npm ci` from
 # web/page/package-lock.json (three.js, uPlot, esbuild, playwright-core for Chromium, puppeteer-core

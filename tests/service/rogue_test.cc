@@ -160,10 +160,10 @@ TEST(RogueTest, NoKeyNoForceNoCommandsAndTheGenuineSessionStillWorks) {
   {
     Watcher recorded(session, &key_file.key());
     ASSERT_TRUE(recorded.good());
-    ChildProcess logger({"lcm-logger", "-q", "-c", session + "_.*", std::string("--lcm-url=") + kUrl,
-                         "-f", log},
+    ChildProcess logger({SNAPTHREAD_LCM_LOGGER, "-q", "-c", session + "_.*",
+                         std::string("--lcm-url=") + kUrl, "-f", log},
                         OneLog(dir + "/logger.txt"));
-    ASSERT_TRUE(logger.started()) << "lcm-logger (liblcm-bin) missing";
+    ASSERT_TRUE(logger.started()) << SNAPTHREAD_LCM_LOGGER << " missing";
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     ChildProcess server(server_argv("10", dir + "/server0.json"), OneLog(dir + "/server0.txt"));
     ASSERT_TRUE(server.started());
