@@ -16,6 +16,15 @@ quick=0
 jobs=$(nproc)
 # The fuzz smoke's targets; one the tree does not define is skipped by name, and said so.
 FUZZERS=(scene_fuzzer message_fuzzer lcm_fuzzer auth_gate_fuzzer)
+# Generator: Ninja where installed, for a build directory configured here first (one that
+# exists keeps its own): it starts a target's compiles as soon as the headers they need
+# are generated, where make waits for every library the target links, so both cores stay
+# busy.
+Generator() {
+  if [ ! -f "$1/CMakeCache.txt" ] && command -v ninja >/dev/null; then
+    echo "-GNinja"
+  fi
+}
 
 # Stage timing: Stage NAME starts a stage (ending the one before); the EXIT trap prints
 # every stage's wall time, marking the one a failure stopped.
@@ -58,7 +67,7 @@ Stage "setup (packages)"
 
 # The same configure and build as deploy/setup.sh's.
 Stage "Release build"
-cmake -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release
+cmake $(Generator "$here/build") -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release
 cmake --build "$here/build" -j"$jobs"
 
 Stage "Release tests"
@@ -76,7 +85,7 @@ Stage "ASan+UBSan build"
 # in libstdc++ under the sanitizers. -O1 -g1 (SNAPTHREAD_SANITIZE's default flags): the
 # reports keep function, file and line; SNAPTHREAD_BUILD_EXTRAS=OFF leaves out the
 # programs and files no test runs (CMakeLists.txt lists them).
-cmake -S "$here" -B "$here/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSNAPTHREAD_SANITIZE=ON \
+cmake $(Generator "$here/build-asan") -S "$here" -B "$here/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSNAPTHREAD_SANITIZE=ON \
   -DSNAPTHREAD_WERROR=OFF -DSNAPTHREAD_BUILD_EXTRAS=OFF >/dev/null
 cmake --build "$here/build-asan" -j"$jobs"
 
@@ -106,14 +115,18 @@ ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
 
 Stage "fuzz build"
 echo "test: libFuzzer smoke runs (clang) in build-fuzz/"
-cmake -S "$here" -B "$here/build-fuzz" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+cmake $(Generator "$here/build-fuzz") -S "$here" -B "$here/build-fuzz" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSNAPTHREAD_FUZZ=ON -DSNAPTHREAD_WERROR=OFF \
   -DSNAPTHREAD_BUILD_TESTS=OFF -DSNAPTHREAD_BUILD_WEB=OFF >/dev/null
 # The build's own list of targets decides which fuzzers exist.
-cmake --build "$here/build-fuzz" --target help >"$scratch/targets"
+if [ -f "$here/build-fuzz/build.ninja" ]; then
+  ninja -C "$here/build-fuzz" -t targets all | sed 's/:.*//' >"$scratch/targets"
+else
+  cmake --build "$here/build-fuzz" --target help | sed -n 's/^\.\.\. \([^ ]*\).*/\1/p' >"$scratch/targets"
+fi
 present=()
 for f in "${FUZZERS[@]}"; do
-  if grep -qE "^\.\.\. $f( |$)" "$scratch/targets"; then
+  if grep -qx "$f" "$scratch/targets"; then
     present+=("$f")
   else
     echo "test: fuzz: SKIPPED $f (no such target in this tree)"
