@@ -7,6 +7,8 @@
 
 #include <dhdc.h>
 
+#include "stale_command.h"
+
 namespace snapthread::device {
 
 DeltaDevice::DeltaDevice() { caps_.model_name = "delta"; }
@@ -33,6 +35,15 @@ bool DeltaDevice::Open(std::string* error) {
   caps_.has_orientation = dhdHasWrist(id_);
   caps_.has_torque_output = dhdHasActiveWrist(id_);
   caps_.max_torque_nm = caps_.has_torque_output ? 0.1 : 0.0;
+  // The controller's watchdog: forces off when no command came for 5 ms (40 x 125 us).
+  constexpr int64_t kWatchdogUnitUs = 125;
+  const auto watchdog =
+      static_cast<unsigned char>(StaleCommand::kDefaultLimitUs / kWatchdogUnitUs);
+  if (dhdSetWatchdog(watchdog, id_) < 0) {
+    if (error) *error = std::string("dhdSetWatchdog: ") + dhdErrorGetLastStr();
+    Close();
+    return false;
+  }
   if (dhdEnableForce(DHD_ON, id_) < 0) {
     if (error) *error = std::string("dhdEnableForce: ") + dhdErrorGetLastStr();
     Close();

@@ -4,6 +4,9 @@
 // transactions (~0.1-0.2 ms), made directly from the servo thread. Devices with a wrist
 // report their orientation (dhdGetOrientationFrame); those with an active wrist (sigma.7,
 // delta.6) render the grip torque too (dhdSetForceAndTorque). Also untested.
+// Watchdog: Open arms the controller's own (dhdSetWatchdog, in units of 125 us) at
+// StaleCommand::kDefaultLimitUs, so the controller drops the force if the servo thread
+// stops commanding (stalled, or the process stopped). Also untested: no SDK here.
 #pragma once
 
 #include "haptic_device.h"

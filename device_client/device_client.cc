@@ -264,6 +264,8 @@ DeviceClientSummary DeviceClient::Summary(int64_t now_us) const {
   s.fade_ticks = sc.fade_ticks.load();
   s.snaps_felt = receiver_.snaps_felt();
   s.snap_ahead_switches = snap_ahead_.switches();
+  s.statuses_accepted = receiver_.statuses_accepted();
+  s.statuses_rejected = receiver_.statuses_rejected();
   s.nonfinite_outputs = sc.nonfinite_outputs.load();
   s.torque_clamps = sc.torque_clamps.load();
   s.torque_slew_limits = sc.torque_slew_limits.load();

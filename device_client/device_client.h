@@ -72,6 +72,11 @@ struct DeviceClientSummary {
   uint64_t torque_clamps = 0, torque_slew_limits = 0;  // torque-output devices only
   uint64_t wrench_models = 0;  // accepted 6-DoF models (has_wrench)
   uint64_t snap_ahead_switches = 0;
+  // Solver statuses authenticated / refused (the device learns the epoch from them); the
+  // transport's unchecked ones replaced before they were checked and those dropped for
+  // their size (set by the caller that owns the transport: snapthread-device).
+  uint64_t statuses_accepted = 0, statuses_rejected = 0;
+  uint64_t statuses_superseded = 0, statuses_oversized = 0;
   uint64_t read_failures = 0, pose_ring_drops = 0, trace_ring_drops = 0;
   uint64_t invalid_poses_unpublished = 0, publish_failures = 0, poses_published = 0;
   double max_force_n = 0.0;

@@ -25,6 +25,8 @@
 #include "safety.h"
 #include "scene/scene.h"
 #include "scripted_path.h"
+#include "sim_path_device.h"
+#include "virtual_hand_device.h"
 
 namespace snapthread::device {
 namespace {
@@ -76,7 +78,9 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
       "  \"max_force_n\": %.6f,\n  \"final_force_n\": %.6f,\n  \"nonfinite_outputs\": %llu,\n  \"overruns\": %llu,\n"
       "  \"read_failures\": %llu,\n  \"pose_ring_drops\": %llu,\n  \"trace_ring_drops\": %llu,\n"
       "  \"invalid_poses_unpublished\": %llu,\n  \"torque_clamps\": %llu,\n"
-      "  \"torque_slew_limits\": %llu,\n  \"wrench_models\": %llu,\n  \"realtime\": %s\n}\n",
+      "  \"torque_slew_limits\": %llu,\n  \"wrench_models\": %llu,\n"
+      "  \"statuses_accepted\": %llu,\n  \"statuses_rejected\": %llu,\n"
+      "  \"statuses_superseded\": %llu,\n  \"statuses_oversized\": %llu,\n  \"realtime\": %s\n}\n",
       o.backend.c_str(), o.session.c_str(), s.duration_s, u(s.ticks), s.tick_rate_hz,
       s.lateness_us.p50, s.lateness_us.p99, s.lateness_us_max, s.round_trip_us.p50,
       s.round_trip_us.p99, u(s.models_received), u(s.models_rejected), u(s.invalid_models),
@@ -84,7 +88,8 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
       u(s.fade_ticks), u(s.snaps_felt), u(s.snap_ahead_switches), s.max_force_n, s.final_force_n, u(s.nonfinite_outputs), u(s.overruns),
       u(s.read_failures), u(s.pose_ring_drops), u(s.trace_ring_drops),
       u(s.invalid_poses_unpublished), u(s.torque_clamps), u(s.torque_slew_limits), u(s.wrench_models),
-      s.realtime ? "true" : "false");
+      u(s.statuses_accepted), u(s.statuses_rejected), u(s.statuses_superseded),
+      u(s.statuses_oversized), s.realtime ? "true" : "false");
   std::fclose(f);
   return true;
 }
@@ -152,6 +157,9 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
   app.add_option("--key", o->key_path,
                  "session key file (default: $SNAPTHREAD_KEY_FILE, else "
                  "$XDG_CONFIG_HOME/snapthread/session.key)");
+  app.add_option("--sim-render-file", o->sim_render_file,
+                 "sim-path / virtual-hand: run the device's own render thread and publish what "
+                 "it renders (zero once the servo's command is 5 ms old) in this file");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -270,6 +278,21 @@ int RunDeviceClient(const DeviceClientOptions& o) {
                  error.c_str());
     return kExitRuntimeFailure;
   }
+  if (!o.sim_render_file.empty()) {
+    bool started = false;
+    if (auto* sim = dynamic_cast<SimPathDevice*>(device.get())) {
+      started = sim->StartRenderer(o.sim_render_file, &error);
+    } else if (auto* hand = dynamic_cast<VirtualHandDevice*>(device.get())) {
+      started = hand->StartRenderer(o.sim_render_file, &error);
+    } else {
+      error = "only the simulated backends (sim-path, virtual-hand) have a render thread";
+    }
+    if (!started) {
+      std::fprintf(stderr, "snapthread-device: --sim-render-file: %s\n", error.c_str());
+      device->Close();
+      return kExitBadArguments;
+    }
+  }
   const DeviceCapabilities caps = device->capabilities();
   DeviceClientConfig cc;
   const DeviceMapping mapping = scene ? GraspDeviceMapping(*scene, grasp) : DeviceMapping{};
@@ -345,7 +368,9 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   device->Close();
 
   // ---- summary ---------------------------------------------------------------------------
-  const DeviceClientSummary summary = client->Summary(transport::MonotonicMicros());
+  DeviceClientSummary summary = client->Summary(transport::MonotonicMicros());
+  summary.statuses_superseded = lcm.statuses_superseded();
+  summary.statuses_oversized = lcm.statuses_oversized();
   LogSummary(summary);
   if (!o.summary_file.empty() && !WriteSummaryJson(o.summary_file, o, summary)) {
     std::fprintf(stderr, "snapthread-device: --summary: cannot write %s\n", o.summary_file.c_str());

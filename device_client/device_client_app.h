@@ -32,6 +32,9 @@ struct DeviceClientOptions {
   int trace_divisor = 1;
   std::string summary_file;              // JSON at exit, empty = none
   std::string key_path;                  // --key; "" = $SNAPTHREAD_KEY_FILE or the XDG default
+  // --sim-render-file: a simulated backend runs its render thread ("firmware",
+  // sim_renderer.h) and publishes what it renders in this memory-mapped file.
+  std::string sim_render_file;
 };
 
 // Exit codes of snapthread-device.

@@ -1,11 +1,13 @@
 #include "lcm_transport.h"
 
+#include <cstring>
+
 #include "messages/subscribe.h"
 
 namespace snapthread::device {
 
 LcmDeviceTransport::LcmDeviceTransport(const std::string& url, const std::string& session)
-    : lcm_(url), channels_(session) {
+    : lcm_(url), channels_(session), status_slot_(kMaxStatusBytes) {
   if (lcm_.good()) {
     subscription_ =
         messages::Subscribe<&LcmDeviceTransport::Handle>(lcm_, channels_.force_model, this);
@@ -21,27 +23,25 @@ LcmDeviceTransport::~LcmDeviceTransport() {
 
 void LcmDeviceTransport::HandleStatus(const lcm::ReceiveBuffer* rbuf,
                                       const std::string& /*channel*/) {
-  if (rbuf == nullptr || rbuf->data_size > (1u << 20)) return;  // a status is < 1 kB
-  try {
-    if (statuses_.size() >= kMaxPendingStatuses) statuses_.pop_front();
-    const auto* bytes = static_cast<const uint8_t*>(rbuf->data);
-    statuses_.emplace_back(bytes, bytes + rbuf->data_size);
-  } catch (...) {
+  if (rbuf == nullptr) return;
+  if (rbuf->data_size > kMaxStatusBytes) {
+    statuses_oversized_.fetch_add(1, std::memory_order_relaxed);
+    return;
   }
+  if (status_pending_) statuses_superseded_.fetch_add(1, std::memory_order_relaxed);
+  std::memcpy(status_slot_.data(), rbuf->data, rbuf->data_size);
+  status_size_ = rbuf->data_size;
+  status_pending_ = true;
 }
 
 int LcmDeviceTransport::PollSolverStatus(const StatusSink& sink) {
-  int n = 0;
-  while (!statuses_.empty()) {
-    const std::vector<uint8_t> bytes = std::move(statuses_.front());
-    statuses_.pop_front();
-    ++n;
-    try {
-      sink(bytes.data(), static_cast<int>(bytes.size()));
-    } catch (...) {
-    }
+  if (!status_pending_) return 0;
+  status_pending_ = false;
+  try {
+    sink(status_slot_.data(), static_cast<int>(status_size_));
+  } catch (...) {
   }
-  return n;
+  return 1;
 }
 
 bool LcmDeviceTransport::PublishDeviceState(const device_state_t& msg) {
@@ -56,10 +56,12 @@ int LcmDeviceTransport::PollForceModels(int wait_ms, const ForceModelSink& sink)
   if (!lcm_.good()) return -1;
   sink_ = &sink;
   delivered_ = 0;
-  int rc = lcm_.handleTimeout(wait_ms);
+  int rc = status_pending_ ? 0 : lcm_.handleTimeout(wait_ms);
   // More may be queued: take them without waiting again (bounded, so a flood cannot
-  // keep the caller from checking its stop flag).
-  for (int i = 0; rc > 0 && i < kMaxPerPoll; ++i) rc = lcm_.handleTimeout(0);
+  // keep the caller from checking its stop flag). A status in the slot ends the round:
+  // it is checked before another datagram can replace it, so forged statuses, however
+  // many, cannot push a genuine one out unchecked.
+  for (int i = 0; rc > 0 && !status_pending_ && i < kMaxPerPoll; ++i) rc = lcm_.handleTimeout(0);
   sink_ = nullptr;
   return rc < 0 ? -1 : delivered_;
 }

@@ -50,6 +50,16 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
       Reject(why);
       return false;
     }
+    // The MAC before anything of the message is looked at: a forged model's grasp name
+    // must not decide how it is counted (it is a bad MAC, not another hand's model).
+    // AdmitForceModel below verifies it again (a few microseconds) with the freshness.
+    if (auth_.key != nullptr &&
+        !auth::VerifyEncoded(data, static_cast<size_t>(size), auth_.force_model_channel,
+                             *auth_.key)) {
+      model_filter_.Reject(auth::Reason::kBadMac);
+      LogAuth(&model_filter_, now_us);
+      return false;
+    }
     // Another hand's model (issue 15): it answers that device's poses, never this one's.
     if (msg.grasp != grasp_) {
       other_grasp_.fetch_add(1);

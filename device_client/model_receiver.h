@@ -37,15 +37,16 @@ class ModelReceiver {
   // epoch becomes the one force models must carry (FreshnessFilter kAdopt). Same thread
   // as Receive. Never throws.
   bool ReceiveStatus(const void* data, int size);
-  // The grasp this device holds (issue 15): a model whose force_model_t.grasp differs is
-  // another hand's and is passed over before any check (counted in other_grasp(), not
-  // rejected: on a session with two hands every other model is the other hand's). Call
-  // before the first Receive.
+  // The grasp this device holds: a model whose force_model_t.grasp differs is another
+  // hand's and is passed over once its MAC verified (counted in other_grasp(), not
+  // rejected: on a session with two hands every other model is the other hand's; a model
+  // with a bad MAC is rejected whatever grasp it names). Call before the first Receive.
   void SetGrasp(std::string grasp) { grasp_ = std::move(grasp); }
   uint64_t other_grasp() const { return other_grasp_.load(); }
   // The server epoch learned from an authenticated status; 0 until one was heard.
   int64_t epoch() const { return status_filter_.epoch(); }
   uint64_t statuses_rejected() const { return status_filter_.rejected(); }
+  uint64_t statuses_accepted() const { return status_filter_.accepted(); }
 
   // One encoded force_model_t received at now_us (device CLOCK_MONOTONIC). True when it
   // reached the servo (possibly as a zero-force model for STATUS_INVALID). Never throws.

@@ -7,6 +7,8 @@
 
 #include <Eigen/Geometry>
 
+#include "realtime/clock.h"
+
 namespace snapthread::device {
 
 PhantomDevice::PhantomDevice() { caps_.model_name = "phantom"; }
@@ -82,9 +84,11 @@ HDCallbackCode HDCALLBACK PhantomDevice::ServoCallback(void* self_ptr) {
   s.orientation[3] = q.z();
   s.buttons = buttons;
   self->state_.Write(s);
-  Force f{{0.0, 0.0, 0.0}};
-  self->force_.Read(&f);
-  hdSetDoublev(HD_CURRENT_FORCE, f.force_n);
+  // The last command while it is fresh, else zero (the servo thread stalled).
+  HDdouble force[3];
+  double torque[3];
+  self->command_.Output(transport::MonotonicMicros(), force, torque);
+  hdSetDoublev(HD_CURRENT_FORCE, force);
   hdEndFrame(self->handle_);
   HDErrorInfo err = hdGetError();
   if (HD_DEVICE_ERROR(err)) {
@@ -101,13 +105,13 @@ bool PhantomDevice::Read(DeviceState* state) {
 
 bool PhantomDevice::Command(const double force_n[3], const double /*torque_nm*/[3]) {
   if (!open_ || fault_.load(std::memory_order_relaxed)) return false;
-  force_.Write(Force{{force_n[0], force_n[1], force_n[2]}});
+  command_.Set(force_n, nullptr, transport::MonotonicMicros());
   return true;
 }
 
 void PhantomDevice::Close() {
   if (handle_ == HD_INVALID_HANDLE) return;
-  force_.Write(Force{{0.0, 0.0, 0.0}});
+  command_.Clear(transport::MonotonicMicros());
   hdStopScheduler();
   if (callback_ != HD_INVALID_HANDLE) hdUnschedule(callback_);
   hdDisable(HD_FORCE_OUTPUT);

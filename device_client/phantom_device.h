@@ -3,9 +3,11 @@
 // device was available where this was written. The HD API only lets a device be read and
 // commanded inside its own scheduler callback, so this backend runs an asynchronous HD
 // callback at the HD servo rate that copies the pose into a LatestValue and applies the
-// latest commanded force from another LatestValue; Read/Command exchange with it
-// wait-free. That adds up to one HD tick of latency; running ServoTick inside the HD
-// callback instead would remove it.
+// latest commanded force from a StaleCommand; Read/Command exchange with it wait-free.
+// That adds up to one HD tick of latency; running ServoTick inside the HD callback instead
+// would remove it. The callback is this backend's watchdog: it renders zero once the last
+// command is older than StaleCommand::kDefaultLimitUs (a stalled servo thread), instead of
+// the last force forever. OpenHaptics has no watchdog of its own to arm.
 #pragma once
 
 #include <atomic>
@@ -14,6 +16,7 @@
 
 #include "haptic_device.h"
 #include "realtime/latest_value.h"
+#include "stale_command.h"
 
 namespace snapthread::device {
 
@@ -29,16 +32,13 @@ class PhantomDevice final : public HapticDevice {
   void Close() override;
 
  private:
-  struct Force {
-    double force_n[3];
-  };
   static HDCallbackCode HDCALLBACK ServoCallback(void* self);
 
   DeviceCapabilities caps_;
   HHD handle_ = HD_INVALID_HANDLE;
   HDSchedulerHandle callback_ = HD_INVALID_HANDLE;
   transport::LatestValue<DeviceState> state_;  // HD thread -> servo thread
-  transport::LatestValue<Force> force_;        // servo thread -> HD thread
+  StaleCommand command_;                       // servo thread -> HD thread
   std::atomic<bool> fault_{false};
   bool open_ = false;
 };

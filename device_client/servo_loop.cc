@@ -94,6 +94,8 @@ void ServoLoop::Start(std::string* notes) {
   }
   stop_.store(false);
   thread_ = std::thread(&ServoLoop::Run, this);
+  // Named, so an operator (top -H) or a test (/proc/PID/task/*/comm) can find it.
+  pthread_setname_np(thread_.native_handle(), "servo");
   if (options_.realtime) {
     sched_param sp{};
     sp.sched_priority = options_.fifo_priority;

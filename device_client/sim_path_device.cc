@@ -44,12 +44,14 @@ bool SimPathDevice::Command(const double force_n[3], const double torque_nm[3]) 
     last_force_n_[k] = force_n[k];
     last_torque_nm_[k] = torque_nm[k];
   }
+  command_.Set(force_n, torque_nm, clock_());
   return true;
 }
 
 void SimPathDevice::Close() {
   for (double& f : last_force_n_) f = 0.0;
   for (double& t : last_torque_nm_) t = 0.0;
+  if (clock_ != nullptr) command_.Clear(clock_());
   open_ = false;
 }
 

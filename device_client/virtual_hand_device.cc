@@ -48,11 +48,15 @@ void VirtualHandDevice::Integrate(double t_s, double dt_s) {
   const int steps = std::max(1, static_cast<int>(std::ceil(dt_s / params_.max_substep_s)));
   const double h = dt_s / steps;
   for (int s = 0; s < steps; ++s) {
+    const double t = t_s - dt_s + (s + 1) * h;
     double target[3], target_v[3];
-    path_.Evaluate(t_s - dt_s + (s + 1) * h, target, target_v);
+    path_.Evaluate(t, target, target_v);
+    // The force the device renders at this substep: zero once the command is stale.
+    double force[3], torque[3];
+    command_.Output(start_us_ + static_cast<int64_t>(std::llround(1e6 * t)), force, torque);
     for (int i = 0; i < 3; ++i) {
       // Spring-damper toward the intended motion plus the rendered force on the hand.
-      const double a = (k * (target[i] - x_[i]) + c * (target_v[i] - v_[i]) + force_n_[i]) / m;
+      const double a = (k * (target[i] - x_[i]) + c * (target_v[i] - v_[i]) + force[i]) / m;
       v_[i] += h * a;
       x_[i] += h * v_[i];
     }
@@ -78,12 +82,12 @@ bool VirtualHandDevice::Read(DeviceState* state) {
 
 bool VirtualHandDevice::Command(const double force_n[3], const double /*torque_nm*/[3]) {
   if (!open_) return false;
-  for (int k = 0; k < 3; ++k) force_n_[k] = force_n[k];
+  command_.Set(force_n, nullptr, clock_());  // no torque output
   return true;
 }
 
 void VirtualHandDevice::Close() {
-  for (double& f : force_n_) f = 0.0;
+  if (clock_ != nullptr) command_.Clear(clock_());
   open_ = false;
 }
 

@@ -19,9 +19,10 @@ int main(int argc, char** argv) {
   bool quiet = false;
   CLI::App app{
       "snapthread-logger: records the LCM messages of the channels matching CHAN into FILE "
-      "(lcm-logger's log format), queueing a minute of traffic so that a busy machine delays "
-      "the writing instead of dropping messages. Ends at SIGINT / SIGTERM or after "
-      "--duration-s."};
+      "(lcm-logger's log format, files of mode 0600), queueing up to --max-queue-bytes of "
+      "traffic so that a busy machine delays the writing instead of dropping messages. "
+      "--max-bytes / --rotate split and rotate files like lcm-logger's --split-mb / --rotate. "
+      "Ends at SIGINT / SIGTERM or after --duration-s."};
   app.add_option("file", o.path, "the log file")->required();
   app.add_option("-c,--channel", o.channel, "channel regex")->capture_default_str();
   app.add_option("-l,--lcm-url", o.lcm_url,
@@ -34,6 +35,18 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--flush-interval", o.flush_interval_ms, "flush the file every MS milliseconds")
       ->capture_default_str()->check(CLI::Range(1, 10000));
+  app.add_option("--max-bytes", o.max_bytes,
+                 "start a new file before one would pass N bytes: FILE, FILE.1, FILE.2, ... "
+                 "(lcm-logger --split-mb, in bytes; 0 = one file)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--rotate", o.rotate,
+                 "write FILE.0 and keep K files: a new file renames FILE.0 -> FILE.1 -> ... and "
+                 "deletes FILE.K-1 (lcm-logger --rotate; existing files are rotated, not refused)")
+      ->check(CLI::Range(1, 1000));
+  app.add_option("--max-queue-bytes", o.max_queue_bytes,
+                 "received but unwritten messages held at most; beyond, messages are dropped and "
+                 "counted (lcm-logger --max-unwritten-mb, in bytes)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   if (!std::isfinite(o.duration_s)) {  // CLI11's NonNegativeNumber lets "nan" through
     std::fprintf(stderr, "snapthread-logger: --duration-s: expected a finite number\n");
@@ -70,11 +83,23 @@ int main(int argc, char** argv) {
     return 1;
   }
   const bool ok = logger->Run(stop_fd);
-  if (!quiet || !ok || logger->write_errors() > 0) {
-    std::printf("snapthread-logger: %lld messages (%lld bytes) in %s, %lld write errors\n",
+  const snapthread::logger::QueueCounts q = logger->queue_counts();
+  const bool lost = logger->write_errors() > 0 || q.dropped_messages > 0 || logger->too_large() > 0;
+  if (!quiet || !ok || lost) {
+    std::printf("snapthread-logger: %lld messages (%lld bytes) in %d file%s (last %s), %lld "
+                "dropped (queue full, %lld bytes; peak queue %lld bytes), %lld larger than "
+                "--max-bytes, %lld write errors\n",
                 static_cast<long long>(logger->messages()), static_cast<long long>(logger->bytes()),
-                o.path.c_str(), static_cast<long long>(logger->write_errors()));
+                logger->files(), logger->files() == 1 ? "" : "s", logger->current_path().c_str(),
+                static_cast<long long>(q.dropped_messages), static_cast<long long>(q.dropped_bytes),
+                static_cast<long long>(q.peak_bytes), static_cast<long long>(logger->too_large()),
+                static_cast<long long>(logger->write_errors()));
   }
-  if (!ok) std::fprintf(stderr, "snapthread-logger: LCM handle failed on %s\n", o.lcm_url.c_str());
+  if (!logger->file_error().empty()) {
+    std::fprintf(stderr, "snapthread-logger: %s\n", logger->file_error().c_str());
+  }
+  if (!ok && logger->file_error().empty()) {
+    std::fprintf(stderr, "snapthread-logger: LCM handle failed on %s\n", o.lcm_url.c_str());
+  }
   return ok && logger->write_errors() == 0 ? 0 : 1;
 }

@@ -63,7 +63,8 @@ SteadyClock::duration Period(double rate_hz) {
       std::chrono::duration<double>(1.0 / rate_hz));
 }
 
-auth::SessionKey LoadServerKey(const auth::KeyLocation& where, bool* created) {
+auth::SessionKey LoadServerKey(const auth::KeyLocation& where, bool create, bool* created) {
+  if (!create) return auth::LoadKey(where);
   auth::LoadedKey loaded = auth::LoadOrCreateKey(where);
   *created = loaded.created;
   return std::move(loaded.key);
@@ -74,7 +75,7 @@ auth::SessionKey LoadServerKey(const auth::KeyLocation& where, bool* created) {
 Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
     : params_(params),
       key_location_(auth::ResolveKeyPath(params.key_path)),
-      key_(LoadServerKey(key_location_, &key_created_)),
+      key_(LoadServerKey(key_location_, params.create_key, &key_created_)),
       epoch_(auth::NewEpoch()),
       hooks_(std::move(hooks)) {
   std::string error;

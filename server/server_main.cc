@@ -102,7 +102,10 @@ int main(int argc, char** argv) {
                  "dropped_poses, rejected_messages) here at exit");
   app.add_option("--key", params.key_path,
                  "Session key file (default: $SNAPTHREAD_KEY_FILE, else "
-                 "$XDG_CONFIG_HOME/snapthread/session.key); created (mode 0600) when missing");
+                 "$XDG_CONFIG_HOME/snapthread/session.key); must exist (snapthread-keygen "
+                 "makes it) unless --create-key");
+  app.add_flag("--create-key", params.create_key,
+               "Make the session key (mode 0600) when the --key file does not exist");
   app.add_option("--state-dir", params.state_dir,
                  "Checkpoint the scene, method, grasp and state here (>= 5 Hz, atomically); "
                  "restarted with the same directory and --session the server resumes on the "

@@ -53,8 +53,11 @@ struct ServerParams {
   // Where to write the end-of-run JSON summary; empty = none.
   std::string summary_path;
   // The session key file (--key): "" = $SNAPTHREAD_KEY_FILE, else the XDG default
-  // (auth/key_file.h). The server creates it when it does not exist.
+  // (auth/key_file.h). It must exist unless create_key.
   std::string key_path;
+  // --create-key: make the key (mode 0600) when the file does not exist. Without it a
+  // missing key is refused (a typo in --key must not give a new key).
+  bool create_key = false;
   // Where the server checkpoints the scene, method, grasp and state (--state-dir; "" =
   // no checkpoints). Restarted with the same directory and session it resumes on the
   // same branch (server/checkpoint.h). Made (mode 0700) when missing.

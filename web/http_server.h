@@ -1,6 +1,9 @@
 // The bridge's HTTP side (Boost.Beast): accepts connections on the bind address, serves
-// the page's files (GET/HEAD) and hands WebSocket upgrades of /ws to a WsClient. When a
-// token is required, every request without ?token=<token> gets 401 before anything else.
+// the page's files (GET/HEAD) and hands WebSocket upgrades of /ws to a WsClient. Every
+// request passes access_policy.h first (Host, the token, a WebSocket's Origin), and every
+// response carries security_headers.h. At most `max_pages` WebSockets are open at once
+// (more get 503) and at most kConnectionsPerPage times as many plain HTTP connections
+// (more are closed at accept); each refusal is counted (Hub::AccessCounts).
 #pragma once
 
 #include <memory>
@@ -9,6 +12,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
 
+#include "access_policy.h"
 #include "hub.h"
 #include "page_files.h"
 
@@ -17,9 +21,13 @@ namespace snapthread::web {
 struct ServeConfig {
   std::shared_ptr<Hub> hub;
   std::shared_ptr<const PageFiles> files;
-  std::string token;       // "" = no token required
+  AccessConfig access;     // token ("" = none required), host names; the port is set on bind
   double max_rate_hz = 60.0;
+  int max_pages = 16;
 };
+
+// Plain HTTP connections allowed per page (a browser opens a few in parallel to load one).
+inline constexpr int kConnectionsPerPage = 4;
 
 class HttpServer {
  public:

@@ -61,6 +61,8 @@ void Hub::PublishStats() {
   w.Int("solver_statuses", c.received[2]).Int("device_statuses", c.received[3]);
   w.Int("malformed", c.malformed).Int("auth_rejected", c.auth_rejected);
   w.Int("shapes_dropped", dropped).Int("bad_commands", bad_commands_);
+  w.Int("pages_refused", access_.refused_pages).Int("connections_refused", access_.refused_connections);
+  w.Int("unauthorized", access_.refused_unauthorized).Int("forbidden", access_.refused_forbidden);
   w.EndObject();
   auto text = std::make_shared<const std::string>(w.Take());
   latest_[Index(FeedKind::kBridge)] = text;

@@ -45,6 +45,17 @@ class Hub : public std::enable_shared_from_this<Hub> {
   void OnClientMessage(WsClient* client, const std::string& text);
   size_t clients() const { return clients_.size(); }
 
+  // The HTTP side's connections and refusals (io thread), sent with the bridge counters.
+  struct AccessCounts {
+    int open_connections = 0;          // HTTP connections not (yet) upgraded
+    int open_pages = 0;                // WebSockets
+    int64_t refused_connections = 0;  // over the connection limit: closed at accept
+    int64_t refused_pages = 0;        // WebSockets over --max-pages: 503
+    int64_t refused_unauthorized = 0;  // no or a wrong token: 401
+    int64_t refused_forbidden = 0;     // a foreign Host or Origin: 403
+  };
+  AccessCounts& access() { return access_; }
+
  private:
   boost::asio::io_context& io_;
   std::string mode_;
@@ -56,6 +67,7 @@ class Hub : public std::enable_shared_from_this<Hub> {
   int64_t connections_ = 0;
   int64_t bad_commands_ = 0;
   int64_t shapes_dropped_ = 0;  // by the pacers of pages gone
+  AccessCounts access_;
 };
 
 }  // namespace snapthread::web

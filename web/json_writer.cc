@@ -84,9 +84,48 @@ JsonWriter& JsonWriter::Numbers(std::string_view key, const double* values, int 
   return EndArray();
 }
 
+namespace {
+
+// The length of the well-formed UTF-8 sequence at the start of `s` (RFC 3629: no
+// overlong forms, no surrogates, at most U+10FFFF), 0 when it is not one.
+size_t Utf8SequenceLength(std::string_view s) {
+  const auto b = [&](size_t i) { return static_cast<unsigned char>(s[i]); };
+  const unsigned char c = b(0);
+  if (c < 0x80) return 1;
+  size_t n;
+  unsigned char lo = 0x80, hi = 0xbf;  // the second byte's range
+  if (c >= 0xc2 && c <= 0xdf) n = 2;
+  else if (c >= 0xe0 && c <= 0xef) n = 3, lo = c == 0xe0 ? 0xa0 : 0x80, hi = c == 0xed ? 0x9f : 0xbf;
+  else if (c >= 0xf0 && c <= 0xf4) n = 4, lo = c == 0xf0 ? 0x90 : 0x80, hi = c == 0xf4 ? 0x8f : 0xbf;
+  else return 0;
+  if (s.size() < n || b(1) < lo || b(1) > hi) return 0;
+  for (size_t i = 2; i < n; ++i) {
+    if (b(i) < 0x80 || b(i) > 0xbf) return 0;
+  }
+  return n;
+}
+
+}  // namespace
+
+// Strings from messages are any bytes: a WebSocket text message must be UTF-8 (a browser
+// closes the connection on anything else), so each byte that does not start a
+// well-formed sequence is written as U+FFFD.
 void JsonWriter::AppendEscaped(std::string_view value) {
   text_ += '"';
-  for (const char c : value) {
+  for (size_t i = 0; i < value.size();) {
+    const char c = value[i];
+    const size_t n = Utf8SequenceLength(value.substr(i));
+    if (n == 0) {
+      text_ += "\\ufffd";
+      i += 1;
+      continue;
+    }
+    if (n > 1) {
+      text_.append(value.substr(i, n));
+      i += n;
+      continue;
+    }
+    i += 1;
     switch (c) {
       case '"': text_ += "\\\""; break;
       case '\\': text_ += "\\\\"; break;

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "auth/message_gate.h"
+#include "auth/message_mac.h"
 #include "message_json.h"
 #include "messages/channels.h"
 #include "messages/lcm_url.h"
@@ -19,7 +19,9 @@
 namespace snapthread::web {
 namespace {
 
-// Devices tracked separately; more are refused (a flood of invented ids stays bounded).
+// Authenticated devices tracked separately; more are refused. Only a key holder can add
+// one (the MAC is checked before a device id is looked at), so this bounds a key holder's
+// mistakes, not a stranger's flood.
 constexpr size_t kMaxDevices = 16;
 
 std::string ToJson(const thread_shape_t& m) { return ShapeJson(m, DrawsSmooth(m.model)); }
@@ -57,8 +59,12 @@ LiveFeed::LiveFeed(const std::string& lcm_url, const std::string& session,
       lcm_, channels.solver_status, this);
   auto* device = messages::Subscribe<&LiveFeed::OnMessage<device_status_t>>(
       lcm_, channels.device_status, this);
+  // The device statuses of a genuine session come at ~1 Hz per device: room for a burst
+  // of forged ones on the same channel (each refused in microseconds) before LCM, which
+  // drops a full queue's newest, would drop a genuine one.
   if (shape) shape->setQueueCapacity(240);
   if (model) model->setQueueCapacity(4000);
+  if (device) device->setQueueCapacity(240);
   subscriptions_ = {shape, model, solver, device};
 }
 
@@ -124,7 +130,25 @@ auth::FreshnessFilter* LiveFeed::FilterFor(const Msg& msg) {
 }
 
 template <class Msg>
+auth::FreshnessFilter* LiveFeed::BadMacCounter() {
+  if constexpr (std::is_same_v<Msg, thread_shape_t>) return &shape_filter_;
+  if constexpr (std::is_same_v<Msg, force_model_t>) return &model_filter_;
+  if constexpr (std::is_same_v<Msg, solver_status_t>) return &status_filter_;
+  if constexpr (std::is_same_v<Msg, device_status_t>) return &device_bad_mac_;
+}
+
+template <class Msg>
 void LiveFeed::OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  // The MAC over the bytes as received comes first: nothing is decoded into state, and
+  // nothing keyed by a field of the message (a device id) is created, for a sender
+  // without the key. Its refusal is counted on the channel's own counter.
+  if (!auth::VerifyEncoded(rbuf->data, rbuf->data_size, channel, key_)) {
+    auth_rejected_++;
+    auth::FreshnessFilter* counter = BadMacCounter<Msg>();
+    counter->Reject(auth::Reason::kBadMac);
+    LogRefusals(counter);
+    return;
+  }
   Msg msg;
   std::string why;
   if (!transport::DecodeAndValidate(rbuf, &msg, &why)) {
@@ -132,15 +156,13 @@ void LiveFeed::OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& chan
     return;
   }
   auth::FreshnessFilter* filter = FilterFor(msg);
-  if (filter == nullptr ||
-      auth::Admit(rbuf->data, rbuf->data_size, msg, channel, key_, filter) !=
-          auth::Reason::kAccepted) {
+  if (filter == nullptr) {  // a key holder's 17th device
     auth_rejected_++;
-    if (filter == nullptr) return;
-    std::string line;
-    if (filter->TakeLogLine(NowUs(), &line)) {
-      std::fprintf(stderr, "snapthread-web: refused %s\n", line.c_str());
-    }
+    return;
+  }
+  if (filter->Admit(msg.epoch, msg.auth_seq) != auth::Reason::kAccepted) {
+    auth_rejected_++;
+    LogRefusals(filter);
     return;
   }
   received_[Index(KindOf(msg))]++;
@@ -153,6 +175,13 @@ void LiveFeed::OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& chan
     PublishIfDue(newest, Clock::now());
   } else {
     publish_(KindOf(msg), std::make_shared<const std::string>(ToJson(msg)));
+  }
+}
+
+void LiveFeed::LogRefusals(auth::FreshnessFilter* filter) {
+  std::string line;
+  if (filter->TakeLogLine(NowUs(), &line)) {
+    std::fprintf(stderr, "snapthread-web: refused %s\n", line.c_str());
   }
 }
 

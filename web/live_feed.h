@@ -1,8 +1,11 @@
 // The bridge's LCM side in live mode: subscribes to <SESSION>_SHAPE, _FORCE_MODEL,
-// _SOLVER_STATUS and _DEVICE_STATUS, vets every message as the viewer does
-// (transport::DecodeAndValidate, then auth::Admit with the session key: MAC, the server
-// epoch learned from an authenticated solver status, a strictly increasing auth_seq per
-// sender) and hands each accepted one, as JSON, to `publish`. Bad and refused messages
+// _SOLVER_STATUS and _DEVICE_STATUS, vets every message as the viewer does (the MAC with
+// the session key over the bytes received, first; then transport::DecodeAndValidate; then
+// the server epoch learned from an authenticated solver status and a strictly increasing
+// auth_seq per sender) and hands each accepted one, as JSON, to `publish`. Per-sender
+// state (a device's sequence floor) is made only for a message whose MAC passed, and the
+// slots below hold only accepted messages, so a sender without the key can neither fill
+// the device table nor replace what the pages are shown. Bad and refused messages
 // are dropped and counted; handlers never throw. LCM is handled on the feed's own thread.
 // Shapes and force models come faster than any page is sent them (force models at the
 // update rate: ~1600/s in curve2d_snap; a page gets at most 60/s of each): every one is
@@ -67,6 +70,10 @@ class LiveFeed {
   void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   template <class Msg>
   auth::FreshnessFilter* FilterFor(const Msg& msg);
+  // Where a bad MAC on Msg's channel is counted (and logged from).
+  template <class Msg>
+  auth::FreshnessFilter* BadMacCounter();
+  static void LogRefusals(auth::FreshnessFilter* filter);
   void Loop();
   // The newest accepted shape or force model not yet published, and when its kind last was.
   template <class Msg>
@@ -86,13 +93,14 @@ class LiveFeed {
   auth::FreshnessFilter model_filter_{"FORCE_MODEL"};
   // One sequence per device (each signs its statuses with its own auth_seq).
   std::map<std::string, std::unique_ptr<auth::FreshnessFilter>> device_filters_;
+  auth::FreshnessFilter device_bad_mac_{"DEVICE_STATUS"};  // counts bad MACs only
   Newest<thread_shape_t> newest_shape_;
   Newest<force_model_t> newest_model_;
   std::thread thread_;
   std::atomic<bool> running_{false};
   std::array<std::atomic<int64_t>, 4> received_{};
   std::atomic<int64_t> malformed_{0};
-  std::atomic<int64_t> auth_rejected_{0};  // refused by any filter, or a 17th device
+  std::atomic<int64_t> auth_rejected_{0};  // bad MAC, refused by a filter, or a 17th device
 };
 
 }  // namespace snapthread::web

@@ -10,10 +10,12 @@
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
 
+#include "access_policy.h"
 #include "auth/key_file.h"
 #include "http_server.h"
 #include "hub.h"
 #include "live_feed.h"
+#include "messages/channels.h"
 #include "observer_token.h"
 #include "replay_feed.h"
 #include "web_options.h"
@@ -44,6 +46,18 @@ int RunWeb(WebOptions o) {
     return 1;
   }
   // Beyond loopback the page is for the observers holding the token only (observer_token.h).
+  try {
+    if (!o.token_file.empty()) o.token = LoadTokenFile(o.token_file);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-web: %s\n", e.what());
+    return 1;
+  }
+  if (!o.token.empty()) {
+    if (const std::string problem = TokenProblem(o.token); !problem.empty()) {
+      std::fprintf(stderr, "snapthread-web: bad --token: %s\n", problem.c_str());
+      return 1;
+    }
+  }
   if (!address.is_loopback() && o.token.empty()) o.token = GenerateObserverToken();
 
   std::unique_ptr<LiveFeed> live;
@@ -60,8 +74,9 @@ int RunWeb(WebOptions o) {
       hub = std::make_shared<Hub>(io, "replay", replay->session(), [&replay] { return replay->counts(); });
       hub->SetCommandHandler([&replay](const std::string& c) { return replay->Command(c); });
       const ReplayPosition p = replay->position();
+      // The log's session name is the log's text: shown escaped.
       std::printf("snapthread-web: replaying %s: session %s, %lld shapes over %.1f s (last seq %lld)\n",
-                  o.log_path.c_str(), replay->session().c_str(), static_cast<long long>(p.shape_count),
+                  o.log_path.c_str(), transport::EscapeForDisplay(replay->session()).c_str(), static_cast<long long>(p.shape_count),
                   p.duration_s, static_cast<long long>(p.last_seq));
     } else {
       key.emplace(auth::LoadKey(auth::ResolveKeyPath(o.key_path)));
@@ -77,15 +92,21 @@ int RunWeb(WebOptions o) {
   std::optional<HttpServer> server;
   try {
     server.emplace(io, asio::ip::tcp::endpoint(address, static_cast<unsigned short>(o.port)),
-                   ServeConfig{hub, files, o.token, o.max_rate_hz});
+                   ServeConfig{hub, files, AccessConfig{o.token, o.host_names, 0}, o.max_rate_hz,
+                               o.max_pages});
   } catch (const std::exception& e) {
     std::fprintf(stderr, "snapthread-web: %s\n", e.what());
     return 1;
   }
-  const std::string host = address.is_v6() ? "[" + o.bind + "]" : o.bind;
+  // The one place the token is printed: in the URL for the operator to open (the page then
+  // moves it into a cookie and out of the address bar). With --host-name, the URL names
+  // the first, as browsers on other machines reach the bridge by it.
+  const std::string host = !o.host_names.empty() ? o.host_names.front()
+                           : address.is_v6()     ? "[" + o.bind + "]"
+                                                 : o.bind;
   std::printf("snapthread-web: serving %s of session %s at http://%s:%u/%s\n",
               replay ? "a replay" : "the live view",
-              replay ? replay->session().c_str() : o.session.c_str(),
+              transport::EscapeForDisplay(replay ? replay->session() : o.session).c_str(),
               host.c_str(), server->port(), o.token.empty() ? "" : ("?token=" + o.token).c_str());
   std::fflush(stdout);
 

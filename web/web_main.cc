@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "access_policy.h"
 #include "messages/channels.h"
 #include "messages/lcm_url.h"
 #include "web_options.h"
@@ -23,14 +24,25 @@ int main(int argc, char** argv) {
       "charts of |F|, update time and residual, rates) to any number of browsers, from "
       "<SESSION>_SHAPE, _FORCE_MODEL, _SOLVER_STATUS and _DEVICE_STATUS; or replays a log "
       "(--log). Never publishes. Binds 127.0.0.1 unless --bind says otherwise; on any other "
-      "address every request needs the observer token (?token=, printed in the URL)."};
+      "address every request needs the observer token (the URL printed ends in ?token=; the "
+      "page then keeps it in a cookie). Requests must name the bound address or a --host-name "
+      "as their Host, and a WebSocket must come from the page itself (Origin)."};
   app.add_option("--port", o.port, "HTTP port (0: any free port, printed)")
       ->capture_default_str()->check(CLI::Range(0, 65535));
   app.add_option("--bind", o.bind, "listen address (beyond loopback the token is required)")
       ->capture_default_str();
-  app.add_option("--token", o.token,
+  auto* token = app.add_option("--token", o.token,
                  "observer token pages must send as ?token= (default: none on loopback, "
-                 "else a random one, printed)");
+                 "else a random one, printed); 16-128 of A-Z a-z 0-9 . _ ~ -");
+  app.add_option("--token-file", o.token_file,
+                 "read the observer token from this file (mode 0600; keeps it off the command "
+                 "line, where other users see it)")
+      ->excludes(token);
+  app.add_option("--host-name", o.host_names,
+                 "a name browsers reach this bridge by (its Host header), besides the bound "
+                 "address; repeatable (e.g. --host-name labpc --host-name labpc.lab.example)");
+  app.add_option("--max-pages", o.max_pages, "pages (WebSockets) open at once, at most; more get 503")
+      ->capture_default_str()->check(CLI::Range(1, 4096));
   app.add_option("--session", o.session, "session name (channel prefix; env SNAPTHREAD_SESSION)")
       ->capture_default_str();
   app.add_option("--lcm-url", o.lcm_url,
@@ -57,6 +69,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "snapthread-web: bad --session '%s' (expected [A-Za-z0-9_]+)\n",
                  o.session.c_str());
     return 1;
+  }
+  for (const std::string& name : o.host_names) {
+    if (!snapthread::web::IsValidHostName(name)) {
+      std::fprintf(stderr, "snapthread-web: bad --host-name '%s' (a DNS name or an IP address)\n",
+                   name.c_str());
+      return 1;
+    }
   }
   // A receiver: a kernel buffer that rides out seconds off the CPU (lcm_url.h).
   o.lcm_url = snapthread::transport::WithReceiveBuffer(snapthread::transport::ResolveLcmUrl(o.lcm_url));

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace snapthread::web {
 
@@ -12,6 +13,9 @@ struct WebOptions {
   std::string bind = "127.0.0.1";      // listen address
   int port = 7000;                     // 0: the kernel picks one (printed)
   std::string token;                   // observer token ("" = generated when not loopback)
+  std::string token_file;              // read the token from this file instead (0600)
+  std::vector<std::string> host_names; // names the page may be reached by (Host), besides the address
+  int max_pages = 16;                  // WebSocket pages open at once, at most
   std::string log_path;                // replay this log instead of the live session
   std::string page_dir;                // the built page (default: the build's web/page)
   double max_rate_hz = 60.0;           // shapes and force models per page, at most

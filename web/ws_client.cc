@@ -9,11 +9,22 @@ namespace websocket = beast::websocket;
 
 WsClient::WsClient(boost::asio::ip::tcp::socket&& socket, std::shared_ptr<Hub> hub,
                    double max_rate_hz)
-    : ws_(std::move(socket)), hub_(std::move(hub)), pacer_(max_rate_hz), timer_(ws_.get_executor()) {}
+    : ws_(std::move(socket)), hub_(std::move(hub)), pacer_(max_rate_hz), timer_(ws_.get_executor()) {
+  hub_->access().open_pages++;
+}
 
-WsClient::~WsClient() { hub_->Leave(this); }
+WsClient::~WsClient() {
+  hub_->Leave(this);
+  hub_->access().open_pages--;
+}
 
-void WsClient::Accept(beast::http::request<beast::http::string_body> request) {
+void WsClient::Accept(beast::http::request<beast::http::string_body> request,
+                      std::vector<std::pair<std::string, std::string>> headers) {
+  ws_.set_option(websocket::stream_base::decorator(
+      [headers = std::move(headers)](websocket::response_type& response) {
+        response.set(beast::http::field::server, "snapthread-web");
+        for (const auto& [name, value] : headers) response.set(name, value);
+      }));
   // Beast's suggested server timeouts: the handshake must finish, and a page that stops
   // answering pings is dropped.
   beast::get_lowest_layer(ws_).expires_never();

@@ -6,6 +6,9 @@
 #pragma once
 
 #include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -26,8 +29,10 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   WsClient(boost::asio::ip::tcp::socket&& socket, std::shared_ptr<Hub> hub, double max_rate_hz);
   ~WsClient();
 
-  // Completes the upgrade of `request` (already checked for the token), then joins the hub.
-  void Accept(boost::beast::http::request<boost::beast::http::string_body> request);
+  // Completes the upgrade of `request` (already checked: access_policy.h), its 101 response
+  // carrying `headers` (security_headers.h), then joins the hub.
+  void Accept(boost::beast::http::request<boost::beast::http::string_body> request,
+              std::vector<std::pair<std::string, std::string>> headers);
   void Offer(FeedKind kind, Text text);
   void Acked();  // the page handled a shape or force model
   const ClientPacer& pacer() const { return pacer_; }

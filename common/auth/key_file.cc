@@ -129,6 +129,61 @@ std::string WriteTempKey(const std::string& file, const SessionKey& key) {
   return tmp;
 }
 
+// "uid 65534 (nobody)": an owner for messages.
+std::string UserName(uid_t uid) {
+  std::vector<char> buf(16384);
+  passwd pw{};
+  passwd* found = nullptr;
+  std::string name = "uid " + std::to_string(uid);
+  if (getpwuid_r(uid, &pw, buf.data(), buf.size(), &found) == 0 && found != nullptr &&
+      found->pw_name != nullptr) {
+    return found->pw_name;
+  }
+  return name;
+}
+
+KeyFileError MissingKey(const KeyLocation& where) {
+  return KeyFileError("no session key at " + where.path + " (" + where.origin + ")" +
+                      ". Fix: make it with `snapthread-keygen --key " + ShellQuoted(where.path) +
+                      "` (or start snapthread-server once with --create-key), or copy the "
+                      "session's key here with scp -p; a missing key is never made silently "
+                      "(a typo would give a new key); see docs/security.md");
+}
+
+KeyFileError Symlink(const KeyLocation& where) {
+  std::error_code ec;
+  const std::filesystem::path real = std::filesystem::canonical(where.path, ec);
+  return KeyFileError(Named(where) + " is a symbolic link, so it is refused (whoever can change "
+                      "the link would choose the key). Fix: use the real path" +
+                      (ec ? std::string() : ": --key " + ShellQuoted(real.string())));
+}
+
+// The directory holding a key: writable by group or others, or owned by someone other
+// than the user or root, lets another user replace the key (rename over it).
+void CheckKeyDir(const std::string& dir, const struct stat& st, const std::string& what) {
+  if ((st.st_mode & 022) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
+    throw KeyFileError("the directory " + dir + " of " + what + " has mode " + mode +
+                       ": group or others may write to it and replace the key, so it is "
+                       "refused. Fix: chmod go-w " + ShellQuoted(dir) +
+                       " (or keep the key in a directory of mode 0700)");
+  }
+  if (st.st_uid != geteuid() && st.st_uid != 0) {
+    throw KeyFileError("the directory " + dir + " of " + what + " is owned by " +
+                       UserName(st.st_uid) + ", who could replace the key, so it is refused. "
+                       "Fix: chown " + UserName(geteuid()) + " " + ShellQuoted(dir) +
+                       " (as root), or keep the key in a directory of your own");
+  }
+}
+
+// Before a key is written: its directory (made 0700 when missing) must pass CheckKeyDir.
+void CheckExistingKeyDir(const KeyLocation& where) {
+  const std::string dir = DirOf(where.path);
+  struct stat st {};
+  if (stat(dir.c_str(), &st) == 0) CheckKeyDir(dir, st, "the " + Named(where));
+}
+
 }  // namespace
 
 KeyLocation ResolveKeyPath(std::string_view flag_path) {
@@ -155,30 +210,56 @@ KeyLocation ResolveKeyPath(std::string_view flag_path, const EnvLookup& env) {
 SessionKey LoadKey(const KeyLocation& where) {
   const std::string& path = where.path;
   const std::string q = ShellQuoted(path);
-  // O_NONBLOCK: opening a FIFO must not wait for a writer (it is refused below).
-  const Fd fd(open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK));
+  const std::string dir = DirOf(path);
+  const std::string base = std::filesystem::path(path).filename().string();
+  // The directory first, then the file relative to that very directory (openat) and its
+  // fstat on the opened descriptor: what is checked is what is read (no TOCTOU).
+  const Fd dir_fd(open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (dir_fd.get() < 0 && errno == ENOENT) throw MissingKey(where);
+  if (dir_fd.get() < 0) {
+    throw KeyFileError("cannot open the directory " + dir + " of the " + Named(where) + ": " +
+                       Errno(errno) + ". Fix: the directory must be searchable by the user "
+                       "running snapthread (chown, then chmod 700 " + ShellQuoted(dir) + ")");
+  }
+  // O_NOFOLLOW: a symbolic link is refused (ELOOP), not followed: whoever can change the
+  // link would choose the key. O_NONBLOCK: opening a FIFO must not wait for a writer (it
+  // is refused below).
+  const Fd fd(base.empty() ? -1
+                           : openat(dir_fd.get(), base.c_str(),
+                                    O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK | O_NOFOLLOW));
   if (fd.get() < 0) {
-    const int err = errno;
-    if (err == ENOENT) {
-      throw KeyFileError("no session key at " + where.path + " (" + where.origin + ")" +
-                         ". Fix: make one on the workstation with `snapthread-keygen` (the server "
-                         "also creates it at its first start) and copy it here with scp -p; see "
-                         "docs/security.md");
+    const int err = base.empty() ? ENOENT : errno;
+    if (err == ENOENT) throw MissingKey(where);
+    struct stat lst {};
+    if (err == ELOOP && fstatat(dir_fd.get(), base.c_str(), &lst, AT_SYMLINK_NOFOLLOW) == 0 &&
+        S_ISLNK(lst.st_mode)) {
+      throw Symlink(where);
     }
     throw KeyFileError("cannot open " + Named(where) + ": " + Errno(err) +
                        ". Fix: the key must be readable by the user running snapthread (chown, "
-                       "then chmod 600 " + q + ")");
+                       "then chmod 0600 " + q + ")");
   }
   struct stat st {};
   if (fstat(fd.get(), &st) != 0) {
     throw KeyFileError("cannot stat " + Named(where) + ": " + Errno(errno));
   }
   if (!S_ISREG(st.st_mode)) throw NotAKeyFile(where, st.st_mode);
+  struct stat dst {};
+  if (fstat(dir_fd.get(), &dst) != 0) {
+    throw KeyFileError("cannot stat the directory " + dir + ": " + Errno(errno));
+  }
+  CheckKeyDir(dir, dst, "the " + Named(where));
+  if (st.st_uid != geteuid()) {
+    throw KeyFileError(Named(where) + " is owned by " + UserName(st.st_uid) + ", not by " +
+                       UserName(geteuid()) + " who runs snapthread, so it is refused (its owner "
+                       "could change it). Fix: chown " + UserName(geteuid()) + " " + q +
+                       " (as root), or run snapthread as its owner");
+  }
   if ((st.st_mode & 077) != 0) {
     char mode[8];
     std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
     throw KeyFileError(Named(where) + " has mode " + mode +
-                       ": group or others may read or write it, so it is refused. Fix: chmod 600 " + q);
+                       ": group or others may read or write it, so it is refused. Fix: chmod 0600 " + q);
   }
   if (st.st_size != static_cast<off_t>(SessionKey::kBytes)) {
     throw KeyFileError(Named(where) + " holds " + std::to_string(st.st_size) + " bytes; a key is " +
@@ -213,6 +294,7 @@ LoadedKey LoadOrCreateKey(const KeyLocation& where) {
   struct stat st {};
   if (lstat(where.path.c_str(), &st) == 0 || errno != ENOENT) return {LoadKey(where), false};
   MakeParentDirs(where.path);
+  CheckExistingKeyDir(where);
   SessionKey key = SessionKey::Generate();
   const std::string tmp = WriteTempKey(where.path, key);
   // link() fails when the name exists: a concurrent creator (another server starting)
@@ -225,11 +307,13 @@ LoadedKey LoadOrCreateKey(const KeyLocation& where) {
     throw KeyFileError("cannot create " + Named(where) + ": " + Errno(err));
   }
   SyncDir(where.path);
-  return {std::move(key), true};
+  // Read back through every check (owner, mode, size), as any other start would.
+  return {LoadKey(where), true};
 }
 
 void WriteNewKey(const KeyLocation& where, bool overwrite) {
   MakeParentDirs(where.path);
+  CheckExistingKeyDir(where);
   const SessionKey key = SessionKey::Generate();
   const std::string tmp = WriteTempKey(where.path, key);
   const int done = overwrite ? rename(tmp.c_str(), where.path.c_str())

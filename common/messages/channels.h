@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <string_view>
 
 namespace snapthread::transport {
 
@@ -30,5 +31,21 @@ inline constexpr size_t kMaxSessionNameLength = 63 - 14;
 // True when `session` matches [A-Za-z0-9_]+ and has at most kMaxSessionNameLength
 // characters, so every channel of the session is a name LCM accepts.
 bool IsValidSessionName(const std::string& session);
+
+// The channel grammar every snapthread tool holds a channel name to: 1 to
+// kMaxChannelNameLength bytes of [A-Za-z0-9_.:/-]. LCM itself takes any bytes but NUL (63 at
+// most on the network, up to 999 in a log file), so a name from the network or a log is
+// hostile text: outside this grammar it is shown only through EscapeForDisplay and never
+// put into a path, a shell command or a script. Session names ([A-Za-z0-9_]) and the
+// project's channels (<SESSION>_SHAPE, ...) are inside it.
+inline constexpr size_t kMaxChannelNameLength = 63;
+bool IsValidChannelName(std::string_view name);
+
+// `text` for a terminal, a HUD, a CSV cell or a summary line: every byte outside the channel
+// grammar's characters (quotes, spaces, ';', '$', '`', '|', '\\', control bytes, non-ASCII)
+// becomes \xNN, so the result is printable, one line, free of shell and gnuplot syntax, and
+// texts shown whole stay distinct (\\ is \x5c). At most `max_bytes` of the input are shown; a longer text
+// ends in "...[N bytes]". A valid channel name comes back unchanged.
+std::string EscapeForDisplay(std::string_view text, size_t max_bytes = 128);
 
 }  // namespace snapthread::transport

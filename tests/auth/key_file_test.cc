@@ -1,6 +1,8 @@
 // The session key file: where it is looked for, what is refused (with the file and the
-// fix in the message), and how the server and snapthread-keygen create it.
+// fix in the message: missing, symbolic link, another owner, group/other bits, a writable
+// or foreign directory), and how snapthread-keygen and the server's --create-key make it.
 #include <gtest/gtest.h>
+#include <pwd.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -107,7 +109,7 @@ TEST_F(KeyFileTest, GroupOrWorldReadableKeyIsRefusedWithTheFix) {
     WriteBytes(path, 32, mode);
     const std::string error = LoadError(path);
     EXPECT_NE(error.find(path), std::string::npos) << error;
-    EXPECT_NE(error.find("chmod 600 " + path), std::string::npos) << error;
+    EXPECT_NE(error.find("chmod 0600 " + path), std::string::npos) << error;
     char octal[8];
     std::snprintf(octal, sizeof octal, "%04o", static_cast<unsigned>(mode));
     EXPECT_NE(error.find(octal), std::string::npos) << error;
@@ -128,7 +130,7 @@ TEST_F(KeyFileTest, OwnerOnlyKeyIsAccepted) {
 TEST_F(KeyFileTest, FixInTheMessageIsQuotedForTheShell) {
   const std::string path = Path("my key");
   WriteBytes(path, 32, 0644);
-  EXPECT_NE(LoadError(path).find("chmod 600 '" + path + "'"), std::string::npos) << LoadError(path);
+  EXPECT_NE(LoadError(path).find("chmod 0600 '" + path + "'"), std::string::npos) << LoadError(path);
 }
 
 TEST_F(KeyFileTest, WrongSizeIsRefused) {
@@ -148,6 +150,83 @@ TEST_F(KeyFileTest, MissingFileSaysHowToMakeOne) {
   EXPECT_NE(error.find(path), std::string::npos) << error;
   EXPECT_NE(error.find("snapthread-keygen"), std::string::npos) << error;
   EXPECT_FALSE(fs::exists(path));  // LoadKey never creates
+}
+
+TEST_F(KeyFileTest, MissingFileIsNeverCreatedAndTheMessageSaysHow) {
+  const std::string path = Path("sesion.key");  // a typo of session.key
+  const std::string error = LoadError(path);
+  EXPECT_NE(error.find("no session key at " + path), std::string::npos) << error;
+  EXPECT_NE(error.find("snapthread-keygen --key " + path), std::string::npos) << error;
+  EXPECT_NE(error.find("--create-key"), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(path));
+}
+
+TEST_F(KeyFileTest, SymbolicLinkIsRefusedNamingTheRealPath) {
+  const std::string real = Path("real.key");
+  WriteBytes(real, 32, 0600);
+  const std::string link = Path("session.key");
+  ASSERT_EQ(symlink(real.c_str(), link.c_str()), 0);
+  const std::string error = LoadError(link);
+  EXPECT_NE(error.find(link), std::string::npos) << error;
+  EXPECT_NE(error.find("symbolic link"), std::string::npos) << error;
+  EXPECT_NE(error.find("use the real path: --key " + fs::canonical(real).string()), std::string::npos)
+      << error;
+  // A dangling link is refused the same way, not reported missing (or created through).
+  const std::string dangling = Path("dangling.key");
+  ASSERT_EQ(symlink(Path("nothing").c_str(), dangling.c_str()), 0);
+  EXPECT_NE(LoadError(dangling).find("symbolic link"), std::string::npos) << LoadError(dangling);
+  EXPECT_THROW(LoadOrCreateKey(At(dangling)), KeyFileError);
+  EXPECT_FALSE(fs::exists(Path("nothing")));
+  // The real path loads.
+  EXPECT_EQ(LoadError(real), "");
+}
+
+TEST_F(KeyFileTest, KeyOwnedByAnotherUserIsRefusedWithChown) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to give a file to another user";
+  const passwd* nobody = getpwnam("nobody");
+  ASSERT_NE(nobody, nullptr);
+  const std::string path = Path("session.key");
+  WriteBytes(path, 32, 0600);
+  ASSERT_EQ(chown(path.c_str(), nobody->pw_uid, nobody->pw_gid), 0);
+  const std::string error = LoadError(path);
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_NE(error.find("owned by nobody"), std::string::npos) << error;
+  EXPECT_NE(error.find("chown root " + path), std::string::npos) << error;
+}
+
+TEST_F(KeyFileTest, GroupOrWorldWritableDirectoryIsRefusedWithChmodGoW) {
+  const std::string sub = Path("shared");
+  ASSERT_TRUE(fs::create_directory(sub));
+  const std::string path = sub + "/session.key";
+  WriteBytes(path, 32, 0600);
+  EXPECT_EQ(LoadError(path), "");
+  for (const mode_t mode : {0770, 0777, 01777, 0702}) {
+    ASSERT_EQ(chmod(sub.c_str(), mode), 0);
+    const std::string error = LoadError(path);
+    EXPECT_NE(error.find("chmod go-w " + sub), std::string::npos) << error;
+    EXPECT_NE(error.find(path), std::string::npos) << error;
+  }
+  // Neither keygen nor --create-key writes a key there.
+  const std::string fresh = sub + "/new.key";
+  EXPECT_THROW(WriteNewKey(At(fresh), false), KeyFileError);
+  EXPECT_THROW(LoadOrCreateKey(At(fresh)), KeyFileError);
+  EXPECT_FALSE(fs::exists(fresh));
+  ASSERT_EQ(chmod(sub.c_str(), 0700), 0);
+  EXPECT_EQ(LoadError(path), "");
+}
+
+TEST_F(KeyFileTest, DirectoryOwnedByAnotherUserIsRefused) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to give a directory to another user";
+  const passwd* nobody = getpwnam("nobody");
+  ASSERT_NE(nobody, nullptr);
+  const std::string sub = Path("theirs");
+  ASSERT_TRUE(fs::create_directory(sub));
+  const std::string path = sub + "/session.key";
+  WriteBytes(path, 32, 0600);
+  ASSERT_EQ(chown(sub.c_str(), nobody->pw_uid, nobody->pw_gid), 0);
+  const std::string error = LoadError(path);
+  EXPECT_NE(error.find("owned by nobody"), std::string::npos) << error;
+  EXPECT_NE(error.find("chown root " + sub), std::string::npos) << error;
 }
 
 TEST_F(KeyFileTest, DirectoryIsRefused) {

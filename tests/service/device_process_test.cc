@@ -35,31 +35,22 @@
 #include "messages/channels.h"
 #include "messages/subscribe.h"
 #include "messages/validate.h"
+#include "device_fake_server.h"
 #include "test_support.h"
 
 namespace snapthread::device {
 namespace {
 
+using testing::DeviceProcess;
+using testing::FakeServer;
+using testing::kNegativeStiffnessNPerM;
+using testing::kSpringNPerM;
 constexpr const char* kUrl = test_support::kLoopbackLcmUrl;
-constexpr double kSpringNPerM = 40.0;
-constexpr double kNegativeStiffnessNPerM = 25.0;
 
 using test_support::ReadFile;
 using test_support::UniqueSession;
 
 std::string DeviceBinary() { return test_support::BinDir() + "/snapthread-device"; }
-
-// A child process with stdout/stderr in <prefix>.out / <prefix>.err.
-class Process : public test_support::ChildProcess {
- public:
-  Process(const std::vector<std::string>& args, const std::string& prefix)
-      : ChildProcess(args, test_support::OutputFiles(prefix + ".out", prefix + ".err")) {}
-  // Exit code, or -1 on a timeout (then the process is killed).
-  int ExitCode(double timeout_s) {
-    int code = -1;
-    return WaitOrKill(timeout_s, &code) ? code : -1;
-  }
-};
 
 // "key": number from the summary JSON (NaN when absent).
 double JsonNumber(const std::string& json, const std::string& key) {
@@ -91,79 +82,6 @@ std::vector<TraceSample> ReadTrace(const std::string& path, std::string* header)
   return rows;
 }
 
-// The fake server: answers each device pose with the spring's local model, signed with
-// the session key and its own epoch, which it announces in a signed solver status every
-// 50 ms (the device learns the epoch from it, as from the real server).
-class FakeServer {
- public:
-  FakeServer(const std::string& session, const auth::SessionKey* key)
-      : channels_(session), lcm_(kUrl), key_(key), epoch_(auth::NewEpoch()) {
-    if (!lcm_.good()) return;
-    messages::Subscribe<&FakeServer::OnPose>(lcm_, channels_.device_state, this);
-    thread_ = std::thread([this] {
-      auto next_status = std::chrono::steady_clock::now();
-      while (!stop_.load()) {
-        lcm_.handleTimeout(10);
-        if (std::chrono::steady_clock::now() >= next_status) {
-          PublishStatus();
-          next_status += std::chrono::milliseconds(50);
-        }
-      }
-    });
-  }
-  ~FakeServer() { Stop(); }
-  bool good() { return lcm_.good(); }
-  void Stop() {
-    stop_.store(true);
-    if (thread_.joinable()) thread_.join();
-  }
-  int poses() const { return poses_.load(); }
-
- private:
-  void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    device_state_t pose;
-    if (!transport::DecodeAndValidate(rbuf, &pose, nullptr)) return;
-    poses_.fetch_add(1);
-    force_model_t m{};
-    m.utime = 0;
-    m.seq = ++seq_;
-    m.device_seq = pose.seq;
-    m.device_utime = pose.utime;
-    // Every 100th model reports a snap (the device counts snaps felt).
-    m.status = m.seq % 100 == 0 ? force_model_t::STATUS_SNAPPED : force_model_t::STATUS_REGULAR;
-    for (int i = 0; i < 3; ++i) {
-      m.u0[i] = pose.position[i];
-      m.f0[i] = -kSpringNPerM * pose.position[i];
-      m.K[i][i] = -kSpringNPerM;
-    }
-    // A negative stiffness along z (dF_z/dz > 0), which the device must clamp to zero in
-    // every model. The sim-path stays at z = 0, so the spring law is unaffected.
-    m.K[2][2] = +kNegativeStiffnessNPerM;
-    if (!auth::Sign(&m, channels_.force_model, epoch_, auth_seq_.Next(), *key_)) return;
-    lcm_.publish(channels_.force_model, &m);
-  }
-
-  void PublishStatus() {
-    solver_status_t st{};
-    st.seq = ++status_seq_;
-    st.scene = "fake";
-    st.method = "spring";
-    if (!auth::Sign(&st, channels_.solver_status, epoch_, auth_seq_.Next(), *key_)) return;
-    lcm_.publish(channels_.solver_status, &st);
-  }
-
-  transport::Channels channels_;
-  lcm::LCM lcm_;
-  const auth::SessionKey* key_;
-  int64_t epoch_;
-  auth::AuthSequence auth_seq_;
-  int64_t status_seq_ = 0;
-  std::thread thread_;
-  std::atomic<bool> stop_{false};
-  std::atomic<int> poses_{0};
-  int64_t seq_ = 0;
-};
-
 std::string WriteScene(const std::string& dir) {
   const std::string path = dir + "/scene.yaml";
   std::ofstream f(path);
@@ -193,7 +111,7 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   ASSERT_TRUE(server->good()) << "udpm on loopback unavailable: " << kUrl;
 
   const double duration_s = 5.0;
-  Process device({bin, "--backend", "sim-path", "--scene", scene, "--session", session,
+  DeviceProcess device({bin, "--backend", "sim-path", "--scene", scene, "--session", session,
                   "--lcm-url", kUrl, "--duration", std::to_string(duration_s), "--speed-m-per-s",
                   "0.04", "--no-rt", "--log-level", "warn", "--trace", dir + "/trace.csv",
                   "--summary", dir + "/summary.json"},
@@ -422,7 +340,7 @@ TEST(DeviceProcessTest, SigtermStopsCleanlyAndPublishesPosesAndStatus) {
   const std::string session = UniqueSession("DEVTEST_TERM");
   Listener listener(session);
   ASSERT_TRUE(listener.good());
-  Process device({bin, "--backend", "virtual-hand", "--scene", WriteScene(dir), "--session",
+  DeviceProcess device({bin, "--backend", "virtual-hand", "--scene", WriteScene(dir), "--session",
                   session, "--lcm-url", kUrl, "--duration", "0", "--no-rt",
                   "--publish-divisor", "4", "--summary", dir + "/summary.json"},
                  dir + "/device");
@@ -479,7 +397,7 @@ TEST(DeviceProcessTest, BadArgumentsExitTwoNamingTheArgument) {
   for (const auto& c : cases) {
     std::vector<std::string> args = {bin};
     args.insert(args.end(), c.args.begin(), c.args.end());
-    Process p(args, dir + "/bad");
+    DeviceProcess p(args, dir + "/bad");
     ASSERT_TRUE(p.started());
     EXPECT_EQ(p.ExitCode(10.0), 2) << c.args[0] << " " << c.args[1];
     const std::string msg = p.Err() + p.Out();
@@ -494,7 +412,7 @@ TEST(DeviceProcessTest, LcmFailureExitsOneWithUrlAndHint) {
   const test_support::ScopedTempDir scoped("device_test");
   const std::string& dir = scoped.path();
   const std::string url = "udpm://239.255.76.67:99999999?ttl=0";
-  Process p({bin, "--backend", "sim-path", "--scene", WriteScene(dir), "--lcm-url", url, "--no-rt",
+  DeviceProcess p({bin, "--backend", "sim-path", "--scene", WriteScene(dir), "--lcm-url", url, "--no-rt",
              "--duration", "1"},
             dir + "/lcmfail");
   ASSERT_TRUE(p.started());

@@ -1,5 +1,6 @@
 // snapthread-report on logs written here with lcm::LogFile: known messages with sequence
 // gaps, a repeat, a snap and clamps; then the same log truncated or damaged.
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -145,8 +146,10 @@ std::string WriteReferenceLog(const std::string& dir) {
   return path;
 }
 
-ProcessResult RunReport(const std::string& log, const std::string& out_dir) {
-  const std::vector<std::string> argv = {BinDir() + "/snapthread-report", log, "--out", out_dir};
+ProcessResult RunReport(const std::string& log, const std::string& out_dir,
+                        const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> argv = {BinDir() + "/snapthread-report", log, "--out", out_dir};
+  argv.insert(argv.end(), extra.begin(), extra.end());
   ChildProcess report(argv, OutputFiles(out_dir + ".stdout", out_dir + ".stderr", true));
   EXPECT_TRUE(report.started());
   return report.Finish(120.0);
@@ -300,6 +303,39 @@ TEST(ReportTest, NothingReadableExitsNonZero) {
   ASSERT_TRUE(r.exited);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("no readable events"), std::string::npos) << r.err;
+}
+
+// A log above --max-log-bytes is refused before it is read, naming its size and the limit.
+TEST(ReportTest, RefusesALogLargerThanTheLimit) {
+  const std::string dir = FreshTempDir("report-size");
+  const std::string log = WriteReferenceLog(dir);
+  const auto size = std::filesystem::file_size(log);
+  const ProcessResult r = RunReport(log, dir + "/out", {"--max-log-bytes", std::to_string(size - 1)});
+  ASSERT_TRUE(r.exited);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(log + " is " + std::to_string(size) + " bytes, larger than the limit of " +
+                       std::to_string(size - 1) + " bytes (--max-log-bytes)"),
+            std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out/summary.txt"));
+  // At the limit it is read.
+  const ProcessResult ok = RunReport(log, dir + "/out", {"--max-log-bytes", std::to_string(size), "--no-plots"});
+  ASSERT_TRUE(ok.exited);
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+}
+
+// The default limit is 2 GiB: a 3 GiB (sparse) log is refused at once, not read for minutes.
+TEST(ReportTest, RefusesAThreeGibLogByDefault) {
+  const std::string dir = FreshTempDir("report-huge");
+  const std::string log = WriteReferenceLog(dir);
+  std::filesystem::resize_file(log, uint64_t(3) << 30);
+  const auto t0 = std::chrono::steady_clock::now();
+  const ProcessResult r = RunReport(log, dir + "/out");
+  ASSERT_TRUE(r.exited);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("3221225472 bytes, larger than the limit of 2147483648 bytes"),
+            std::string::npos) << r.err;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+            10.0 * SpeedScale());
 }
 
 }  // namespace

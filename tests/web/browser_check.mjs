@@ -10,7 +10,8 @@
 //   page URL OUT_DIR SECONDS: one 1280x900 page, a screenshot of all of it after SECONDS
 //        (the README's picture).
 //   auth URL_WITHOUT_TOKEN OUT_DIR TOKEN: HTTP status of the page and of a WebSocket
-//        upgrade without, with a wrong and with the right token (no browser).
+//        upgrade without, with a wrong and with the right token (no browser); the page with
+//        the right token redirects (303), setting the cookie the script then loads with.
 import { createRequire } from 'node:module';
 import { readdirSync, readFileSync } from 'node:fs';
 import http from 'node:http';
@@ -207,9 +208,12 @@ async function wholePage(browser, seconds) {
   return { screenshot: shot, ...(await p.page.evaluate(() => ({ ...document.body.dataset }))) };
 }
 
-function status(target, headers = {}) {
+function status(target, headers = {}, withCookie = false) {
   return new Promise((resolve, reject) => {
-    const req = http.get(target, { headers }, (res) => { res.resume(); resolve(res.statusCode); });
+    const req = http.get(target, { headers }, (res) => {
+      res.resume();
+      resolve(withCookie ? { status: res.statusCode, cookie: (res.headers['set-cookie'] || [''])[0] } : res.statusCode);
+    });
     req.on('upgrade', (res, socket) => { socket.destroy(); resolve(res.statusCode); });
     req.on('error', reject);
     req.setTimeout(10000, () => req.destroy(new Error('timeout')));
@@ -217,16 +221,21 @@ function status(target, headers = {}) {
 }
 
 async function auth(token) {
-  const upgrade = { Connection: 'Upgrade', Upgrade: 'websocket', 'Sec-WebSocket-Version': '13',
-                    'Sec-WebSocket-Key': 'dGhlIHNhbXBsZSBub25jZQ==' };
   const base = url.replace(/\/$/, '');
+  const upgrade = { Connection: 'Upgrade', Upgrade: 'websocket', 'Sec-WebSocket-Version': '13',
+                    'Sec-WebSocket-Key': 'dGhlIHNhbXBsZSBub25jZQ==', Origin: base };
+  const right = await status(`${base}/?token=${token}`, {}, true);
+  const cookie = { Cookie: right.cookie.split(';')[0] };
   return {
     page_without: await status(`${base}/`),
     script_without: await status(`${base}/app.js`),
     page_wrong: await status(`${base}/?token=${'0'.repeat(token.length)}`),
-    page_right: await status(`${base}/?token=${token}`),
+    page_right: right.status,
+    page_cookie: await status(`${base}/`, cookie),
+    script_cookie: await status(`${base}/app.js`, cookie),
     ws_without: await status(`${base}/ws`, upgrade),
     ws_right: await status(`${base}/ws?token=${token}`, upgrade),
+    ws_cookie: await status(`${base}/ws`, { ...upgrade, ...cookie }),
   };
 }
 

@@ -3,7 +3,7 @@
 // + sim-path device, unique session and key): two pages each receive >= 30 shapes/s, draw
 // >= 10 frames/s with WebGL and show the thread in the tube's colour on a screenshot;
 // the recorded session replays in the page to its last frame; beyond loopback a request
-// without the observer token gets 401. "Works in Chromium and Firefox": the same live
+// without the observer token gets 401, and with it (in the cookie it sets) 200. "Works in Chromium and Firefox": the same live
 // page and replay in headless Debian firefox-esr, driven by puppeteer-core over WebDriver
 // BiDi. Headless Firefox has WebGL only with an X display to open Mesa's GL on (with none
 // it reports "tryNativeGL () ... FEATURE_FAILURE_WEBGL_EXHAUSTED_DRIVERS"; there is no
@@ -210,8 +210,11 @@ TEST_F(WebBrowserTest, BeyondLoopbackARequestWithoutTheTokenGets401) {
   EXPECT_EQ(Field(result, "script_without"), 401);
   EXPECT_EQ(Field(result, "page_wrong"), 401);
   EXPECT_EQ(Field(result, "ws_without"), 401);
-  EXPECT_EQ(Field(result, "page_right"), 200);
+  EXPECT_EQ(Field(result, "page_right"), 303) << "the token moves into a cookie";
+  EXPECT_EQ(Field(result, "page_cookie"), 200);
+  EXPECT_EQ(Field(result, "script_cookie"), 200);
   EXPECT_EQ(Field(result, "ws_right"), 101);
+  EXPECT_EQ(Field(result, "ws_cookie"), 101);
 }
 
 }  // namespace

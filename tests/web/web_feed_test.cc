@@ -65,6 +65,49 @@ TEST(LiveFeed, PassesOnlyMessagesSignedWithTheSessionKey) {
 }
 
 
+// A sender without the key invents 100 device ids (the bridge tracks 16 devices) before
+// the genuine device speaks: nothing is kept for an id whose message fails its MAC, so
+// the genuine device's status still passes, and the forged ones are refused and counted.
+TEST(LiveFeed, ForgedDeviceIdsTakeNoPlaceOfTheGenuineDevice) {
+  const auth::SessionKey key = auth::SessionKey::Generate();
+  const std::string session = test_support::UniqueSession("WEBIDS");
+  const transport::Channels channels(session);
+  std::mutex mutex;
+  std::string last_device;
+  LiveFeed feed(test_support::kLoopbackLcmUrl, session, key, [&](FeedKind k, Text t) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (k == FeedKind::kDeviceStatus) last_device = *t;
+  });
+  feed.Start();
+  lcm::LCM lcm(test_support::kLoopbackLcmUrl);
+  ASSERT_TRUE(lcm.good());
+  const int64_t epoch = auth::NewEpoch();
+  auth::AuthSequence seq;
+  solver_status_t status = test_support::Sample<solver_status_t>();
+  ASSERT_TRUE(auth::Sign(&status, channels.solver_status, epoch, seq.Next(), key));
+  lcm.publish(channels.solver_status, &status);
+  ASSERT_TRUE(test_support::WaitUntil([&] { return feed.counts().epoch == epoch; }, 5.0));
+  constexpr int kForged = 100;
+  for (int i = 0; i < kForged; ++i) {
+    device_status_t forged = test_support::Sample<device_status_t>();
+    forged.device_id = "forged-" + std::to_string(i);
+    forged.epoch = epoch;  // read off the network: the epoch is no secret
+    forged.auth_seq = seq.Next();
+    for (int b = 0; b < 32; ++b) forged.mac[b] = static_cast<uint8_t>(i + b);
+    lcm.publish(channels.device_status, &forged);
+  }
+  // (UDP on loopback may drop a few: the count is of those the feed got.)
+  ASSERT_TRUE(test_support::WaitUntil([&] { return feed.counts().auth_rejected >= kForged / 2; }, 5.0));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  device_status_t genuine = test_support::Sample<device_status_t>();
+  ASSERT_TRUE(auth::Sign(&genuine, channels.device_status, epoch, seq.Next(), key));
+  lcm.publish(channels.device_status, &genuine);
+  EXPECT_TRUE(test_support::WaitUntil([&] { return feed.counts().received[3] == 1; }, 5.0))
+      << "the genuine device's status was refused after " << feed.counts().auth_rejected << " forged ones";
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_NE(last_device.find("\"device_id\":\"sim-path\""), std::string::npos) << last_device;
+}
+
 // Force models at the update rate (a burst of 2000 here, sent as fast as LCM sends): every
 // one received is vetted and counted, fewer are turned into JSON, and the newest is always
 // among them once the burst ends.

@@ -1,6 +1,8 @@
 // Helpers shared by the bench's charts (internal to tools/bench/).
 #pragma once
 
+#include <sys/types.h>
+
 #include <chrono>
 #include <string>
 #include <vector>
@@ -26,5 +28,13 @@ double ForceScaleOf(const Scene& scene);
 
 // The scene solved with `method`, `cutoff` and an iteration budget (0 = unlimited).
 Scene WithSolver(const Scene& scene, const std::string& method, double cutoff, int budget);
+
+// Child processes of the service and flood charts (service.cc).
+// The whole file ("" when it cannot be read).
+std::string ReadFile(const std::string& path);
+// Starts argv[0] with stdout and stderr into `log`; returns the pid or -1.
+pid_t Spawn(const std::vector<std::string>& args, const std::string& log);
+// Waits for pid up to `timeout_s`; returns its exit status, or -1 after killing it.
+int WaitFor(pid_t pid, double timeout_s);
 
 }  // namespace snapthread

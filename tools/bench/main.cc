@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench.h"
+#include "flood.h"
 #include "path.h"
 #include "solvers/registry.h"
 #include "tool_main.h"
@@ -70,9 +71,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   bool quick = false, no_plot = false, fixed_length = false, no_ceres = false;
   int repetitions = 0, reference_n = 0, path_steps = 0;
-  double service_duration = 0.0, target_force_error = 0.0, target_rate_hz = 0.0;
+  double service_duration = 0.0, target_force_error = 0.0, target_rate_hz = 0.0, flood_rate = 10000.0;
+  std::string flood_scene = "curve2d_snap";
   app.add_flag("--quick", quick, "small grids, one repetition, short service run (for development)");
-  app.add_option("--only", only, "benchmarks to run: accuracy,scaling,service,path,rod (comma-separated)");
+  app.add_option("--only", only, "benchmarks to run: accuracy,scaling,service,path,rod,flood (comma-separated)");
   app.add_option("--out", out_dir, "output folder (CSV, gnuplot scripts, PNG charts, summary.txt)");
   app.add_option("--scenes", scenes_dir, "folder with the scene files");
   app.add_option("--bin-dir", bin_dir, "folder with snapthread-server and snapthread-device (service)");
@@ -93,6 +95,9 @@ int main(int argc, char** argv) {
   app.add_option("--service-scenes", service_scenes, "service: scene names (default curve2d_snap,thread3d_loop)");
   app.add_option("--service-duration", service_duration, "service: seconds per run (default 10, quick 3)")
       ->check(CLI::Range(1.0, 600.0));
+  app.add_option("--flood-rate", flood_rate, "flood: forged messages per second on each session channel (default 10000)")
+      ->check(CLI::Range(1.0, 1e6));
+  app.add_option("--flood-scene", flood_scene, "flood: scene name (default curve2d_snap); seconds per run: --service-duration");
   app.add_flag("--no-plot", no_plot, "skip the gnuplot charts");
   app.add_option("--advise", advise, "scene file: advise the smallest n and cheapest method/cutoff/budget instead");
   app.add_option("--set", sets, "advise: scene override key=value (e.g. targets.rate_hz=20000), repeatable");
@@ -143,8 +148,9 @@ int main(int argc, char** argv) {
     const auto parts = SplitList(only);
     auto want = [&](const char* p) { return std::find(parts.begin(), parts.end(), p) != parts.end(); };
     for (const auto& p : parts)
-      if (p != "accuracy" && p != "scaling" && p != "service" && p != "path" && p != "rod")
-        throw std::invalid_argument("--only: unknown benchmark '" + p + "' (accuracy, scaling, service, path, rod)");
+      if (p != "accuracy" && p != "scaling" && p != "service" && p != "path" && p != "rod" && p != "flood")
+        throw std::invalid_argument("--only: unknown benchmark '" + p +
+                                    "' (accuracy, scaling, service, path, rod, flood)");
     fs::create_directories(out_dir);
     const std::string out_abs = fs::absolute(out_dir).string();
     std::ofstream summary(fs::path(out_dir) / "summary.txt");
@@ -277,6 +283,33 @@ int main(int argc, char** argv) {
       summary << table.str() << '\n';
       for (const auto& r : runs)
         if (!r.ok) std::cerr << "snapthread-bench: service run failed: " << r.error << '\n';
+    }
+    if (want("flood")) {
+      // A keyless flood of forged messages on every session channel during a genuine
+      // session (flood.h); not part of the default set (it loads the machine on purpose).
+      FloodBenchOptions o;
+      o.bin_dir = bin_dir;
+      o.scenes_dir = scenes_dir;
+      o.scene = flood_scene;
+      o.rate_per_channel_hz = flood_rate;
+      o.work_dir = (fs::path(out_dir) / "flood").string();
+      if (quick) {
+        o.duration_s = 3.0;
+        o.repetitions = 1;
+      }
+      if (service_duration > 0) o.duration_s = service_duration;
+      if (repetitions > 0) o.repetitions = repetitions;
+      const auto runs = RunFloodBench(o, &std::cerr);
+      std::ofstream csv(fs::path(out_dir) / "flood.csv");
+      WriteFloodCsv(runs, csv);
+      std::ostringstream table;
+      table << "== flood: " << o.scene << ", server + device (virtual-hand, --no-rt, 1 kHz) on loopback, "
+            << o.duration_s << " s per run, " << o.rate_per_channel_hz << " forged msgs/s per channel\n";
+      PrintFloodSummary(runs, table);
+      std::cout << table.str();
+      summary << table.str() << '\n';
+      for (const auto& r : runs)
+        if (!r.ok) std::cerr << "snapthread-bench: flood run failed: " << r.error << '\n';
     }
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     summary << "total " << total << " s\n";

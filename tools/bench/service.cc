@@ -46,8 +46,6 @@ bool JsonNumber(const std::string& json, const std::string& key, double* value) 
   return true;
 }
 
-namespace {
-
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path);
   std::stringstream ss;
@@ -55,7 +53,6 @@ std::string ReadFile(const std::string& path) {
   return ss.str();
 }
 
-// Starts argv[0] with stdout and stderr into `log`; returns the pid or -1.
 pid_t Spawn(const std::vector<std::string>& args, const std::string& log) {
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
@@ -70,7 +67,6 @@ pid_t Spawn(const std::vector<std::string>& args, const std::string& log) {
   return rc == 0 ? pid : -1;
 }
 
-// Waits for pid up to `timeout_s`; returns its exit status, or -1 after killing it.
 int WaitFor(pid_t pid, double timeout_s) {
   const auto t0 = Clock::now();
   while (true) {
@@ -86,8 +82,6 @@ int WaitFor(pid_t pid, double timeout_s) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
 }
-
-}  // namespace
 
 ServiceRun RunServiceOnce(const ServiceOptions& o, const std::string& scene, int index) {
   ServiceRun run;

@@ -1,12 +1,17 @@
 #include "gnuplot_plots.h"
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+
+#include "gnuplot_runner.h"
+#include "messages/channels.h"
 
 namespace snapthread::report {
 namespace {
 
+// Every script names its files relative to the output directory (gnuplot runs there), so no
+// path reaches gnuplot's command language; the only log-derived text is the session name in
+// the titles, and only a valid one (SessionLabel).
 constexpr char kPreamble[] =
     "set terminal pngcairo size 1100,700 font ',10' noenhanced\n"
     "set datafile separator ','\n"
@@ -14,41 +19,42 @@ constexpr char kPreamble[] =
     "set key top right\n"
     "bin(x,w) = w*floor(x/w) + w/2\n";
 
+// The session for a title: a name of the session grammar ([A-Za-z0-9_], which holds no
+// quote, backquote, newline or other gnuplot syntax), else a fixed placeholder. The review's
+// session is one already (InferSession, --session), so this is the second wall.
+std::string SessionLabel(const std::string& session) {
+  return transport::IsValidSessionName(session) ? session : "unnamed session";
+}
+
 // Runs one script; on success the PNG must exist and be non-empty.
 bool RunGnuplot(const std::string& dir, const std::string& name, const std::string& body,
                 PlotOutcome* out) {
-  const std::string script = dir + "/" + name + ".gp";
   const std::string png = name + ".png";
-  {
-    std::ofstream f(script);
-    f << kPreamble << "set output '" << dir << "/" << png << "'\n" << body;
-  }
-  const std::string cmd = "gnuplot '" + script + "' > '" + dir + "/" + name + ".gnuplot.log' 2>&1";
-  const int rc = std::system(cmd.c_str());
   std::error_code ec;
+  std::filesystem::remove(dir + "/" + png, ec);  // a PNG of an earlier run is no proof
+  const GnuplotRun run =
+      RunGnuplotScript(dir, name, kPreamble + ("set output '" + png + "'\n") + body);
   const auto size = std::filesystem::file_size(dir + "/" + png, ec);
-  if (rc != 0 || ec || size == 0) {
-    out->notes.push_back(png + " failed: gnuplot exit " + std::to_string(rc) + ", see " + name +
-                         ".gnuplot.log");
+  if (!run.ok || ec || size == 0) {
+    out->notes.push_back(png + " failed: " + (run.ok ? "no image written" : run.problem));
     return false;
   }
   out->written.push_back(png);
   return true;
 }
 
-std::string Csv(const std::string& dir, const std::string& name) {
-  return "'" + dir + "/" + name + "'";
-}
+// A data file of the output directory, by its fixed name.
+std::string Csv(const std::string& name) { return "'" + name + "'"; }
 
 }  // namespace
 
 PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
   PlotOutcome out;
-  const std::string ch = r.session();
+  const std::string ch = SessionLabel(r.session());
   if (r.HasForce()) {
     std::string body = "set title 'Force on the grasp (" + ch + "_FORCE_MODEL f0); snaps marked'\n"
                        "set xlabel 'time [s]'\nset ylabel 'force [N]'\n"
-                       "plot " + Csv(dir, "force.csv") + " skip 1 using 1:5 with lines lw 2 title '|F|', "
+                       "plot " + Csv("force.csv") + " skip 1 using 1:5 with lines lw 2 title '|F|', "
                        "'' skip 1 using 1:2 with lines title 'Fx', "
                        "'' skip 1 using 1:3 with lines title 'Fy', "
                        "'' skip 1 using 1:4 with lines title 'Fz'";
@@ -57,7 +63,7 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
     std::string header, first;
     std::getline(snaps, header);
     if (std::getline(snaps, first) && !first.empty()) {
-      body += ", " + Csv(dir, "snaps.csv") +
+      body += ", " + Csv("snaps.csv") +
               " skip 1 using 1:2 with impulses lw 2 lc rgb 'red' title 'snap', "
               "'' skip 1 using 1:2 with points pt 7 ps 1.5 lc rgb 'red' notitle";
     }
@@ -72,7 +78,7 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
                    "_SOLVER_STATUS)'\nset xlabel 'time [s]'\n"
                    "set ylabel 'knot determinant'\nset yrange [0:*]\n"
                    "set ytics add ('unknot 1' 1, 'trefoil 3' 3, 'figure-eight 5' 5)\n"
-                   "plot " + Csv(dir, "knot.csv") + " skip 1 using 1:3 with steps lw 2 "
+                   "plot " + Csv("knot.csv") + " skip 1 using 1:3 with steps lw 2 "
                    "title '|Delta(-1)|'\nset ylabel 'active contacts'\n"
                    "set ytics autofreq\nplot '' skip 1 using 1:4 with steps lw 2 lc rgb 'red' "
                    "title 'contacts'\nunset multiplot\n",
@@ -84,12 +90,12 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
   if (r.HasSolve() || r.HasSolverStatus()) {
     std::string body = "set multiplot layout 3,1 title 'Solver (" + ch + ")'\nset xlabel 'time [s]'\n";
     if (r.HasSolve()) {
-      body += "set ylabel 'iterations'\nplot " + Csv(dir, "solve.csv") +
+      body += "set ylabel 'iterations'\nplot " + Csv("solve.csv") +
               " skip 1 using 1:2 with steps title 'iterations per update'\n"
               "set logscale y\nset ylabel '||E_x||'\nplot '' skip 1 using 1:($3 > 0 ? $3 : 1e-300) "
               "with points pt 7 ps 0.3 title 'residual'\nunset logscale y\n";
     } else {
-      body += "set ylabel 'iterations'\nplot " + Csv(dir, "solver_status.csv") +
+      body += "set ylabel 'iterations'\nplot " + Csv("solver_status.csv") +
               " skip 1 using 1:4 with steps title 'iterations'\n"
               "set logscale y\nset ylabel '||E_x||'\nplot '' skip 1 using 1:5 with points "
               "title 'residual'\nunset logscale y\n";
@@ -97,9 +103,9 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
     if (r.HasSolverStatus()) {
       body += "set ylabel 'method'\nset yrange [-0.5:3.5]\n"
               "set ytics ('newton' 0, 'newton-ls' 1, 'higher-order' 2, 'other' 3)\n"
-              "plot " + Csv(dir, "solver_status.csv") + " skip 1 using 1:3 with steps lw 2 title 'method'\n";
+              "plot " + Csv("solver_status.csv") + " skip 1 using 1:3 with steps lw 2 title 'method'\n";
     } else {
-      body += "set ylabel 'solve [us]'\nplot " + Csv(dir, "solve.csv") +
+      body += "set ylabel 'solve [us]'\nplot " + Csv("solve.csv") +
               " skip 1 using 1:4 with points pt 7 ps 0.3 title 'solve time'\n";
     }
     body += "unset multiplot\n";
@@ -111,7 +117,7 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
   if (r.HasDevice()) {
     const std::string body =
         "set multiplot layout 2,1 title 'Device (" + ch + "_DEVICE_STATUS)'\nset xlabel 'time [s]'\n"
-        "set ylabel 'tick lateness [us]'\nplot " + Csv(dir, "device_status.csv") +
+        "set ylabel 'tick lateness [us]'\nplot " + Csv("device_status.csv") +
         " skip 1 using 1:3 with lines title 'p50', '' skip 1 using 1:4 with lines title 'p99', "
         "'' skip 1 using 1:5 with lines title 'max'\n"
         "set ylabel 'model age [ms]'\nplot '' skip 1 using 1:6 with lines title 'model age'\n"
@@ -120,28 +126,28 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
     // Histograms of the per-window statistics the device publishes (~2 Hz windows).
     const std::string hist =
         "set multiplot layout 1,2 title 'Latency histograms (" + ch + ")'\n"
-        "stats " + Csv(dir, "device_status.csv") + " skip 1 using 5 nooutput\n"
+        "stats " + Csv("device_status.csv") + " skip 1 using 5 nooutput\n"
         "w = STATS_max > 0 ? STATS_max / 40.0 : 1.0\nset boxwidth w\nset xrange [0:STATS_max + 2*w]\n"
         "set xlabel 'tick lateness per device window [us]'\nset ylabel 'windows'\n"
         "set style fill solid 0.5\n"
-        "plot " + Csv(dir, "device_status.csv") + " skip 1 using (bin($3,w)):(1.0) smooth freq with boxes title 'p50', "
+        "plot " + Csv("device_status.csv") + " skip 1 using (bin($3,w)):(1.0) smooth freq with boxes title 'p50', "
         "'' skip 1 using (bin($4,w)):(1.0) smooth freq with boxes title 'p99'\n" +
         (r.HasRoundTrip()
-             ? "stats " + Csv(dir, "round_trip.csv") + " skip 1 using 2 nooutput\n"
+             ? "stats " + Csv("round_trip.csv") + " skip 1 using 2 nooutput\n"
                "w = STATS_max > 0 ? STATS_max / 40.0 : 1.0\nset boxwidth w\nset xrange [0:STATS_max + 2*w]\n"
                "set xlabel 'round trip, pose -> model as logged [us]'\nset ylabel 'models'\n"
-               "plot " + Csv(dir, "round_trip.csv") + " skip 1 using (bin($2,w)):(1.0) smooth freq with boxes title 'round trip'\n"
+               "plot " + Csv("round_trip.csv") + " skip 1 using (bin($2,w)):(1.0) smooth freq with boxes title 'round trip'\n"
              : "set xlabel 'round trip'\nunset key\nset label 1 'no pose/model pairs in the log' at graph 0.5, graph 0.5 center\n"
                "plot [0:1][0:1] NaN notitle\n") +
         "unset multiplot\n";
     RunGnuplot(dir, "latency_hist", hist, &out);
   } else if (r.HasRoundTrip()) {
     const std::string hist =
-        "stats " + Csv(dir, "round_trip.csv") + " skip 1 using 2 nooutput\n"
+        "stats " + Csv("round_trip.csv") + " skip 1 using 2 nooutput\n"
         "w = STATS_max > 0 ? STATS_max / 40.0 : 1.0\nset boxwidth w\nset xrange [0:STATS_max + 2*w]\nset style fill solid 0.5\n"
         "set title 'Round trip, pose -> model as logged (" + ch + ")'\n"
         "set xlabel 'round trip [us]'\nset ylabel 'models'\n"
-        "plot " + Csv(dir, "round_trip.csv") + " skip 1 using (bin($2,w)):(1.0) smooth freq with boxes title 'round trip'\n";
+        "plot " + Csv("round_trip.csv") + " skip 1 using (bin($2,w)):(1.0) smooth freq with boxes title 'round trip'\n";
     RunGnuplot(dir, "latency_hist", hist, &out);
     out.notes.push_back("device.png not drawn: no " + ch + "_DEVICE_STATUS messages");
   } else {

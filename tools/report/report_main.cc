@@ -1,6 +1,8 @@
 // snapthread-report LOGFILE [--out DIR] [--session NAME]: review of a logged session.
 // Exit 0 when a report was written (with a warning on stderr when the log was only partly
-// readable), 2 when nothing could be read, 1 on usage errors.
+// readable), 2 when nothing could be read or the log is larger than --max-log-bytes, 1 on
+// usage errors. Every byte of the log is hostile: channel names and strings are shown
+// escaped, only a valid session name is used, and gnuplot runs without a shell.
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -10,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "gnuplot_plots.h"
+#include "messages/channels.h"
 #include "log_reader.h"
 #include "session_review.h"
 
@@ -17,13 +20,38 @@ int main(int argc, char** argv) {
   using namespace snapthread::report;
   std::string log_path, out_dir, session;
   bool no_plots = false;
+  // A review holds every force model in memory: 2 GiB of log is hours of a session.
+  int64_t max_log_bytes = int64_t{2} << 30;
   CLI::App app{"snapthread-report: turns an LCM log of a snapthread session into CSV files, "
                "gnuplot PNG plots and summary.txt"};
   app.add_option("LOGFILE", log_path, "LCM log written by lcm-logger")->required();
   app.add_option("--out", out_dir, "output directory (default: <LOGFILE>.report)");
   app.add_option("--session", session, "session name (default: the busiest one in the log)");
   app.add_flag("--no-plots", no_plots, "write CSV and summary only (no gnuplot)");
+  app.add_option("--max-log-bytes", max_log_bytes,
+                 "refuse a log larger than this (split long sessions: snapthread-logger --max-bytes)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
+  if (!session.empty() && !snapthread::transport::IsValidSessionName(session)) {
+    std::fprintf(stderr, "snapthread-report: bad --session %s: expected 1 to %zu characters of "
+                         "[A-Za-z0-9_]\n",
+                 snapthread::transport::EscapeForDisplay(session).c_str(),
+                 snapthread::transport::kMaxSessionNameLength);
+    return 1;
+  }
+  {
+    std::error_code size_error;
+    const auto size = std::filesystem::file_size(log_path, size_error);
+    if (!size_error && size > uint64_t(max_log_bytes)) {
+      std::fprintf(stderr,
+                   "snapthread-report: %s is %llu bytes, larger than the limit of %lld bytes "
+                   "(--max-log-bytes): refused. Split the session (snapthread-logger "
+                   "--max-bytes) or raise --max-log-bytes\n",
+                   log_path.c_str(), static_cast<unsigned long long>(size),
+                   static_cast<long long>(max_log_bytes));
+      return 2;
+    }
+  }
   if (out_dir.empty()) out_dir = log_path + ".report";
 
   std::string error;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "messages/channels.h"
 #include "messages/validate.h"
 
 namespace snapthread::report {
@@ -14,6 +15,10 @@ namespace {
 constexpr const char* kSuffixes[] = {"_DEVICE_STATE", "_FORCE_MODEL",   "_SHAPE",
                                      "_SOLVER_STATUS", "_DEVICE_STATUS", "_COMMAND"};
 constexpr size_t kMaxRememberedPoses = 20000;
+
+// Text from the log (channel names, method and knot strings) as it may appear in the
+// summary and in CSV cells: escaped (no comma, quote, newline or control byte survives).
+std::string Shown(const std::string& text) { return transport::EscapeForDisplay(text); }
 
 std::string TypeOf(const std::string& channel, const std::string& session) {
   if (channel.rfind(session + "_", 0) != 0) return "";
@@ -63,7 +68,10 @@ std::string InferSession(const std::map<std::string, int64_t>& channel_counts) {
       const std::string s(suffix);
       if (channel.size() > s.size() &&
           channel.compare(channel.size() - s.size(), s.size(), s) == 0) {
-        per_session[channel.substr(0, channel.size() - s.size())] += n;
+        // Only a name of the session grammar can be a session: a channel such as
+        // LAB1_';system "id"#_FORCE_MODEL is a foreign channel, counted and shown escaped.
+        const std::string session = channel.substr(0, channel.size() - s.size());
+        if (transport::IsValidSessionName(session)) per_session[session] += n;
       }
     }
   }
@@ -81,7 +89,14 @@ void SessionReview::Add(const lcm::LogEvent& e) {
   if (t0_us_ < 0) t0_us_ = e.timestamp;
   const double t = TimeS(e.timestamp);
   last_s_ = std::max(last_s_, t);
-  ChannelStats& c = channels_[e.channel];
+  auto found = channels_.find(e.channel);
+  if (found == channels_.end() && channels_.size() >= kMaxListedChannels) {
+    // A log with ever new channel names cannot grow the table without bound.
+    unlisted_messages_++;
+    unlisted_bytes_ += e.datalen;
+    return;
+  }
+  ChannelStats& c = found != channels_.end() ? found->second : channels_[e.channel];
   if (c.messages == 0) {
     c.type = TypeOf(e.channel, session_);
     c.first_s = t;
@@ -194,7 +209,7 @@ std::vector<std::string> SessionReview::WriteCsv(const std::string& dir) const {
          "solve_us_p50,solve_us_p99,dropped_poses\n";
     for (const auto& r : status_) {
       const int mi = r.method == "newton" ? 0 : r.method == "newton-ls" ? 1 : r.method == "higher-order" ? 2 : 3;
-      f << r.t_s << ',' << r.method << ',' << mi << ',' << r.iterations << ',' << r.residual << ','
+      f << r.t_s << ',' << Shown(r.method) << ',' << mi << ',' << r.iterations << ',' << r.residual << ','
         << r.lambda_min << ',' << r.negative_pivots << ',' << r.update_rate_hz << ','
         << r.solve_us_p50 << ',' << r.solve_us_p99 << ',' << r.dropped_poses << '\n';
     }
@@ -203,7 +218,7 @@ std::vector<std::string> SessionReview::WriteCsv(const std::string& dir) const {
     auto f = open("knot.csv");
     f << "t_s,knot,knot_determinant,contacts\n";
     for (const auto& r : knot_) {
-      f << r.t_s << ',' << (r.knot.empty() ? "-" : r.knot) << ',' << r.determinant << ','
+      f << r.t_s << ',' << (r.knot.empty() ? "-" : Shown(r.knot)) << ',' << r.determinant << ','
         << r.contacts << '\n';
     }
   }
@@ -229,7 +244,7 @@ std::vector<std::string> SessionReview::WriteCsv(const std::string& dir) const {
     auto f = open("channels.csv");
     f << "channel,type,messages,rejected,seq_first,seq_highest,missing,gaps,out_of_order\n";
     for (const auto& [name, c] : channels_) {
-      f << name << ',' << c.type << ',' << c.messages << ',' << c.rejected << ','
+      f << Shown(name) << ',' << c.type << ',' << c.messages << ',' << c.rejected << ','
         << (c.has_seq ? c.seq.first() : 0) << ',' << (c.has_seq ? c.seq.highest() : 0) << ','
         << c.seq.missing() << ',' << c.seq.gap_count() << ',' << c.seq.out_of_order() << '\n';
     }
@@ -251,7 +266,7 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
   s << "channels (messages, rate, rejected, sequence numbers):\n";
   for (const auto& [name, c] : channels_) {
     const double span = c.last_s - c.first_s;
-    s << "channel " << name << " type " << (c.type.empty() ? "-" : c.type) << " messages "
+    s << "channel " << Shown(name) << " type " << (c.type.empty() ? "-" : c.type) << " messages "
       << c.messages << " rate_hz " << Fmt("%.1f", span > 0 ? (c.messages - 1) / span : 0.0)
       << " rejected " << c.rejected;
     if (c.has_seq) {
@@ -261,12 +276,22 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
     s << "\n";
     if (c.rejected > 0) s << "  first rejection: " << c.first_rejection << "\n";
   }
+  if (unlisted_messages_ > 0) {
+    s << "channels beyond the first " << kMaxListedChannels << ": " << unlisted_messages_
+      << " messages (" << unlisted_bytes_ << " bytes), not listed\n";
+  }
+  int invalid_names = 0;
+  for (const auto& [name, c] : channels_) invalid_names += !transport::IsValidChannelName(name);
+  if (invalid_names > 0) {
+    s << "channel names outside the channel grammar [A-Za-z0-9_.:/-]{1,63}: " << invalid_names
+      << " (shown escaped, \\xNN per byte; never taken as a session)\n";
+  }
   s << "\nsequence gaps (seq after -> seq before: missing; first "
     << SequenceTracker::kMaxListedGaps << " per channel):\n";
   bool any_gap = false;
   for (const auto& [name, c] : channels_) {
     for (const auto& g : c.seq.gaps()) {
-      s << "gap " << name << " " << g.after << " -> " << g.before << ": " << g.Missing() << "\n";
+      s << "gap " << Shown(name) << " " << g.after << " -> " << g.before << ": " << g.Missing() << "\n";
       any_gap = true;
     }
   }
@@ -310,7 +335,8 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
   if (!status_.empty()) {
     std::string methods;
     for (const auto& r : status_) {
-      if (methods.find(r.method) == std::string::npos) methods += (methods.empty() ? "" : ", ") + r.method;
+      const std::string m = Shown(r.method);
+      if (methods.find(m) == std::string::npos) methods += (methods.empty() ? "" : ", ") + m;
     }
     s << "methods: " << methods << "; dropped_poses (latest wins) " << status_.back().dropped_poses
       << "\n";
@@ -332,12 +358,12 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
         s << " ...";
         break;
       }
-      s << " " << Fmt("%.3f", r.t_s) << " " << (r.knot.empty() ? "-" : r.knot) << " (det "
+      s << " " << Fmt("%.3f", r.t_s) << " " << (r.knot.empty() ? "-" : Shown(r.knot)) << " (det "
         << r.determinant << ")";
     }
     int max_contacts = 0;
     for (const auto& r : knot_) max_contacts = std::max(max_contacts, r.contacts);
-    s << "\nknot_last: " << (knot_.back().knot.empty() ? "-" : knot_.back().knot)
+    s << "\nknot_last: " << (knot_.back().knot.empty() ? "-" : Shown(knot_.back().knot))
       << "; contacts max " << max_contacts << " last " << knot_.back().contacts << "\n";
   }
 

@@ -43,12 +43,16 @@ struct DeviceRow {
 struct KnotRow { double t_s; std::string knot; int determinant; int contacts; };
 struct RoundTripRow { double t_s; double loop_us; double server_us; };
 
-// Picks the session with the most messages among channels named <SESSION>_<KNOWN SUFFIX>;
-// "" when there is none.
+// Picks the session with the most messages among channels named <SESSION>_<KNOWN SUFFIX>
+// whose <SESSION> is a valid session name (transport::IsValidSessionName); "" when there is
+// none. A hostile channel name is never chosen, however busy.
 std::string InferSession(const std::map<std::string, int64_t>& channel_counts);
 
 class SessionReview {
  public:
+  // Channels listed one by one; messages on further channels are only counted.
+  static constexpr size_t kMaxListedChannels = 1000;
+
   explicit SessionReview(std::string session);
   void Add(const lcm::LogEvent& event);
 
@@ -75,7 +79,8 @@ class SessionReview {
   std::string session_;
   int64_t t0_us_ = -1;
   double last_s_ = 0.0;
-  std::map<std::string, ChannelStats> channels_;
+  std::map<std::string, ChannelStats> channels_;  // by the raw name; shown escaped
+  int64_t unlisted_messages_ = 0, unlisted_bytes_ = 0;  // beyond kMaxListedChannels
   std::vector<ForceRow> force_;
   std::vector<double> snap_times_s_;
   std::vector<SolveRow> solve_;

@@ -1,5 +1,7 @@
-// The WebSocket to the bridge: /ws on the page's own host, with the page's ?token= (the
-// bridge refuses the upgrade without it when it needs one), reconnecting after a drop.
+// The WebSocket to the bridge: /ws on the page's own host, reconnecting after a drop.
+// Beyond loopback the bridge needs the observer token: the browser sends it in the
+// HttpOnly cookie the bridge set when the page was first opened with ?token= (the page
+// never sees it), like every other request of the page.
 // Sends "ping <ms>" once a second; the bridge's "pong" gives the browser round trip.
 export class Connection {
   constructor(onMessage, onState) {
@@ -11,9 +13,8 @@ export class Connection {
   }
 
   url() {
-    const token = new URLSearchParams(location.search).get('token');
     const scheme = location.protocol === 'https:' ? 'wss:' : 'ws:';
-    return `${scheme}//${location.host}/ws${token ? `?token=${encodeURIComponent(token)}` : ''}`;
+    return `${scheme}//${location.host}/ws`;
   }
 
   open() {

@@ -1,6 +1,8 @@
 // The status panel: what the page measures (shapes and frames per second, the shape's
 // age, the browser round trip), the server's solver status, the device's status (tick
 // rate, lateness, pose -> model round trip) and the bridge's counters.
+// Every text here comes from the session's messages or a log, so it is hostile: it goes
+// into the page only as DOM text (textContent), never as markup.
 import { STATUS_NAMES, statusColour, css } from './colours.js';
 
 const fmt = (v, digits = 0) => (v === undefined || v === null || Number.isNaN(v) ? '–' : Number(v).toFixed(digits));
@@ -22,7 +24,10 @@ export class StatusPanel {
       ['server', s ? `${s.scene} · ${s.method}` : 'waiting'],
     ];
     if (sh) {
-      rows.push(['state', `<span style="color:${css(statusColour(sh.status))}">${STATUS_NAMES[sh.status] ?? sh.status}</span>`]);
+      const state = document.createElement('span');
+      state.style.color = css(statusColour(sh.status));
+      state.textContent = STATUS_NAMES[sh.status] ?? String(sh.status);
+      rows.push(['state', state]);
       rows.push(['model · nodes', `${sh.model} · ${sh.positions.length / 3}`], ['snaps', sh.snaps]);
       if (sh.knot) rows.push(['knot', sh.knot]);
       if (sh.contacts) rows.push(['contacts', sh.contacts.length / 6]);
@@ -43,11 +48,31 @@ export class StatusPanel {
     if (b) {
       rows.push(['bridge', `${b.mode} · ${b.session}`], ['pages', b.clients],
                 ['refused (malformed · auth)', `${b.malformed} · ${b.auth_rejected}`],
-                ['shapes dropped (slow pages)', b.shapes_dropped]);
+                ['shapes dropped (slow pages)', b.shapes_dropped],
+                ['requests refused (401 · 403 · pages)',
+                 `${b.unauthorized ?? 0} · ${b.forbidden ?? 0} · ${(b.pages_refused ?? 0) + (b.connections_refused ?? 0)}`]);
     }
-    this.element.innerHTML = rows
-      .map(([k, v]) => (v === '' || k === 'server' || k === 'device' || k === 'bridge'
-        ? `<tr class="head"><th colspan="2">${k} ${v}</th></tr>` : `<tr><td>${k}</td><td>${v}</td></tr>`))
-      .join('');
+    this.element.replaceChildren(...rows.map(([k, v]) => row(k, v)));
   }
+}
+
+// One row: a heading row for the sections (page, server, device, bridge), else a key and
+// its value (text, or a node built above).
+function row(key, value) {
+  const tr = document.createElement('tr');
+  if (value === '' || key === 'server' || key === 'device' || key === 'bridge') {
+    tr.className = 'head';
+    const th = document.createElement('th');
+    th.colSpan = 2;
+    th.textContent = `${key} ${value}`;
+    tr.append(th);
+    return tr;
+  }
+  const k = document.createElement('td');
+  k.textContent = key;
+  const v = document.createElement('td');
+  if (value instanceof Node) v.append(value);
+  else v.textContent = String(value);
+  tr.append(k, v);
+  return tr;
 }

@@ -1,0 +1,166 @@
+// A stranger without the key floods the device's channels before and while a session runs:
+// forged solver statuses (well-formed, 12 kB of strings each, a made-up epoch and MAC),
+// 1 MiB datagrams on the status channel, and forged force models. The device must still
+// learn the genuine server's epoch from its statuses and feel its models: every unchecked
+// status is checked before another datagram is read, so none is pushed out unchecked
+// (statuses_superseded == 0), oversized ones are dropped unread, forged ones refused and
+// counted. snapthread-device runs as a process against a fake server in this test (the
+// one of tests/service/device_fake_server.h) over udpm on loopback.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "device_fake_server.h"
+#include "messages/channels.h"
+#include "snapthread/force_model_t.hpp"
+#include "snapthread/solver_status_t.hpp"
+#include "test_support.h"
+
+namespace snapthread::device {
+namespace {
+
+using testing::DeviceProcess;
+using testing::FakeServer;
+
+// The stranger: publishes forged statuses and models in batches as fast as it can (it
+// yields 1 ms between batches so the machine's other tests keep a core), and one 1 MiB
+// datagram on the status channel every 100 ms.
+class Flooder {
+ public:
+  explicit Flooder(const std::string& session)
+      : channels_(session), lcm_(test_support::kLoopbackLcmUrl) {
+    if (!lcm_.good()) return;
+    thread_ = std::thread([this] { Run(); });
+  }
+  ~Flooder() { Stop(); }
+  bool good() { return lcm_.good(); }
+  void Stop() {
+    stop_.store(true);
+    if (thread_.joinable()) thread_.join();
+  }
+  uint64_t statuses() const { return statuses_.load(); }
+  uint64_t models() const { return models_.load(); }
+  uint64_t huge() const { return huge_.load(); }
+
+ private:
+  void Run() {
+    std::mt19937_64 rng(23);
+    solver_status_t st{};
+    st.scene = std::string(4096, 's');
+    st.method = std::string(4096, 'm');
+    st.knot = std::string(4096, 'k');
+    force_model_t m{};
+    m.status = force_model_t::STATUS_REGULAR;
+    m.f0[1] = 3.0;  // what a forged model would push with
+    const std::vector<uint8_t> big(1 << 20, 0xEE);
+    auto next_big = std::chrono::steady_clock::now();
+    int64_t seq = 1000000000;
+    while (!stop_.load()) {
+      for (int i = 0; i < 40; ++i) {
+        st.epoch = static_cast<int64_t>(rng());
+        st.auth_seq = ++seq;
+        for (auto& b : st.mac) b = static_cast<uint8_t>(rng());
+        if (lcm_.publish(channels_.solver_status, &st) == 0) statuses_.fetch_add(1);
+        m.epoch = st.epoch;
+        m.auth_seq = seq;
+        m.device_seq = static_cast<int64_t>(rng() % 100000);
+        for (auto& b : m.mac) b = static_cast<uint8_t>(rng());
+        if (lcm_.publish(channels_.force_model, &m) == 0) models_.fetch_add(1);
+      }
+      if (std::chrono::steady_clock::now() >= next_big) {
+        if (lcm_.publish(channels_.solver_status, big.data(), static_cast<unsigned>(big.size())) == 0) {
+          huge_.fetch_add(1);
+        }
+        next_big += std::chrono::milliseconds(100);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+
+  transport::Channels channels_;
+  lcm::LCM lcm_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<uint64_t> statuses_{0}, models_{0}, huge_{0};
+};
+
+std::string WriteScene(const std::string& dir) {
+  const std::string path = dir + "/scene.yaml";
+  std::ofstream f(path);
+  f << "name: device_flood_test\nmodel: zeeman\n"
+       "grasp:\n  start: [0, 2.5]\n  path: [[-2, 3.0], [2, 1.5]]\n"
+       "device:\n  model_units_per_metre: 100\n  model_origin: [0, 2.5, 0]\n";
+  return path;
+}
+
+TEST(DeviceFloodAttackTest, GenuineStatusesAndModelsGetThroughAFloodOfForgedOnes) {
+  const test_support::SessionKeyFile key_file;  // SNAPTHREAD_KEY_FILE for the device
+  const test_support::ScopedTempDir scoped("device_flood");
+  const std::string& dir = scoped.path();
+  const std::string session = test_support::UniqueSession("DEVFLOOD");
+
+  // The flood is on before the device and the server start.
+  Flooder flood(session);
+  ASSERT_TRUE(flood.good()) << "udpm on loopback unavailable";
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const double duration_s = 4.0;
+  DeviceProcess device({test_support::BinDir() + "/snapthread-device", "--backend", "sim-path",
+                        "--scene", WriteScene(dir), "--session", session, "--lcm-url",
+                        test_support::kLoopbackLcmUrl, "--duration", std::to_string(duration_s),
+                        "--speed-m-per-s", "0.04", "--no-rt", "--log-level", "warn",
+                        "--summary", dir + "/summary.json"},
+                       dir + "/device");
+  ASSERT_TRUE(device.started());
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const uint64_t flood_statuses_0 = flood.statuses(), flood_models_0 = flood.models();
+  const auto t0 = std::chrono::steady_clock::now();
+  FakeServer server(session, &key_file.key());
+  ASSERT_TRUE(server.good());
+  const int code = device.ExitCode(30.0 * test_support::SpeedScale());
+  const double flood_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const int genuine_statuses = server.statuses_sent();
+  server.Stop();
+  const double status_rate = (flood.statuses() - flood_statuses_0) / flood_s;
+  const double model_rate = (flood.models() - flood_models_0) / flood_s;
+  flood.Stop();
+  ASSERT_EQ(code, 0) << test_support::ReadFile(dir + "/device.err");
+
+  const auto s = test_support::ReadJsonNumbers(dir + "/summary.json");
+  ASSERT_FALSE(s.empty()) << test_support::ReadFile(dir + "/device.err");
+  std::printf("flood: %.0f forged statuses/s (12 kB), %.0f forged models/s, %llu datagrams of 1 MiB; "
+              "genuine statuses sent %d, accepted %.0f; status refusals %.0f, superseded %.0f, "
+              "oversized %.0f; models received %.0f, rejected %.0f; max |F| %.3f N\n",
+              status_rate, model_rate, static_cast<unsigned long long>(flood.huge()),
+              genuine_statuses, s.at("statuses_accepted"), s.at("statuses_rejected"),
+              s.at("statuses_superseded"), s.at("statuses_oversized"), s.at("models_received"),
+              s.at("models_rejected"), s.at("max_force_n"));
+
+  // It was a flood: far more forged statuses than genuine ones (20/s), and they arrived.
+  EXPECT_GT(status_rate, 50.0 * 20.0);
+  EXPECT_GT(s.at("statuses_rejected"), 1000.0);
+  EXPECT_GT(s.at("statuses_oversized"), 0.0);
+  EXPECT_GT(s.at("models_rejected"), 1000.0);
+  // Nothing unchecked was pushed out, and the genuine statuses were heard: at least half
+  // of those sent while the device ran (the rest: the server's last ones after the device
+  // stopped, and what the kernel drops under the flood).
+  EXPECT_EQ(s.at("statuses_superseded"), 0.0);
+  EXPECT_GE(s.at("statuses_accepted"), 0.5 * genuine_statuses * (duration_s - 0.5) / flood_s);
+  // The genuine models were felt: the server ran ~3.5 s of the device's 4 s at ~1 model
+  // per pose (1 kHz); at least a third of that, and the spring's force (a few N at most).
+  EXPECT_GT(s.at("models_received"), 1000.0);
+  EXPECT_GT(s.at("max_force_n"), 0.05);
+  EXPECT_EQ(s.at("nonfinite_outputs"), 0.0);
+}
+
+}  // namespace
+}  // namespace snapthread::device
