@@ -88,7 +88,8 @@ set(kSnapthreadUnityAlone
   common/models/cusp_model.cc common/models/curve2d_model.cc common/models/thread3d_model.cc
   common/models/rod_model.cc
   common/topology/diagram.cc
-  device_client/device_client_app.cc)
+  device_client/device_client_app.cc
+  tests/rod_evaluate_test.cc tests/service/device_wrench_test.cc tests/auth/freshness_filter_test.cc)
 set(kSnapthreadPchEigen <Eigen/Core> <Eigen/SparseCore>)
 set(kSnapthreadPchGTest <gtest/gtest.h>)
 set(kSnapthreadPchSpdlog <spdlog/spdlog.h>)
@@ -177,18 +178,22 @@ function(snapthread_build_aids)
       list(APPEND _headers ${kSnapthreadPchSpdlog})
     endif()
     if(_type STREQUAL "EXECUTABLE" AND GTest::gtest IN_LIST _closure)
-      # A test program: the shared header (its Eigen include path too, should GCC refuse
-      # the precompiled header and read the text).
+      # A test program: the shared header, with its Eigen include path (should GCC refuse
+      # the precompiled header and read the text) and -pthread, which the tests that link
+      # LCM (glib) have anyway: GCC refuses a header built with another _REENTRANT.
       if(NOT _test_pch_made)
         set(_holder ${PROJECT_BINARY_DIR}/snapthread_test_pch.cc)
         file(CONFIGURE OUTPUT ${_holder} CONTENT "// Builds the test programs' shared precompiled header.\n")
         add_library(snapthread_test_pch OBJECT ${_holder})
         target_link_libraries(snapthread_test_pch PRIVATE GTest::gtest GTest::gtest_main Eigen3::Eigen
                               snapthread::warnings)
+        target_compile_options(snapthread_test_pch PRIVATE -pthread)
         target_precompile_headers(snapthread_test_pch PRIVATE ${kSnapthreadPchGTest} ${kSnapthreadPchEigen})
         set(_test_pch_made ON)
       endif()
       target_link_libraries(${_t} PRIVATE Eigen3::Eigen)
+      target_compile_options(${_t} PRIVATE -pthread)
+      target_link_options(${_t} PRIVATE -pthread)
       target_precompile_headers(${_t} REUSE_FROM snapthread_test_pch)
     elseif(_headers AND _n GREATER_EQUAL kSnapthreadPchMinSources)
       target_precompile_headers(${_t} PRIVATE ${_headers})

@@ -96,11 +96,12 @@ cd "$here/build-asan"
 # server, device, viewer, logger and web bridge. LCM subscriptions go through
 # messages::Subscribe (common/messages/subscribe.h): liblcm's own member-function
 # subscriptions trip a GCC 12 UBSan false report (see that header).
-# SNAPTHREAD_SPEED_SCALE=16: the rod's sweep takes 14x the CPU time in this build, so
-# thresholds that are about speed (a time budget, start-up-and-refusal time, models per
+# SNAPTHREAD_SPEED_SCALE=20: the knot's sweep takes 15x the CPU time of the Release build
+# in this one (13x at -O2 -g, when the scale was 16; docs/testing.md), so thresholds that
+# are about speed (a time budget, start-up-and-refusal time, models per
 # servo tick, shapes and frames per second) are divided by it (tests/support/environment.h); no
 # safety property is.
-export SNAPTHREAD_SPEED_SCALE=16 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+export SNAPTHREAD_SPEED_SCALE=20 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
   ctest --output-on-failure -j2 --timeout 900 -LE 'open|viewer|soak|netns'
 # The tests that start the viewer (OpenGL under Xvfb: labels viewer, soak, netns) run with
