@@ -57,9 +57,15 @@ void LogFileWriter::OpenNext() {
   }
   const std::string path = NextPath();
   const bool take_over = options_.force || options_.rotate > 0;
-  const int flags = O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC | (take_over ? O_TRUNC : O_EXCL);
+  // O_NONBLOCK: opening a FIFO for writing would otherwise wait for a reader (ENXIO instead);
+  // it is cleared once the file is known to be regular.
+  const int flags =
+      O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK | (take_over ? O_TRUNC : O_EXCL);
   const int fd = open(path.c_str(), flags, 0600);
   if (fd < 0) {
+    if (errno == ENXIO) {
+      throw std::runtime_error(path + " is not a regular file (a FIFO or device): the log must be a file");
+    }
     if (errno == EEXIST) {
       throw std::runtime_error("refusing to overwrite existing file " + path + " (--force overwrites it)");
     }
@@ -70,6 +76,10 @@ void LogFileWriter::OpenNext() {
   if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
     close(fd);
     throw std::runtime_error(path + " is not a regular file (a FIFO or device): the log must be a file");
+  }
+  if (fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0) {
+    close(fd);
+    throw std::runtime_error(Errno("cannot write the log file " + path));
   }
   // A file taken over with --force keeps its inode and would keep its mode: make it private.
   if (fchmod(fd, 0600) != 0) {

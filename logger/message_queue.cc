@@ -8,6 +8,7 @@ namespace snapthread::logger {
 bool MessageQueue::Push(int64_t timestamp_us, const std::string& channel, const void* data,
                         size_t size) {
   const int64_t footprint = Footprint(channel.size(), size);
+  bool wake = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (closed_ || bytes_ + footprint > max_bytes_) {
@@ -15,10 +16,9 @@ bool MessageQueue::Push(int64_t timestamp_us, const std::string& channel, const 
       counts_.dropped_bytes += int64_t(size);
       return false;
     }
-    bytes_ += footprint;
+    bytes_ += footprint;  // reserved before the copy, so the limit holds meanwhile
     counts_.peak_bytes = std::max(counts_.peak_bytes, bytes_);
   }
-  // Copied outside the lock; the space is already reserved.
   QueuedMessage m;
   m.timestamp_us = timestamp_us;
   m.channel = channel;
@@ -27,19 +27,31 @@ bool MessageQueue::Push(int64_t timestamp_us, const std::string& channel, const 
   {
     std::lock_guard<std::mutex> lock(mutex_);
     queue_.push_back(std::move(m));
+    wake = consumer_waiting_;
   }
-  ready_.notify_one();
+  if (wake) ready_.notify_one();
   return true;
 }
 
-bool MessageQueue::Pop(QueuedMessage* out, std::chrono::milliseconds timeout) {
+bool MessageQueue::TakeAll(std::deque<QueuedMessage>* batch, int64_t* batch_bytes,
+                           std::chrono::milliseconds timeout) {
+  batch->clear();
+  *batch_bytes = 0;
   std::unique_lock<std::mutex> lock(mutex_);
-  if (!ready_.wait_for(lock, timeout, [&] { return !queue_.empty() || closed_; })) return false;
+  if (queue_.empty() && !closed_) {
+    consumer_waiting_ = true;
+    ready_.wait_for(lock, timeout, [&] { return !queue_.empty() || closed_; });
+    consumer_waiting_ = false;
+  }
   if (queue_.empty()) return false;
-  *out = std::move(queue_.front());
-  queue_.pop_front();
-  bytes_ -= Footprint(out->channel.size(), out->data.size());
+  batch->swap(queue_);
+  for (const QueuedMessage& m : *batch) *batch_bytes += Footprint(m.channel.size(), m.data.size());
   return true;
+}
+
+void MessageQueue::Release(int64_t batch_bytes) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  bytes_ -= batch_bytes;
 }
 
 void MessageQueue::Close() {

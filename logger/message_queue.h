@@ -34,12 +34,16 @@ class MessageQueue {
 
   explicit MessageQueue(int64_t max_bytes) : max_bytes_(max_bytes) {}
 
-  // Copies the message in; false (and counted) when it does not fit under the limit.
+  // Copies the message in; false (and counted) when it does not fit under the limit. One
+  // producer (LCM's handler thread); it wakes the consumer only when that one waits.
   bool Push(int64_t timestamp_us, const std::string& channel, const void* data, size_t size);
-  // Waits up to `timeout` for a message; false when none came (or the queue is closed and
-  // empty).
-  bool Pop(QueuedMessage* out, std::chrono::milliseconds timeout);
-  // No more pushes; Pop drains what is left and then returns false at once.
+  // Waits up to `timeout` for messages and takes all of them at once into *batch (one
+  // wake-up per batch, not per message); false when none came (at once when closed and
+  // empty). The batch still counts against the limit until Release(its bytes).
+  bool TakeAll(std::deque<QueuedMessage>* batch, int64_t* batch_bytes,
+               std::chrono::milliseconds timeout);
+  void Release(int64_t batch_bytes);
+  // No more pushes; TakeAll hands over what is left and then returns false at once.
   void Close();
   QueueCounts counts() const;
   int64_t max_bytes() const { return max_bytes_; }
@@ -49,8 +53,9 @@ class MessageQueue {
   mutable std::mutex mutex_;
   std::condition_variable ready_;
   std::deque<QueuedMessage> queue_;
-  int64_t bytes_ = 0;
+  int64_t bytes_ = 0;  // queued and taken but not yet released
   bool closed_ = false;
+  bool consumer_waiting_ = false;
   QueueCounts counts_;
 };
 

@@ -71,16 +71,21 @@ void SessionLogger::WriteLoop() {
         break;
     }
   };
-  QueuedMessage m;
+  std::deque<QueuedMessage> batch;
+  int64_t batch_bytes = 0;
+  const auto write_batch = [&] {
+    for (const QueuedMessage& m : batch) write(m);
+    queue_.Release(batch_bytes);
+  };
   while (!stop_writer_) {
-    if (queue_.Pop(&m, flush_every)) write(m);
+    if (queue_.TakeAll(&batch, &batch_bytes, flush_every)) write_batch();
     if (Clock::now() - last_flush >= flush_every) {
       writer_->Flush();
       last_flush = Clock::now();
     }
   }
   // The LCM loop has ended and the queue is closed: write out what it still holds.
-  while (queue_.Pop(&m, std::chrono::milliseconds(0))) write(m);
+  while (queue_.TakeAll(&batch, &batch_bytes, std::chrono::milliseconds(0))) write_batch();
   writer_->Flush();
 }
 

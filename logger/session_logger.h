@@ -12,8 +12,10 @@
 // So this logger's handler thread only copies each message into its own queue, bounded in
 // bytes (--max-queue-bytes, as lcm-logger's --max-unwritten-mb), and a writer thread puts
 // the queue on disk: a stall of either delays the writing, and only a queue full for longer
-// than the disk can catch up drops messages, counted and reported once per second. LCM's own
-// subscription queue in front of the handler is bounded in messages (kLcmQueueMessages).
+// than the disk can catch up drops messages, counted and reported once per second. The
+// writer takes the queue a batch at a time (one wake-up per batch). LCM's own subscription
+// queue in front of the handler is bounded in messages only (kLcmQueueMessages): liblcm
+// 1.3.1 has no byte limit, and what it drops there is not counted.
 // Files are private (0600) and split / rotated like lcm-logger's (log_file_writer.h).
 #pragma once
 
@@ -43,9 +45,10 @@ struct LoggerOptions {
 
 class SessionLogger {
  public:
-  // Messages LCM may hold for the handler thread before it drops (~8 s of a session); the
-  // handler only copies, so this covers the handler thread's stalls, not the disk's.
-  static constexpr int kLcmQueueMessages = 1 << 14;
+  // Messages LCM may hold for the handler thread before it drops (~60 s of a session). The
+  // handler only copies into queue_, so LCM's queue fills only while the handler thread is
+  // off the CPU; the disk's delays land in queue_, which is bounded in bytes.
+  static constexpr int kLcmQueueMessages = 1 << 17;
 
   // Opens the file and subscribes; throws std::runtime_error with a message naming the file
   // or URL when either fails (an existing file without options.force, too).

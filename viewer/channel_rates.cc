@@ -1,5 +1,6 @@
 #include "channel_rates.h"
 
+#include "messages/channels.h"
 #include "messages/subscribe.h"
 
 #include <cstdio>
@@ -30,12 +31,14 @@ std::map<std::string, ChannelCount> ChannelRateMonitor::Totals() const {
 std::string ChannelRateMonitor::RateReport(double interval_s) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::string out;
-  char line[256];
+  char line[512];
   for (const auto& [channel, total] : totals_) {
     const ChannelCount& before = at_last_report_[channel];
     const double hz = interval_s > 0 ? (total.messages - before.messages) / interval_s : 0.0;
     const double kbps = interval_s > 0 ? (total.bytes - before.bytes) / interval_s / 1000.0 : 0.0;
-    std::snprintf(line, sizeof line, "%-32s %9.1f Hz %9.1f kB/s  total %lld\n", channel.c_str(),
+    // A channel name from the network is hostile text: escaped (a valid one is unchanged).
+    std::snprintf(line, sizeof line, "%-32s %9.1f Hz %9.1f kB/s  total %lld\n",
+                  transport::EscapeForDisplay(channel, 63).c_str(),
                   hz, kbps, static_cast<long long>(total.messages));
     out += line;
   }

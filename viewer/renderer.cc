@@ -10,6 +10,7 @@
 #include "hud_layout.h"
 #include "marker_colors.h"
 #include "material_frames.h"
+#include "messages/channels.h"
 #include "spline.h"
 #include "models/registry.h"
 
@@ -360,21 +361,24 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
   // Overlay in pixel coordinates (origin top-left, y down).
   char line[256];
   std::string text;
-  std::snprintf(line, sizeof line, "snapthread  session %s\n", info.session.c_str());
+  // Strings of messages (scene, model, method, knot) are hostile text: escaped and cut short,
+  // so no newline, control byte or long string can forge or push away HUD lines.
+  const auto shown = [](const std::string& t) { return transport::EscapeForDisplay(t, 40); };
+  std::snprintf(line, sizeof line, "snapthread  session %s\n", shown(info.session).c_str());
   text += line;
   if (s.has_shape) {
     const double fN = Norm3(s.shape.force_newtons);
     std::snprintf(line, sizeof line,
                   "scene %s (%s), %d nodes\nshape seq %lld  %.0f Hz  bad msgs %lld\n"
                   "state %s   snaps %lld\n|F| %.3f N\n",
-                  s.shape.scene.c_str(), s.shape.model.c_str(), s.shape.num_nodes,
+                  shown(s.shape.scene).c_str(), shown(s.shape.model).c_str(), s.shape.num_nodes,
                   static_cast<long long>(s.shape.seq), s.shape_rate_hz,
                   static_cast<long long>(s.bad_messages), StatusName(s.shape.status),
                   static_cast<long long>(s.shape.snaps), fN);
     text += line;
   } else {
     std::snprintf(line, sizeof line, "waiting for %s_SHAPE\non %s\nbad msgs %lld\n",
-                  info.session.c_str(), info.lcm_url.c_str(),
+                  shown(info.session).c_str(), info.lcm_url.c_str(),
                   static_cast<long long>(s.bad_messages));
     text += line;
   }
@@ -382,7 +386,7 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
     std::snprintf(line, sizeof line,
                   "method %s  iters %d\nresidual %.2e  lambda_min %.3g\n"
                   "updates %.0f Hz  solve p50 %.0f us p99 %.0f us\ndropped poses %lld\n",
-                  s.status.method.c_str(), s.status.iterations, s.status.residual,
+                  shown(s.status.method).c_str(), s.status.iterations, s.status.residual,
                   s.status.lambda_min, s.status.update_rate_hz, s.status.solve_us_p50,
                   s.status.solve_us_p99, static_cast<long long>(s.status.dropped_poses));
     text += line;
@@ -392,7 +396,7 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
     // contacts of the shape drawn, else the status's count.
     const bool status_knot = s.has_status && !s.status.knot.empty();
     const std::string& knot = status_knot ? s.status.knot : s.shape.knot;
-    std::snprintf(line, sizeof line, "knot %s", knot.empty() ? "-" : knot.c_str());
+    std::snprintf(line, sizeof line, "knot %s", knot.empty() ? "-" : shown(knot).c_str());
     text += line;
     if (status_knot && s.status.knot_determinant > 0) {
       std::snprintf(line, sizeof line, " (det %d)", s.status.knot_determinant);

@@ -14,6 +14,7 @@
 
 #include "auth/key_file.h"
 #include "channel_rates.h"
+#include "messages/channels.h"
 #include "grasp_publisher.h"
 #include "png_writer.h"
 #include "renderer.h"
@@ -201,7 +202,8 @@ int RunPrintRates(const ViewerOptions& options) {
   }
   // Final totals in a fixed format that scripts (the two-host test) parse.
   for (const auto& [channel, count] : monitor.Totals()) {
-    std::printf("TOTAL %s %lld\n", channel.c_str(), static_cast<long long>(count.messages));
+    std::printf("TOTAL %s %lld\n", transport::EscapeForDisplay(channel).c_str(),
+                static_cast<long long>(count.messages));
   }
   std::printf("REJECTED %lld\n", static_cast<long long>(checked.auth_rejected()));
   std::fflush(stdout);

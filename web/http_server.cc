@@ -2,9 +2,9 @@
 
 #include <chrono>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 #include <vector>
-#include <stdexcept>
 
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>

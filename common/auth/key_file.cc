@@ -153,9 +153,16 @@ KeyFileError MissingKey(const KeyLocation& where) {
 KeyFileError Symlink(const KeyLocation& where) {
   std::error_code ec;
   const std::filesystem::path real = std::filesystem::canonical(where.path, ec);
+  std::string fix = ": --key " + ShellQuoted(real.string());
+  if (ec) {
+    std::error_code ec2;
+    const std::filesystem::path target = std::filesystem::read_symlink(where.path, ec2);
+    fix = ec2 ? std::string(" of the key file")
+              : " of the key file (this link points to " + target.string() +
+                    ", which does not exist)";
+  }
   return KeyFileError(Named(where) + " is a symbolic link, so it is refused (whoever can change "
-                      "the link would choose the key). Fix: use the real path" +
-                      (ec ? std::string() : ": --key " + ShellQuoted(real.string())));
+                      "the link would choose the key). Fix: use the real path" + fix);
 }
 
 // The directory holding a key: writable by group or others, or owned by someone other
@@ -164,10 +171,16 @@ void CheckKeyDir(const std::string& dir, const struct stat& st, const std::strin
   if ((st.st_mode & 022) != 0) {
     char mode[8];
     std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
+    // A shared directory such as /tmp (sticky, or not the user's) must stay writable for
+    // the others: the key moves instead.
+    const bool shared = (st.st_mode & S_ISVTX) != 0 || st.st_uid != geteuid();
     throw KeyFileError("the directory " + dir + " of " + what + " has mode " + mode +
                        ": group or others may write to it and replace the key, so it is "
-                       "refused. Fix: chmod go-w " + ShellQuoted(dir) +
-                       " (or keep the key in a directory of mode 0700)");
+                       "refused. Fix: " +
+                       (shared ? "keep the key in a directory of your own (mkdir -m 700 DIR, "
+                                 "then snapthread-keygen --key DIR/session.key)"
+                               : "chmod go-w " + ShellQuoted(dir) +
+                                     " (or keep the key in a directory of mode 0700)"));
   }
   if (st.st_uid != geteuid() && st.st_uid != 0) {
     throw KeyFileError("the directory " + dir + " of " + what + " is owned by " +

@@ -44,8 +44,8 @@ bool IsValidChannelName(std::string_view name);
 // `text` for a terminal, a HUD, a CSV cell or a summary line: every byte outside the channel
 // grammar's characters (quotes, spaces, ';', '$', '`', '|', '\\', control bytes, non-ASCII)
 // becomes \xNN, so the result is printable, one line, free of shell and gnuplot syntax, and
-// texts shown whole stay distinct (\\ is \x5c). At most `max_bytes` of the input are shown; a longer text
-// ends in "...[N bytes]". A valid channel name comes back unchanged.
+// texts shown whole stay distinct ('\\' is \x5c). At most `max_bytes` of the input are
+// shown; a longer text ends in "...[N bytes]". A valid channel name comes back unchanged.
 std::string EscapeForDisplay(std::string_view text, size_t max_bytes = 128);
 
 }  // namespace snapthread::transport

@@ -8,7 +8,8 @@
 //   * the device keeps admitting genuine models during and after the flood, and the
 //     server keeps updating;
 //   * the forged messages are refused and counted (the device's and the server's
-//     rejection counts grow during the flood, by at least a few hundred);
+//     rejection counts grow during the flood, by at least a few hundred), and the
+//     forged commands change nothing (the server reports one scene throughout);
 //   * no forged force reaches the hand: on the planar scene every genuine force has
 //     z = 0, so the rendered z-force is 0 at every traced tick, and |F| never exceeds
 //     the scene's max_force_n.
@@ -65,6 +66,7 @@ class StatusWatch {
     int64_t device_statuses = 0, models_received = 0, models_rejected = 0;
     int64_t server_statuses = 0, updates = 0, server_rejected = 0;
     double max_status_force_n = 0.0;
+    std::string scenes;  // every scene name the genuine server reported, ';'-separated
   };
   Snapshot Now() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -91,6 +93,7 @@ class StatusWatch {
     ++now_.server_statuses;
     now_.updates = st.updates;
     now_.server_rejected = st.rejected_messages;
+    if (now_.scenes.find(st.scene + ";") == std::string::npos) now_.scenes += st.scene + ";";
   }
 
   transport::Channels channels_;
@@ -210,6 +213,9 @@ TEST(FloodAttackTest, GenuineSessionKeepsItsModelsAndNoForgedForceReachesTheHand
   const auto device_summary = ReadJsonNumbers(dir + "/device.json");
   EXPECT_GE(device_summary.at("models_rejected"), static_cast<double>(flood_end.models_rejected));
   EXPECT_NE(device.Out().find("bad MAC"), std::string::npos) << "the device did not log the refusals";
+  // The forged LOAD_SCENE commands changed nothing: one scene all along.
+  EXPECT_EQ(after.scenes.find(';'), after.scenes.size() - 1) << "scenes reported: " << after.scenes;
+  EXPECT_EQ(after.scenes.find("forged"), std::string::npos) << after.scenes;
 
   // No forged force on the hand.
   const TraceForces forces = ReadTraceForces(dir + "/trace.csv");

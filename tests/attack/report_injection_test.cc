@@ -225,7 +225,7 @@ std::string Record(const std::string& dir, const Hostile* hostile) {
         lcm.publish("LAB1_PROBE", &byte, 1);
         return CountEvents(log_path).count("LAB1_PROBE") > 0 || !logger.running();
       },
-      20.0, 0.05);
+      20.0 * SpeedScale(), 0.05);
   EXPECT_TRUE(ready && logger.running()) << "logger did not start: " << logger.Out();
   const std::vector<Message> genuine = GenuineSession();
   const std::vector<uint8_t> forged = Encode(Model(7));  // a valid model: it decodes
@@ -245,10 +245,10 @@ std::string Record(const std::string& dir, const Hostile* hostile) {
         lcm.publish("LAB1_END", &byte, 1);
         return CountEvents(log_path).count("LAB1_END") > 0;
       },
-      20.0, 0.05));
+      20.0 * SpeedScale(), 0.05));
   logger.Signal(SIGINT);
   int code = -1;
-  EXPECT_TRUE(logger.Wait(10.0, &code));
+  EXPECT_TRUE(logger.Wait(10.0 * SpeedScale(), &code));
   EXPECT_EQ(code, 0) << logger.Out();
   if (hostile != nullptr && !hostile->over_network) {
     AppendEvents(log_path, std::vector<Message>(kHostileModels, {hostile->channel, forged}),
@@ -460,14 +460,14 @@ TEST(ReportInjectionViewerTest, PrintRatesShowsHostileChannelNamesEscaped) {
   ChildProcess viewer({BinDir() + "/snapthread-viewer", "--print-rates", "--session", "LAB1",
                        "--lcm-url", url, "--duration-s", "3"},
                       OutputFiles(dir + "/viewer.out", dir + "/viewer.err"));
-  ASSERT_TRUE(viewer.WaitForOutput("channel rates", 20.0)) << viewer.Err();
+  ASSERT_TRUE(viewer.WaitForOutput("channel rates", 20.0 * SpeedScale())) << viewer.Err();
   const std::vector<uint8_t> forged = Encode(Model(7));
   const auto t0 = std::chrono::steady_clock::now();
   while (viewer.running() && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
     for (const std::string& channel : hostile) lcm.publish(channel, forged.data(), int(forged.size()));
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  const ProcessResult r = viewer.Finish(20.0);
+  const ProcessResult r = viewer.Finish(20.0 * SpeedScale());
   ASSERT_TRUE(r.exited);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(PrintableLines(r.out)) << r.out;
@@ -478,6 +478,33 @@ TEST(ReportInjectionViewerTest, PrintRatesShowsHostileChannelNamesEscaped) {
     EXPECT_EQ(r.out.find(channel), std::string::npos) << "raw name printed";
   }
   EXPECT_TRUE(Markers(dir).empty());
+}
+
+// The grammar and the escaping the report and the viewer rely on (common/messages/channels.h).
+TEST(ChannelGrammarTest, AcceptsTheProjectsNamesAndRefusesEverythingElse) {
+  for (const std::string& ok : std::vector<std::string>{"LAB1_FORCE_MODEL", "SNAPTHREAD_DEVICE_STATUS", "LCM_SELF_TEST",
+                               "a.b:c/d-e", std::string(63, 'S')}) {
+    EXPECT_TRUE(transport::IsValidChannelName(ok)) << ok;
+    EXPECT_EQ(transport::EscapeForDisplay(ok), ok);
+  }
+  for (const Hostile& h : HostileChannels()) EXPECT_FALSE(transport::IsValidChannelName(h.channel));
+  for (const std::string& bad : std::vector<std::string>{"", std::string(64, 'S'), "A B", "A\tB", "\xc3\xa4", "A\\B"}) {
+    EXPECT_FALSE(transport::IsValidChannelName(bad)) << transport::EscapeForDisplay(bad);
+  }
+}
+
+TEST(ChannelGrammarTest, EscapingIsPrintableOneLineAndKeepsBytesApart) {
+  std::set<std::string> seen;
+  for (int b = 0; b < 256; ++b) {
+    const std::string one(1, char(b));
+    const std::string shown = transport::EscapeForDisplay("x" + one + "y");
+    EXPECT_TRUE(PrintableLines(shown) && shown.find('\n') == std::string::npos) << b;
+    for (char c : std::string("'\"`$;|# ,")) EXPECT_EQ(shown.find(c), std::string::npos) << b;
+    EXPECT_TRUE(seen.insert(shown).second) << "two bytes escape alike: " << shown;
+  }
+  EXPECT_EQ(transport::EscapeForDisplay("\\x41"), "\\x5cx41");  // a backslash is escaped too
+  const std::string shown = transport::EscapeForDisplay(std::string(900, 'B'));
+  EXPECT_EQ(shown, std::string(128, 'B') + "...[900 bytes]");
 }
 
 }  // namespace

@@ -7,7 +7,8 @@
 //   elements_from_text: img, script, svg or iframe elements in the status panel
 //   csp_violations:     securitypolicyviolation events (and their directives)
 //   literal_<field>:    the field's payload appears, as text, in the status panel
-//   shapes, frames:     the page's counters; csp: the page's Content-Security-Policy header
+//   shapes, frames:     the page's counters; last_seq: the last shape's seq, once the replay
+//                       ended; csp: the page's Content-Security-Policy header
 import { createRequire } from 'node:module';
 import path from 'node:path';
 
@@ -51,6 +52,10 @@ try {
   await page.waitForFunction(() => document.getElementById('status').textContent.includes('pwned-img-session'),
                              null, { timeout: 15000 }).catch(() => {});
   await sleep(2000);
+  // Then to the log's end (its second half holds bytes that are not UTF-8).
+  await page.waitForFunction(() => document.body.dataset.replayAtEnd === 'true', null, { timeout: 60000 })
+    .catch(() => {});
+  await sleep(1000);
   const seen = await page.evaluate(() => ({
     pwned: window.__pwned ?? null,
     csp: window.__csp,
@@ -58,11 +63,12 @@ try {
     elements: document.getElementById('status').querySelectorAll('img, script, svg, iframe').length,
     shapes: Number(document.body.dataset.shapesReceived || 0),
     frames: Number(document.body.dataset.framesDrawn || 0),
+    lastSeq: Number(document.body.dataset.lastShapeSeq ?? -1),
   }));
   const result = {
-    pwned: seen.pwned, marker_requests: markerRequests.length, marker_urls: markerRequests,
+    pwned: seen.pwned, marker_requests: markerRequests.length, marker_urls: [...new Set(markerRequests)].slice(0, 8),
     elements_from_text: seen.elements, csp_violations: seen.csp.length, violations: seen.csp,
-    page_errors: pageErrors, shapes: seen.shapes, frames: seen.frames, csp,
+    page_errors: pageErrors, shapes: seen.shapes, frames: seen.frames, last_seq: seen.lastSeq, csp,
   };
   for (const field of ['session', 'scene', 'method', 'model', 'knot', 'device']) {
     result[`literal_${field}`] = seen.text.includes(payload(field));

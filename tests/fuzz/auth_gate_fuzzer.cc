@@ -311,7 +311,8 @@ void ForceModelStep(Script& in, State& st) {
   if (echoed) REQUIRE(st.recorded.count({decoded.epoch, decoded.device_seq, decoded.device_utime}) == 1);
   Reason expected = mac_ok ? st.model.Check(decoded.epoch, decoded.auth_seq) : Reason::kBadMac;
   if (expected == Reason::kAccepted && !echoed) expected = Reason::kUnsentPoseEcho;
-  const Reason got = auth::AdmitForceModel(s.bytes.data(), s.bytes.size(), decoded, kChannel, Key(), st.poses, &st.filter);
+  const Reason got =
+      auth::AdmitForceModel(s.bytes.data(), s.bytes.size(), decoded, kChannel, Key(), st.poses, &st.filter);
   REQUIRE(got == expected);
   if (flip >= 224 && s.bytes != test_support::Encode(m)) {
     REQUIRE(!mac_ok);
@@ -497,7 +498,9 @@ void WriteSeeds(const std::string& dir) {
   std::vector<uint8_t> raw = {0, 0};
   int64_t seq = 1;
   auto add_raw = [&](uint8_t type, std::vector<uint8_t> bytes) {
-    raw.insert(raw.end(), {kRaw, type, static_cast<uint8_t>(bytes.size() & 0xff), static_cast<uint8_t>(bytes.size() >> 8)});
+    const auto size_lo = static_cast<uint8_t>(bytes.size() & 0xff);
+    const auto size_hi = static_cast<uint8_t>(bytes.size() >> 8);
+    raw.insert(raw.end(), {kRaw, type, size_lo, size_hi});
     raw.insert(raw.end(), bytes.begin(), bytes.end());
   };
   {

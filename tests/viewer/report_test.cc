@@ -338,5 +338,32 @@ TEST(ReportTest, RefusesAThreeGibLogByDefault) {
             10.0 * SpeedScale());
 }
 
+// A log with ever new channel names lists the first 1000 and counts the rest.
+TEST(ReportTest, ListsAtMostAThousandChannels) {
+  const std::string dir = FreshTempDir("report-channels");
+  const std::string log = WriteReferenceLog(dir);
+  {
+    std::ofstream f(log, std::ios::binary | std::ios::app);
+    for (int i = 0; i < 1500; ++i) {
+      const std::string channel = "FLOOD_" + std::to_string(i);
+      std::string e = {'\xED', '\xA1', '\xDA', '\x01', 0, 0, 0, 0, 0, 0, 0, 0};
+      for (int k = 7; k >= 0; --k) e.push_back(char(((kT0 + 300000 + i) >> (8 * k)) & 0xff));
+      for (uint32_t v : {uint32_t(channel.size()), 1u}) {
+        for (int k = 3; k >= 0; --k) e.push_back(char((v >> (8 * k)) & 0xff));
+      }
+      e += channel + "x";
+      f.write(e.data(), std::streamsize(e.size()));
+    }
+  }
+  const ProcessResult r = RunReport(log, dir + "/out", {"--no-plots"});
+  ASSERT_TRUE(r.exited);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string summary = ReadFile(dir + "/out/summary.txt");
+  // The session's 5 channels and OTHER_CHANNEL come first; 994 flood channels fill the table.
+  EXPECT_NE(summary.find("channels beyond the first 1000: 506 messages (506 bytes), not listed"),
+            std::string::npos) << summary.substr(0, 2000);
+  EXPECT_NE(summary.find("session: RPT\n"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace snapthread::viewer_test

@@ -38,6 +38,7 @@ url="udpm://239.255.76.67:7667?ttl=0"
 session="WEBNETNS_$tag"
 work=$(mktemp -d /tmp/snapthread-webnetns-XXXXXX)
 pids=()
+passed=0
 
 cleanup() {
   for ns in "${all_ns[@]}"; do
@@ -48,6 +49,7 @@ cleanup() {
     for p in $(ip netns pids "$ns" 2>/dev/null); do kill -9 "$p" 2>/dev/null || true; done
     ip netns del "$ns" 2>/dev/null || true
   done
+  [ $passed -eq 1 ] && rm -rf "$work"  # kept when the test fails, for its outputs
 }
 trap cleanup EXIT
 
@@ -132,4 +134,5 @@ assert t['csp_violations'] == [], t['csp_violations']
 " || fail "the observer with the token did not get the live page"
 echo "observer with the token: $(py "t=r['with_token']; print(f\"final URL {t['final_url']}, {t['shapes_per_s']:.0f} shapes/s, {t['frames_per_s']:.0f} frames/s, {t['tube_pixels']} tube pixels\")")"
 echo "PASS: the page works off loopback with the token and gives nothing without it"
+passed=1
 exit 0

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -30,16 +31,19 @@ double Percentile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
 }
 
-// The device's --trace (device_client.cc: t_s, seq, x, y, z, fx, fy, fz, model_age_ms,
-// model_status, clamped, fading, ...): model ages after skip_s, rendered force maxima.
+// The device's --trace (device_client.cc: t_s, seq = tick, x, y, z, fx, fy, fz,
+// model_age_ms, model_status, clamped, fading, ...) over [skip_s, end - kTailSeconds]: the
+// start-up (no model yet) and the fade-out at exit are not the steady state. Rendered
+// force maxima over the whole trace.
+constexpr double kTailSeconds = 0.25;  // > the device's 100 ms exit fade
+
 bool ReadTrace(const std::string& path, double skip_s, FloodRun* run) {
   std::ifstream in(path);
   std::string line;
   if (!std::getline(in, line)) return false;  // header
-  std::vector<double> ages;
-  long rows = 0, fading = 0;
+  std::vector<std::array<double, 12>> rows;
   while (std::getline(in, line)) {
-    double f[12];
+    std::array<double, 12> f{};
     std::stringstream ss(line);
     std::string cell;
     int k = 0;
@@ -48,17 +52,30 @@ bool ReadTrace(const std::string& path, double skip_s, FloodRun* run) {
     const double force = std::sqrt(f[5] * f[5] + f[6] * f[6] + f[7] * f[7]);
     run->max_force_n = std::max(run->max_force_n, force);
     run->max_abs_fz_n = std::max(run->max_abs_fz_n, std::fabs(f[7]));
-    if (f[0] < skip_s) continue;
-    ++rows;
+    rows.push_back(f);
+  }
+  if (rows.empty()) return false;
+  const double end_s = rows.back()[0] - kTailSeconds;
+  std::vector<double> ages;
+  long counted = 0, fading = 0;
+  const std::array<double, 12>* first = nullptr;
+  const std::array<double, 12>* last = nullptr;
+  for (const auto& f : rows) {
+    if (f[0] < skip_s || f[0] > end_s) continue;
+    if (first == nullptr) first = &f;
+    last = &f;
+    ++counted;
     if (f[11] != 0.0) ++fading;
     if (f[8] >= 0.0) ages.push_back(f[8]);
   }
-  if (rows == 0) return false;
+  if (counted < 2 || (*last)[0] <= (*first)[0]) return false;
+  // Ticks (the trace's seq column) over time: the servo's steady rate in the window.
+  run->window_tick_rate_hz = ((*last)[1] - (*first)[1]) / ((*last)[0] - (*first)[0]);
   run->model_age_ms_p50 = Percentile(ages, 0.50);
   run->model_age_ms_p99 = Percentile(ages, 0.99);
   run->model_age_ms_max = ages.empty() ? 0.0 : *std::max_element(ages.begin(), ages.end());
   // A tick without any model yet counts as fading: it renders nothing.
-  run->fading_fraction = static_cast<double>(fading + (rows - static_cast<long>(ages.size()))) / rows;
+  run->fading_fraction = static_cast<double>(fading + (counted - static_cast<long>(ages.size()))) / counted;
   return true;
 }
 
@@ -121,11 +138,12 @@ FloodRun RunFloodOnce(const FloodBenchOptions& o, bool flood, int repetition) {
     run.error = "flood: " + flood_error;
     return run;
   }
-  const pid_t device =
-      Spawn({device_bin, "--key", key_path, "--backend", "virtual-hand", "--scene", scene_file, "--session", session,
-             "--lcm-url", o.lcm_url, "--duration", duration, "--rate-hz", "1000", "--publish-divisor", "1", "--no-rt",
-             "--summary", base + "_device.json", "--trace", base + "_trace.csv"},
-            base + "_device.log");
+  std::vector<std::string> device_args = {device_bin, "--key", key_path, "--backend", "virtual-hand", "--scene",
+                                          scene_file, "--session", session, "--lcm-url", o.lcm_url, "--duration",
+                                          duration, "--rate-hz", "1000", "--publish-divisor", "1", "--summary",
+                                          base + "_device.json", "--trace", base + "_trace.csv"};
+  if (!o.realtime) device_args.push_back("--no-rt");
+  const pid_t device = Spawn(device_args, base + "_device.log");
   const int device_rc = device < 0 ? -1 : WaitFor(device, o.duration_s + 30.0);
   forger.Stop();
   run.flood_rate_per_channel_hz = forger.AchievedRatePerChannel();
@@ -144,6 +162,7 @@ FloodRun RunFloodOnce(const FloodBenchOptions& o, bool flood, int repetition) {
                   JsonNumber(srv, "update_rate_hz", &run.server_update_rate_hz) &&
                   JsonNumber(srv, "updates", &run.server_updates) &&
                   JsonNumber(srv, "rejected_messages", &run.server_rejected);
+  run.realtime = dev.find("\"realtime\": true") != std::string::npos;
   if (!ok) {
     run.error = "a summary lacks a figure (" + base + "_device.json, _server.json)";
     return run;
@@ -174,15 +193,18 @@ std::vector<FloodRun> RunFloodBench(const FloodBenchOptions& o, std::ostream* pr
 }
 
 void WriteFloodCsv(const std::vector<FloodRun>& runs, std::ostream& out) {
-  out << "repetition,flood,ok,flood_rate_per_channel_hz,tick_rate_hz,model_age_ms_p50,model_age_ms_p99,"
+  out << "repetition,flood,ok,flood_rate_per_channel_hz,window_tick_rate_hz,tick_rate_hz,model_age_ms_p50,"
+         "model_age_ms_p99,"
          "model_age_ms_max,fading_fraction,server_update_rate_hz,server_updates,models_received,models_rejected,"
-         "server_rejected,max_force_n,max_abs_fz_n,error\n";
+         "server_rejected,max_force_n,max_abs_fz_n,realtime,error\n";
   for (const auto& r : runs)
     out << r.repetition << ',' << (r.flood ? 1 : 0) << ',' << (r.ok ? 1 : 0) << ',' << r.flood_rate_per_channel_hz
-        << ',' << r.tick_rate_hz << ',' << r.model_age_ms_p50 << ',' << r.model_age_ms_p99 << ','
+        << ',' << r.window_tick_rate_hz << ',' << r.tick_rate_hz << ',' << r.model_age_ms_p50 << ','
+        << r.model_age_ms_p99 << ','
         << r.model_age_ms_max << ',' << r.fading_fraction << ',' << r.server_update_rate_hz << ','
         << r.server_updates << ',' << r.models_received << ',' << r.models_rejected << ',' << r.server_rejected
-        << ',' << r.max_force_n << ',' << r.max_abs_fz_n << ",\"" << r.error << "\"\n";
+        << ',' << r.max_force_n << ',' << r.max_abs_fz_n << ',' << (r.realtime ? 1 : 0) << ",\"" << r.error
+        << "\"\n";
 }
 
 void PrintFloodSummary(const std::vector<FloodRun>& runs, std::ostream& out) {
@@ -198,7 +220,7 @@ void PrintFloodSummary(const std::vector<FloodRun>& runs, std::ostream& out) {
       ++m.total;
       if (!run.ok) continue;
       ++m.ok;
-      t.push_back(run.tick_rate_hz);
+      t.push_back(run.window_tick_rate_hz);
       a.push_back(run.model_age_ms_p50);
       b.push_back(run.model_age_ms_p99);
       s.push_back(run.server_update_rate_hz);
@@ -232,8 +254,8 @@ void PrintFloodSummary(const std::vector<FloodRun>& runs, std::ostream& out) {
   char buf[512];
   auto row = [&](const char* name, const Medians& m) {
     std::snprintf(buf, sizeof buf,
-                  "%-14s %2d/%-2d %8.0f %12.1f [%.1f..%.1f] %8.2f %8.2f [%.2f..%.2f] %10.0f [%.0f..%.0f] %10.0f %10.0f %9.4f "
-                  "%8.3f\n",
+                  "%-14s %2d/%-2d %8.0f %12.1f [%.1f..%.1f] %8.2f %8.2f [%.2f..%.2f] "
+                  "%10.0f [%.0f..%.0f] %10.0f %10.0f %9.4f %8.3f\n",
                   name, m.ok, m.total, m.flood_rate.median, m.tick.median, m.tick.min, m.tick.max, m.age50.median,
                   m.age99.median, m.age99.min, m.age99.max, m.server.median, m.server.min, m.server.max,
                   m.rejected.median, m.server_rejected.median, m.fading.median, m.fz.median);

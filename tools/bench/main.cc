@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
               bin_dir = ExeDir(), advise, methods_text, cutoffs_text, budgets_text, ns_text, backends_text,
               sweeps_text, ladder_text, service_scenes, path_ns_text;
   std::vector<std::string> sets;
-  bool quick = false, no_plot = false, fixed_length = false, no_ceres = false;
+  bool quick = false, no_plot = false, fixed_length = false, no_ceres = false, flood_rt = false;
   int repetitions = 0, reference_n = 0, path_steps = 0;
   double service_duration = 0.0, target_force_error = 0.0, target_rate_hz = 0.0, flood_rate = 10000.0;
   std::string flood_scene = "curve2d_snap";
@@ -97,6 +97,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 600.0));
   app.add_option("--flood-rate", flood_rate, "flood: forged messages per second on each session channel (default 10000)")
       ->check(CLI::Range(1.0, 1e6));
+  app.add_flag("--flood-rt", flood_rt, "flood: run the device with SCHED_FIFO + mlockall (default --no-rt)");
   app.add_option("--flood-scene", flood_scene, "flood: scene name (default curve2d_snap); seconds per run: --service-duration");
   app.add_flag("--no-plot", no_plot, "skip the gnuplot charts");
   app.add_option("--advise", advise, "scene file: advise the smallest n and cheapest method/cutoff/budget instead");
@@ -292,6 +293,7 @@ int main(int argc, char** argv) {
       o.scenes_dir = scenes_dir;
       o.scene = flood_scene;
       o.rate_per_channel_hz = flood_rate;
+      o.realtime = flood_rt;
       o.work_dir = (fs::path(out_dir) / "flood").string();
       if (quick) {
         o.duration_s = 3.0;
@@ -303,7 +305,8 @@ int main(int argc, char** argv) {
       std::ofstream csv(fs::path(out_dir) / "flood.csv");
       WriteFloodCsv(runs, csv);
       std::ostringstream table;
-      table << "== flood: " << o.scene << ", server + device (virtual-hand, --no-rt, 1 kHz) on loopback, "
+      table << "== flood: " << o.scene << ", server + device (virtual-hand, " << (o.realtime ? "SCHED_FIFO" : "--no-rt")
+            << ", 1 kHz) on loopback, "
             << o.duration_s << " s per run, " << o.rate_per_channel_hz << " forged msgs/s per channel\n";
       PrintFloodSummary(runs, table);
       std::cout << table.str();

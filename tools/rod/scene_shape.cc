@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   app.add_option("--rate-hz", rate_hz, "shapes per second")->capture_default_str()
       ->check(CLI::Range(1.0, 200.0));
   return RunTool("snapthread-scene-shape", app, argc, argv, [&]() -> int {
+    transport::Channels{session};  // refuses a --session outside [A-Za-z0-9_] before the sweep
     std::vector<SceneOverride> overrides;
     for (const auto& s : sets) overrides.push_back(ParseOverride(s));
     const Scene scene = LoadScene(scene_file, overrides);
