@@ -11,7 +11,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libspdlog-dev libgtest-dev libgmock-dev
   libyaml-cpp-dev libcli11-dev libsodium-dev
   libglfw3-dev libepoxy-dev xvfb xauth libstb-dev libpng-dev libgl1-mesa-dri xdotool
-  gnuplot-nox graphviz python3 ccache
+  gnuplot-nox graphviz python3 ccache ninja-build
   clang libclang-rt-14-dev
   libceres-dev liblapack-dev
   iproute2 procps
