@@ -6,7 +6,7 @@ set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-cmake -S "$here" -B "$tmp/b" --graphviz="$tmp/deps.dot" >/dev/null
+cmake -S "$here" -B "$tmp/b" -DSNAPTHREAD_SYSTEM_LCM=ON --graphviz="$tmp/deps.dot" >/dev/null
 /usr/bin/python3 "$here/tools/architecture/layers.py" "$tmp/deps.dot" > "$here/docs/diagrams/layers.dot"
 tred "$here/docs/diagrams/layers.dot" | dot -Tsvg -o "$here/docs/images/architecture_layers.svg"
 dot -Tsvg "$here/docs/diagrams/pose_path.dot" -o "$here/docs/images/architecture_pose_path.svg"
