@@ -1,7 +1,9 @@
-# snapthread_add_test(NAME SOURCES a.cc b.cc LIBS x y [LABELS l] [TIMEOUT s])
-# One GoogleTest executable, registered with ctest through gtest_discover_tests.
+# snapthread_add_test(NAME SOURCES a.cc b.cc LIBS x y [LABELS l] [TIMEOUT s] [SERIAL])
+# One GoogleTest executable, registered with ctest through gtest_discover_tests. SERIAL:
+# its tests run alone (RUN_SERIAL), for a test that loads the machine or the loopback on
+# purpose (a flood) and would otherwise make its neighbours lose datagrams.
 function(snapthread_add_test name)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "SERIAL" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main snapthread::warnings)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
@@ -13,9 +15,13 @@ function(snapthread_add_test name)
   if(NOT ARG_LABELS)
     set(ARG_LABELS unit)
   endif()
+  set(_serial "")
+  if(ARG_SERIAL)
+    set(_serial RUN_SERIAL TRUE)
+  endif()
   include(GoogleTest)
   gtest_discover_tests(${name}
-    PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}"
+    PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}" ${_serial}
                ENVIRONMENT "SNAPTHREAD_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
                # A second variable in ENVIRONMENT is lost (gtest_discover_tests splits the
                # list), so it goes through ENVIRONMENT_MODIFICATION.

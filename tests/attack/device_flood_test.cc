@@ -32,13 +32,17 @@ namespace {
 using testing::DeviceProcess;
 using testing::FakeServer;
 
+// A multicast group and port of this test alone: the flood would otherwise fill the socket
+// buffers of every other test's processes on the shared group (they would lose datagrams).
+constexpr char kFloodUrl[] = "udpm://239.255.76.93:7693?ttl=0";
+
 // The stranger: publishes forged statuses and models in batches as fast as it can (it
 // yields 1 ms between batches so the machine's other tests keep a core), and one 1 MiB
 // datagram on the status channel every 100 ms.
 class Flooder {
  public:
   explicit Flooder(const std::string& session)
-      : channels_(session), lcm_(test_support::kLoopbackLcmUrl) {
+      : channels_(session), lcm_(kFloodUrl) {
     if (!lcm_.good()) return;
     thread_ = std::thread([this] { Run(); });
   }
@@ -117,7 +121,7 @@ TEST(DeviceFloodAttackTest, GenuineStatusesAndModelsGetThroughAFloodOfForgedOnes
   const uint64_t flood_at_device_start = flood.statuses();
   DeviceProcess device({test_support::BinDir() + "/snapthread-device", "--backend", "sim-path",
                         "--scene", WriteScene(dir), "--session", session, "--lcm-url",
-                        test_support::kLoopbackLcmUrl, "--duration", std::to_string(duration_s),
+                        kFloodUrl, "--duration", std::to_string(duration_s),
                         "--speed-m-per-s", "0.04", "--no-rt", "--log-level", "warn",
                         "--summary", dir + "/summary.json"},
                        dir + "/device");
@@ -125,7 +129,7 @@ TEST(DeviceFloodAttackTest, GenuineStatusesAndModelsGetThroughAFloodOfForgedOnes
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const uint64_t flood_statuses_0 = flood.statuses(), flood_models_0 = flood.models();
   const auto t0 = std::chrono::steady_clock::now();
-  FakeServer server(session, &key_file.key());
+  FakeServer server(session, &key_file.key(), kFloodUrl);
   ASSERT_TRUE(server.good());
   const int code = device.ExitCode(30.0 * test_support::SpeedScale());
   const double flood_s =

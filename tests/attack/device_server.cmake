@@ -16,6 +16,7 @@ snapthread_add_test(device_flood_test
   SOURCES device_flood_test.cc
   LIBS snapthread::messages snapthread::auth snapthread::test_support
   LABELS attack
+  SERIAL
   TIMEOUT 120)
 # The fake server of the device's process tests (header-only).
 target_include_directories(device_flood_test PRIVATE ${PROJECT_SOURCE_DIR}/tests/service)

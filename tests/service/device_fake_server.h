@@ -47,8 +47,9 @@ class DeviceProcess : public test_support::ChildProcess {
 // 50 ms (the device learns the epoch from it, as from the real server).
 class FakeServer {
  public:
-  FakeServer(const std::string& session, const auth::SessionKey* key)
-      : channels_(session), lcm_(test_support::kLoopbackLcmUrl), key_(key), epoch_(auth::NewEpoch()) {
+  FakeServer(const std::string& session, const auth::SessionKey* key,
+             const std::string& lcm_url = test_support::kLoopbackLcmUrl)
+      : channels_(session), lcm_(lcm_url), key_(key), epoch_(auth::NewEpoch()) {
     if (!lcm_.good()) return;
     messages::Subscribe<&FakeServer::OnPose>(lcm_, channels_.device_state, this);
     thread_ = std::thread([this] {
