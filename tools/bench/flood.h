@@ -23,7 +23,9 @@ struct FloodBenchOptions {
   double skip_s = 1.0;                 // trace rows before this (start-up) are not counted
   int repetitions = 3;                 // pairs of runs (without, with the flood)
   double rate_per_channel_hz = 10000.0;
-  std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  // Loopback only (ttl=0) and a group and port of the bench's own: the flood must not
+  // reach a session on the default group of this host or the LAN.
+  std::string lcm_url = "udpm://239.255.76.95:7695?ttl=0";
   std::string work_dir;                // keys, logs, summaries, traces
   // The device's servo thread with SCHED_FIFO + mlockall (as in the lab) instead of
   // --no-rt (the service chart's default); needs the privilege, else the device says so.
