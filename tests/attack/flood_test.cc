@@ -31,6 +31,7 @@
 #include "auth/message_mac.h"
 #include "flood_forger.h"
 #include "messages/channels.h"
+#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "snapthread/device_status_t.hpp"
 #include "snapthread/solver_status_t.hpp"
@@ -52,8 +53,10 @@ constexpr double kSceneMaxForceN = 3.0;  // scenes/curve2d_snap.yaml device.max_
 class StatusWatch {
  public:
   StatusWatch(const std::string& session, const auth::SessionKey* key) : channels_(session), key_(key) {
-    lcm_.subscribe(channels_.device_status, &StatusWatch::OnDevice, this);
-    lcm_.subscribe(channels_.solver_status, &StatusWatch::OnServer, this);
+    // messages::Subscribe, not lcm::LCM::subscribe's member-function overload: GCC 12's
+    // sanitizer build miscompiles that call (common/messages/subscribe.h).
+    messages::Subscribe<&StatusWatch::OnDevice>(lcm_, channels_.device_status, this);
+    messages::Subscribe<&StatusWatch::OnServer>(lcm_, channels_.solver_status, this);
     thread_ = std::thread([this] {
       while (!stop_) lcm_.handleTimeout(10);
     });
