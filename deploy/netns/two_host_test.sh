@@ -37,32 +37,13 @@ url="udpm://239.255.76.67:7667?ttl=1"
 session="NETNS_$tag"
 work=$(mktemp -d /tmp/snapthread-netns-XXXXXX)
 
-cleanup() {
-  for ns in "${all_ns[@]}"; do
-    # Processes started in our namespaces only (ip netns pids lists exactly those).
-    for p in $(ip netns pids "$ns" 2>/dev/null); do kill "$p" 2>/dev/null || true; done
-  done
-  sleep 0.3
-  for ns in "${all_ns[@]}"; do
-    for p in $(ip netns pids "$ns" 2>/dev/null); do kill -9 "$p" 2>/dev/null || true; done
-    ip netns del "$ns" 2>/dev/null || true
-  done
-}
+cleanup() { netns_kill "${all_ns[@]}"; }
 trap cleanup EXIT
 
-# fail, json, make_key, run_session, end_session
+# fail, json, make_key, run_session, end_session, netns_kill, netns_remove_stale
 source "$(dirname "$0")/../../tests/support/script_support.sh"
 make_key
-
-# Namespaces left by an earlier run of this script that was killed before its trap ran
-# (their names end in the pid of that run, which is gone).
-for ns in $(ip netns list 2>/dev/null | awk '{print $1}' | grep -E '^st_(br|srv|dev|obs)_[0-9]+$'); do
-  owner=${ns##*_}
-  if ! kill -0 "$owner" 2>/dev/null; then
-    for p in $(ip netns pids "$ns" 2>/dev/null); do kill -9 "$p" 2>/dev/null || true; done
-    ip netns del "$ns" 2>/dev/null && echo "removed stale namespace $ns"
-  fi
-done
+netns_remove_stale '^st_(br|srv|dev|obs)_[0-9]+$'
 
 if ! ip netns add "$ns_br" 2>"$work/netns_err.txt"; then
   echo "SKIPPED: ip netns add not permitted here: $(cat "$work/netns_err.txt")"

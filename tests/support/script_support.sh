@@ -55,3 +55,30 @@ end_session() {
   [ $device_rc -eq 0 ] || fail "device exited $device_rc"
   [ $server_rc -eq 0 ] || fail "server exited $server_rc"
 }
+
+# Network-namespace tests (deploy/netns/two_host_test.sh, tests/web/web_netns_test.sh).
+# netns_kill NS...: ends the processes started in these namespaces (ip netns pids lists
+# exactly those; TERM, then KILL after 0.3 s) and deletes the namespaces.
+netns_kill() {
+  local ns p
+  for ns in "$@"; do
+    for p in $(ip netns pids "$ns" 2>/dev/null); do kill "$p" 2>/dev/null || true; done
+  done
+  sleep 0.3
+  for ns in "$@"; do
+    for p in $(ip netns pids "$ns" 2>/dev/null); do kill -9 "$p" 2>/dev/null || true; done
+    ip netns del "$ns" 2>/dev/null || true
+  done
+}
+# netns_remove_stale REGEX: namespaces left by an earlier run killed before its trap ran,
+# named REGEX_<pid of that run> (e.g. '^st_(br|srv)_[0-9]+$'), whose run is gone.
+netns_remove_stale() {
+  local ns owner
+  for ns in $(ip netns list 2>/dev/null | awk '{print $1}' | grep -E "$1"); do
+    owner=${ns##*_}
+    if ! kill -0 "$owner" 2>/dev/null; then
+      netns_kill "$ns"
+      echo "removed stale namespace $ns"
+    fi
+  done
+}

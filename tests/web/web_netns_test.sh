@@ -41,31 +41,15 @@ pids=()
 passed=0
 
 cleanup() {
-  for ns in "${all_ns[@]}"; do
-    for p in $(ip netns pids "$ns" 2>/dev/null); do kill "$p" 2>/dev/null || true; done
-  done
-  sleep 0.3
-  for ns in "${all_ns[@]}"; do
-    for p in $(ip netns pids "$ns" 2>/dev/null); do kill -9 "$p" 2>/dev/null || true; done
-    ip netns del "$ns" 2>/dev/null || true
-  done
+  netns_kill "${all_ns[@]}"
   [ $passed -eq 1 ] && rm -rf "$work"  # kept when the test fails, for its outputs
 }
 trap cleanup EXIT
 
-# fail, json, make_key
+# fail, json, make_key, netns_kill, netns_remove_stale
 source "$(dirname "$0")/../support/script_support.sh"
 make_key
-
-# Namespaces of an earlier run of this script killed before its trap ran (named after the
-# pid of that run, which is gone).
-for ns in $(ip netns list 2>/dev/null | awk '{print $1}' | grep -E '^st_(wsrv|wobs)_[0-9]+$'); do
-  owner=${ns##*_}
-  if ! kill -0 "$owner" 2>/dev/null; then
-    for p in $(ip netns pids "$ns" 2>/dev/null); do kill -9 "$p" 2>/dev/null || true; done
-    ip netns del "$ns" 2>/dev/null && echo "removed stale namespace $ns"
-  fi
-done
+netns_remove_stale '^st_(wsrv|wobs)_[0-9]+$'
 
 if ! ip netns add "$ns_srv" 2>"$work/netns_err.txt"; then
   echo "SKIPPED: ip netns add not permitted here: $(cat "$work/netns_err.txt")"
