@@ -52,7 +52,6 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
     }
     // The MAC before anything of the message is looked at: a forged model's grasp name
     // must not decide how it is counted (it is a bad MAC, not another hand's model).
-    // AdmitForceModel below verifies it again (a few microseconds) with the freshness.
     if (auth_.key != nullptr &&
         !auth::VerifyEncoded(data, static_cast<size_t>(size), auth_.force_model_channel,
                              *auth_.key)) {
@@ -70,8 +69,7 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
       // everything is refused and the device stays in its fade).
       const int64_t epoch = status_filter_.epoch();
       if (epoch != model_filter_.epoch()) model_filter_.SetEpoch(epoch);
-      if (auth::AdmitForceModel(data, static_cast<size_t>(size), msg, auth_.force_model_channel,
-                                *auth_.key, *auth_.sent, &model_filter_) !=
+      if (auth::AdmitVerifiedForceModel(msg, *auth_.sent, &model_filter_) !=
           auth::Reason::kAccepted) {
         LogAuth(&model_filter_, now_us);
         return false;

@@ -30,16 +30,12 @@ Reason Admit(const void* data, std::size_t size, const Msg& decoded, std::string
   return filter->Admit(decoded.epoch, decoded.auth_seq);
 }
 
-// The device's check of a force model: Admit, plus the model must echo the
-// (epoch, device_seq, device_utime) of a pose in `sent`. A model refused for its echo
-// does not raise the sequence floor.
-inline Reason AdmitForceModel(const void* data, std::size_t size, const force_model_t& decoded,
-                              std::string_view channel, const SessionKey& key,
-                              const PoseEchoWindow& sent, FreshnessFilter* filter) {
-  if (!VerifyEncoded(data, size, channel, key)) {
-    filter->Reject(Reason::kBadMac);
-    return Reason::kBadMac;
-  }
+// The device's check of a force model whose MAC has already passed (VerifyEncoded, e.g.
+// so that a forged model's grasp name is never read): its freshness, then the echo of the
+// (epoch, device_seq, device_utime) of a pose in `sent`. A model refused for its echo does
+// not raise the sequence floor.
+inline Reason AdmitVerifiedForceModel(const force_model_t& decoded, const PoseEchoWindow& sent,
+                                      FreshnessFilter* filter) {
   const Reason fresh = filter->Check(decoded.epoch, decoded.auth_seq);
   if (fresh != Reason::kAccepted) {
     filter->Reject(fresh);
@@ -50,6 +46,17 @@ inline Reason AdmitForceModel(const void* data, std::size_t size, const force_mo
     return Reason::kUnsentPoseEcho;
   }
   return filter->Admit(decoded.epoch, decoded.auth_seq);
+}
+
+// The device's whole check of a force model: the MAC, then AdmitVerifiedForceModel.
+inline Reason AdmitForceModel(const void* data, std::size_t size, const force_model_t& decoded,
+                              std::string_view channel, const SessionKey& key,
+                              const PoseEchoWindow& sent, FreshnessFilter* filter) {
+  if (!VerifyEncoded(data, size, channel, key)) {
+    filter->Reject(Reason::kBadMac);
+    return Reason::kBadMac;
+  }
+  return AdmitVerifiedForceModel(decoded, sent, filter);
 }
 
 }  // namespace snapthread::auth
