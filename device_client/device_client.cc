@@ -73,7 +73,7 @@ DeviceClient::DeviceClient(HapticDevice* device, DeviceTransport* transport,
 DeviceClient::~DeviceClient() { Stop(); }
 
 int64_t DeviceClient::Now() const {
-  return config_.clock != nullptr ? config_.clock() : transport::MonotonicMicros();
+  return config_.clock != nullptr ? config_.clock() : realtime::MonotonicMicros();
 }
 
 void DeviceClient::Start(std::string* notes) {
@@ -155,7 +155,7 @@ bool DeviceClient::SignStatus(device_status_t* st) {
 }
 
 void DeviceClient::Drain() {
-  PoseSample p;
+  PoseToPublish p;
   while (poses_->TryPop(&p)) {
     state_msg_.utime = p.utime_us;
     state_msg_.seq = p.seq;
@@ -165,7 +165,7 @@ void DeviceClient::Drain() {
     state_msg_.snap_fold_id = p.snap_fold_id;
     // The servo already refused bad positions; this also catches a backend's bad
     // orientation, so the server never receives a pose it would have to reject.
-    if (!transport::Validate(state_msg_, nullptr) || !SignPose()) {
+    if (!messages::Validate(state_msg_, nullptr) || !SignPose()) {
       invalid_poses_unpublished_.fetch_add(1);
     } else if (transport_->PublishDeviceState(state_msg_)) {
       poses_published_.fetch_add(1);
@@ -196,7 +196,7 @@ void DeviceClient::MaybeReport(int64_t now_us) {
   const double rate =
       static_cast<double>(ticks - last_status_ticks_) / Seconds(now_us - last_status_us_);
   device_status_t st = BuildStatus(now_us, rate, status_seq_++);
-  if (transport::Validate(st, nullptr) && SignStatus(&st) && !transport_->PublishDeviceStatus(st)) {
+  if (messages::Validate(st, nullptr) && SignStatus(&st) && !transport_->PublishDeviceStatus(st)) {
     publish_failures_.fetch_add(1);
   }
   last_status_ticks_ = ticks;

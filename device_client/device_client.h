@@ -52,7 +52,7 @@ struct DeviceClientConfig {
   // models and solver statuses checked (docs/security.md). snapthread-device always
   // sets it; nullptr (no authentication) is for in-process tests of other concerns.
   const auth::SessionKey* key = nullptr;
-  std::string session = transport::kDefaultSession;  // channel prefix (for the MACs)
+  std::string session = messages::kDefaultSession;  // channel prefix (for the MACs)
   // Snap-ahead (snap_ahead.h): switch to a fold's post-snap model at the tick the hand
   // crosses its boundary. --no-snap-ahead turns it off.
   bool snap_ahead = true;
@@ -63,9 +63,9 @@ struct DeviceClientSummary {
   double duration_s = 0.0;
   uint64_t ticks = 0;
   double tick_rate_hz = 0.0;
-  transport::PercentileSummary lateness_us;
+  realtime::PercentileSummary lateness_us;
   double lateness_us_max = 0.0;
-  transport::PercentileSummary round_trip_us;
+  realtime::PercentileSummary round_trip_us;
   uint64_t models_received = 0, models_rejected = 0, invalid_models = 0;
   uint64_t poses_rejected = 0, force_clamps = 0, stiffness_clamps = 0, slew_limits = 0;
   uint64_t fade_ticks = 0, snaps_felt = 0, nonfinite_outputs = 0, overruns = 0;
@@ -140,7 +140,7 @@ class DeviceClient {
   std::unique_ptr<TraceRing> trace_ring_;
   std::unique_ptr<LatenessRing> lateness_;
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> trace_file_;
-  transport::Channels channels_;
+  messages::Channels channels_;
   std::unique_ptr<auth::PoseEchoWindow> sent_poses_;  // written by the io thread
   ModelReceiver receiver_;
   SnapAhead snap_ahead_;  // servo thread (via tick_)
@@ -150,8 +150,8 @@ class DeviceClient {
   // io-thread state.
   auth::AuthSequence auth_seq_;
   device_state_t state_msg_{};
-  transport::SampleWindow lateness_window_{1000};  // last second, for DEVICE_STATUS
-  transport::SampleWindow lateness_run_{600000};   // last 10 min at 1 kHz, for the summary
+  realtime::SampleWindow lateness_window_{1000};  // last second, for DEVICE_STATUS
+  realtime::SampleWindow lateness_run_{600000};   // last 10 min at 1 kHz, for the summary
   double lateness_max_us_ = 0.0;
   int64_t last_status_us_ = 0;
   int64_t last_log_us_ = 0;

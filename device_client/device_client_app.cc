@@ -168,7 +168,7 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
   }
   o->realtime = !no_rt;
   o->snap_ahead = !no_snap_ahead;
-  if (!transport::IsValidSessionName(o->session)) {
+  if (!messages::IsValidSessionName(o->session)) {
     std::fprintf(stderr, "snapthread-device: --session '%s': expected [A-Za-z0-9_]+\n",
                  o->session.c_str());
     return kExitBadArguments;
@@ -178,7 +178,7 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
 
 int RunDeviceClient(const DeviceClientOptions& o) {
   spdlog::set_level(spdlog::level::from_str(o.log_level));
-  if (!transport::IsValidSessionName(o.session)) {
+  if (!messages::IsValidSessionName(o.session)) {
     std::fprintf(stderr, "snapthread-device: --session '%s': expected [A-Za-z0-9_]+\n",
                  o.session.c_str());
     return kExitBadArguments;
@@ -265,11 +265,11 @@ int RunDeviceClient(const DeviceClientOptions& o) {
 
   // ---- transport ------------------------------------------------------------------------
   const std::string url =
-      transport::WithReceiveBuffer(transport::ResolveLcmUrl(o.lcm_url), transport::kServiceBufferBytes);
+      messages::WithReceiveBuffer(messages::ResolveLcmUrl(o.lcm_url), messages::kServiceBufferBytes);
   LcmDeviceTransport lcm(url, o.session);
   if (!lcm.good()) {
     std::fprintf(stderr, "snapthread-device: LCM could not start with URL '%s'.\n  hint: %s\n",
-                 url.c_str(), transport::LcmStartHint(url).c_str());
+                 url.c_str(), messages::LcmStartHint(url).c_str());
     return kExitRuntimeFailure;
   }
 
@@ -356,7 +356,7 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   if (o.realtime && client->realtime_active()) spdlog::info("servo: SCHED_FIFO active");
   const int64_t start_us = client->start_us();
   while (!g_stop_requested.load()) {
-    if (o.duration_s > 0.0 && Seconds(transport::MonotonicMicros() - start_us) >= o.duration_s) break;
+    if (o.duration_s > 0.0 && Seconds(realtime::MonotonicMicros() - start_us) >= o.duration_s) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   // Fade to zero within the safety ramp before the servo loop stops (issue 12 item 5).
@@ -368,7 +368,7 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   device->Close();
 
   // ---- summary ---------------------------------------------------------------------------
-  DeviceClientSummary summary = client->Summary(transport::MonotonicMicros());
+  DeviceClientSummary summary = client->Summary(realtime::MonotonicMicros());
   summary.statuses_superseded = lcm.statuses_superseded();
   summary.statuses_oversized = lcm.statuses_oversized();
   LogSummary(summary);

@@ -29,7 +29,7 @@ bool BackendNeedsPath(const std::string& name) {
 }
 
 std::unique_ptr<HapticDevice> MakeDevice(const BackendConfig& config, std::string* error) {
-  const MicrosClock clock = config.clock ? config.clock : &transport::MonotonicMicros;
+  const MicrosClock clock = config.clock ? config.clock : &realtime::MonotonicMicros;
   if (BackendNeedsPath(config.name) && !config.path) {
     if (error) *error = "backend " + config.name + " needs a path (--scene or --path-csv)";
     return nullptr;

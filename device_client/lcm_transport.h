@@ -51,7 +51,7 @@ class LcmDeviceTransport final : public DeviceTransport {
   void HandleStatus(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
 
   lcm::LCM lcm_;
-  transport::Channels channels_;
+  messages::Channels channels_;
   lcm::Subscription* subscription_ = nullptr;
   lcm::Subscription* status_subscription_ = nullptr;
   // The latest unchecked solver status: one slot of kMaxStatusBytes, allocated once, so

@@ -25,11 +25,11 @@ bool ModelReceiver::ReceiveStatus(const void* data, int size) {
   try {
     solver_status_t msg;
     std::string why;
-    if (!transport::DecodeAndValidate(data, size, &msg, &why)) return false;
+    if (!messages::DecodeAndValidate(data, size, &msg, &why)) return false;
     const int64_t before = status_filter_.epoch();
     if (auth::Admit(data, static_cast<size_t>(size), msg, auth_.status_channel, *auth_.key,
                     &status_filter_) != auth::Reason::kAccepted) {
-      LogAuth(&status_filter_, transport::MonotonicMicros());
+      LogAuth(&status_filter_, realtime::MonotonicMicros());
       return false;
     }
     if (status_filter_.epoch() != before) {
@@ -46,7 +46,7 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
   try {
     force_model_t msg;
     std::string why;
-    if (!transport::DecodeAndValidate(data, size, &msg, &why)) {
+    if (!messages::DecodeAndValidate(data, size, &msg, &why)) {
       Reject(why);
       return false;
     }
@@ -109,7 +109,7 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
   }
 }
 
-transport::PercentileSummary ModelReceiver::RoundTrip(bool whole_run) const {
+realtime::PercentileSummary ModelReceiver::RoundTrip(bool whole_run) const {
   std::lock_guard<std::mutex> lock(mutex_);
   return whole_run ? round_trip_run_.Compute() : round_trip_window_.Compute();
 }

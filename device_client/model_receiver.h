@@ -53,7 +53,7 @@ class ModelReceiver {
   bool Receive(const void* data, int size, int64_t now_us);
 
   // Round trip pose -> answering model on the device's clock: the last ~2 s, or the run.
-  transport::PercentileSummary RoundTrip(bool whole_run) const;
+  realtime::PercentileSummary RoundTrip(bool whole_run) const;
 
   uint64_t received() const { return received_.load(); }
   // Malformed or unsafe models, those refused by authentication and those older than
@@ -85,8 +85,8 @@ class ModelReceiver {
   std::atomic<uint64_t> received_{0}, rejected_{0}, stiffness_clamps_{0}, invalid_models_{0},
       snaps_felt_{0}, out_of_order_{0}, other_grasp_{0}, wrench_models_{0};
   mutable std::mutex mutex_;  // the round-trip windows (receiver and status threads)
-  transport::SampleWindow round_trip_window_{2000};
-  transport::SampleWindow round_trip_run_{200000};
+  realtime::SampleWindow round_trip_window_{2000};
+  realtime::SampleWindow round_trip_run_{200000};
 };
 
 }  // namespace snapthread::device

@@ -87,7 +87,7 @@ HDCallbackCode HDCALLBACK PhantomDevice::ServoCallback(void* self_ptr) {
   // The last command while it is fresh, else zero (the servo thread stalled).
   HDdouble force[3];
   double torque[3];
-  self->command_.Output(transport::MonotonicMicros(), force, torque);
+  self->command_.Output(realtime::MonotonicMicros(), force, torque);
   hdSetDoublev(HD_CURRENT_FORCE, force);
   hdEndFrame(self->handle_);
   HDErrorInfo err = hdGetError();
@@ -105,13 +105,13 @@ bool PhantomDevice::Read(DeviceState* state) {
 
 bool PhantomDevice::Command(const double force_n[3], const double /*torque_nm*/[3]) {
   if (!open_ || fault_.load(std::memory_order_relaxed)) return false;
-  command_.Set(force_n, nullptr, transport::MonotonicMicros());
+  command_.Set(force_n, nullptr, realtime::MonotonicMicros());
   return true;
 }
 
 void PhantomDevice::Close() {
   if (handle_ == HD_INVALID_HANDLE) return;
-  command_.Clear(transport::MonotonicMicros());
+  command_.Clear(realtime::MonotonicMicros());
   hdStopScheduler();
   if (callback_ != HD_INVALID_HANDLE) hdUnschedule(callback_);
   hdDisable(HD_FORCE_OUTPUT);

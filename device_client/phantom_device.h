@@ -37,7 +37,7 @@ class PhantomDevice final : public HapticDevice {
   DeviceCapabilities caps_;
   HHD handle_ = HD_INVALID_HANDLE;
   HDSchedulerHandle callback_ = HD_INVALID_HANDLE;
-  transport::LatestValue<DeviceState> state_;  // HD thread -> servo thread
+  realtime::LatestValue<DeviceState> state_;  // HD thread -> servo thread
   StaleCommand command_;                       // servo thread -> HD thread
   std::atomic<bool> fault_{false};
   bool open_ = false;

@@ -169,7 +169,7 @@ bool ClampWrenchStiffness(const double K6_in[6][6], const SafetyLimits& limits, 
 
 ModelVerdict PrepareModel(const force_model_t& msg, int64_t receive_us,
                           const SafetyLimits& limits, LocalModel* out, std::string* why) {
-  if (!transport::Validate(msg, why)) return ModelVerdict::kRejected;
+  if (!messages::Validate(msg, why)) return ModelVerdict::kRejected;
   LocalModel m;
   m.seq = msg.seq;
   m.device_seq = msg.device_seq;

@@ -42,7 +42,7 @@ void ServoTick::Tick(int64_t now_us, int64_t lateness_us) {
 
   // A rejected pose is never published (the server must not solve for it).
   if (!last_.pose_rejected && tick_ % options_.publish_divisor == 0 && poses_ != nullptr) {
-    PoseSample p;
+    PoseToPublish p;
     p.utime_us = now_us;
     p.seq = pose_seq_;
     for (int k = 0; k < 3; ++k) p.position_m[k] = state_.position_m[k];
@@ -142,7 +142,7 @@ void ServoLoop::Run() {
     advance(&next, period_ns);
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr) == EINTR) {
     }
-    const int64_t now_us = transport::MonotonicMicros();
+    const int64_t now_us = realtime::MonotonicMicros();
     const int64_t deadline_us =
         static_cast<int64_t>(next.tv_sec) * 1000000 + next.tv_nsec / 1000;
     const int64_t lateness_us = now_us - deadline_us;

@@ -20,7 +20,7 @@
 namespace snapthread::device {
 
 // A pose for the publisher thread (becomes a device_state_t).
-struct PoseSample {
+struct PoseToPublish {
   int64_t utime_us = 0;  // CLOCK_MONOTONIC at the read
   int64_t seq = 0;       // published pose number
   double position_m[3] = {0.0, 0.0, 0.0};
@@ -44,10 +44,10 @@ struct TraceRow {
 };
 
 // Ring sizes: a few seconds of 1 kHz data, so a descheduled consumer loses nothing.
-using PoseRing = transport::SpscRing<PoseSample, 4096>;
-using TraceRing = transport::SpscRing<TraceRow, 8192>;
-using LatenessRing = transport::SpscRing<int32_t, 8192>;  // microseconds
-using ModelSlot = transport::LatestValue<LocalModel>;
+using PoseRing = realtime::SpscRing<PoseToPublish, 4096>;
+using TraceRing = realtime::SpscRing<TraceRow, 8192>;
+using LatenessRing = realtime::SpscRing<int32_t, 8192>;  // microseconds
+using ModelSlot = realtime::LatestValue<LocalModel>;
 
 struct ServoTickOptions {
   int publish_divisor = 1;  // hand every k-th pose to the publisher

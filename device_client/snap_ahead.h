@@ -30,7 +30,7 @@
 namespace snapthread::device {
 
 // Off the servo thread, from PrepareModel: copies and checks a force model's fold
-// (finite, unit normal, positive id; transport::Validate checked the message already)
+// (finite, unit normal, positive id; messages::Validate checked the message already)
 // and clamps the post-snap K's stiffness like K. A message without a fold leaves
 // out->has_fold false. False (with *why) when the fold is not usable: the whole model
 // is refused, so a bad fold never reaches the servo.

@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
     o.path = name;
   }
   // A receiver: a kernel buffer that rides out seconds off the CPU (lcm_url.h).
-  o.lcm_url = snapthread::transport::WithReceiveBuffer(snapthread::transport::ResolveLcmUrl(o.lcm_url));
+  o.lcm_url = snapthread::messages::WithReceiveBuffer(snapthread::messages::ResolveLcmUrl(o.lcm_url));
 
   // SIGINT / SIGTERM arrive on a signalfd that the loop polls next to LCM's: blocked before
   // LCM starts its reader thread, so every thread inherits the mask.

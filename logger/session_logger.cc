@@ -31,7 +31,7 @@ SessionLogger::SessionLogger(const LoggerOptions& options)
   if (options_.max_queue_bytes <= 0) throw std::runtime_error("--max-queue-bytes must be positive");
   if (!lcm_.good()) {
     throw std::runtime_error("cannot open LCM at " + options_.lcm_url + ". " +
-                             transport::LcmStartHint(options_.lcm_url));
+                             messages::LcmStartHint(options_.lcm_url));
   }
   writer_ = std::make_unique<LogFileWriter>(FileOptions(options_));
   subscription_ = messages::Subscribe<&SessionLogger::OnMessage>(lcm_, options_.channel, this);

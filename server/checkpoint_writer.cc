@@ -53,7 +53,7 @@ CheckpointWriterStats CheckpointWriter::Stats() const {
   s.offered = offered_;
   s.written = written_;
   s.failed = failed_;
-  const transport::PercentileSummary w = write_us_.Compute();
+  const realtime::PercentileSummary w = write_us_.Compute();
   s.write_us_p50 = w.p50;
   s.write_us_p99 = w.p99;
   s.write_us_max = w.max;

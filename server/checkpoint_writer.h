@@ -65,7 +65,7 @@ class CheckpointWriter {
   bool writing_ = false;
   bool stop_ = false;
   int64_t offered_ = 0, written_ = 0, failed_ = 0;
-  transport::SampleWindow write_us_{kWindow};
+  realtime::SampleWindow write_us_{kWindow};
   std::chrono::steady_clock::time_point last_error_log_{};
   std::thread thread_;
 };

@@ -274,7 +274,7 @@ void FoldBoundary::Fill(force_model_t* msg) const {
     for (int j = 0; j < 3; ++j) msg->post_K[i][j] = f.post_K[i][j];
   }
   // The last line before the device: a prediction that fails the check is not sent.
-  if (!transport::Validate(*msg, nullptr)) msg->has_fold = 0;
+  if (!messages::Validate(*msg, nullptr)) msg->has_fold = 0;
 }
 
 }  // namespace snapthread::server

@@ -6,14 +6,14 @@
 namespace snapthread::server {
 
 std::vector<int> ApplyGraspPoses(const Scene& scene, const Eigen::Vector3d& rest_direction,
-                                 const std::vector<PoseSample>& poses, Vec* u, Vec* renamed) {
+                                 const std::vector<ReceivedPose>& poses, Vec* u, Vec* renamed) {
   std::vector<int> grasp_of;
   grasp_of.reserve(poses.size());
   const int m = scene.grasp_layout.NumControls();
   const int dim = scene.grasp_layout.spatial_dimension;
   const bool rotation = scene.grasp_layout.grip_rotation && m >= dim + 3;
   if (renamed != nullptr) *renamed = *u;
-  for (const PoseSample& pose : poses) {
+  for (const ReceivedPose& pose : poses) {
     int g = FindGrasp(scene, pose.state.grasp);
     const int offset = scene.grasps.empty() ? 0 : scene.grasps[g < 0 ? 0 : g].offset;
     if (g >= 0 && offset + m > u->size()) g = -1;

@@ -33,7 +33,7 @@ constexpr double kRelabelAngle = 1.25 * std::numbers::pi;
 // new ones continue: equal to *u on entry unless a rotation vector was renamed. Without
 // it φ only continues (never renamed).
 std::vector<int> ApplyGraspPoses(const Scene& scene, const Eigen::Vector3d& rest_direction,
-                                 const std::vector<PoseSample>& poses, Vec* u,
+                                 const std::vector<ReceivedPose>& poses, Vec* u,
                                  Vec* renamed = nullptr);
 
 }  // namespace snapthread::server

@@ -81,7 +81,7 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
   std::string error;
   if (!params_.IsValid(&error)) throw std::invalid_argument(error);
   command_filter_.SetEpoch(epoch_);  // commands must carry this start's epoch
-  channels_ = transport::Channels(params_.session);
+  channels_ = messages::Channels(params_.session);
   method_override_ = params_.method;
   if (params_.scene_dir.empty()) params_.scene_dir = DefaultSceneDir();
 
@@ -96,12 +96,12 @@ Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
     lcm_ = lcm;
     lcm_url_ = "(provided)";
   } else {
-    lcm_url_ = transport::WithReceiveBuffer(transport::ResolveLcmUrl(params_.lcm_url),
-                                             transport::kServiceBufferBytes);
+    lcm_url_ = messages::WithReceiveBuffer(messages::ResolveLcmUrl(params_.lcm_url),
+                                             messages::kServiceBufferBytes);
     owned_lcm_ = std::make_unique<lcm::LCM>(lcm_url_);
     if (!owned_lcm_->good()) {
       throw LcmInitError("LCM failed to start on " + lcm_url_ + ": " +
-                         transport::LcmStartHint(lcm_url_));
+                         messages::LcmStartHint(lcm_url_));
     }
     lcm_ = owned_lcm_.get();
   }
@@ -220,9 +220,9 @@ auth::FreshnessFilter* Server::DeviceFilter(const std::string& device_id) {
 
 void Server::HandleDeviceState(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
   try {
-    PoseSample sample;
+    ReceivedPose sample;
     std::string why;
-    if (!transport::DecodeAndValidate(rbuf, &sample.state, &why)) {
+    if (!messages::DecodeAndValidate(rbuf, &sample.state, &why)) {
       Reject(channel, why);
       return;
     }
@@ -241,7 +241,7 @@ void Server::HandleDeviceState(const lcm::ReceiveBuffer* rbuf, const std::string
       RejectAuth(filter);
       return;
     }
-    sample.receive_utime = transport::RealtimeMicros();
+    sample.receive_utime = realtime::RealtimeMicros();
     poses_received_.fetch_add(1);
     if (inbox_.PutPose(sample)) dropped_poses_.fetch_add(1);
   } catch (...) {
@@ -254,7 +254,7 @@ void Server::HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& ch
   try {
     command_t command;
     std::string why;
-    if (!transport::DecodeAndValidate(rbuf, &command, &why)) {
+    if (!messages::DecodeAndValidate(rbuf, &command, &why)) {
       Reject(channel, why);
       return;
     }
@@ -330,7 +330,7 @@ void Server::SolveLoop() {
   }
 }
 
-void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
+void Server::SolveAndPublish(const std::vector<ReceivedPose>& poses) {
   EquilibriumTracker& tracker = *session_->tracker;
   const Scene& scene = session_->scene;
   // Each pose moves its own grasp (grasp_poses.h); the others keep their controls.
@@ -354,7 +354,7 @@ void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
     // The device felt the post-snap model of the current fold: start on the new branch.
     Vec x_after, u_after;
     switched_ = false;
-    for (const PoseSample& pose : poses) {
+    for (const ReceivedPose& pose : poses) {
       if (session_->fold && session_->fold->TakeSwitch(pose.state.snap_fold_id, &x_after, &u_after)) {
         tracker.Resume(x_after, u_after);
         switched_ = true;  // the snap happened (felt ahead by the device): counted as one
@@ -406,7 +406,7 @@ void Server::SolveAndPublish(const std::vector<PoseSample>& poses) {
   }
 }
 
-void Server::PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, const TrackResult* result,
+void Server::PublishGraspModel(const ReceivedPose& pose, int grasp, const Vec& u, const TrackResult* result,
                                double solve_us, bool first) {
   const Model& model = session_->tracker->model();
   const Scene& scene = session_->scene;
@@ -427,14 +427,14 @@ void Server::PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, 
   in.server_receive_utime = pose.receive_utime;
   in.solve_us = solve_us;
   in.seq = model_seq_++;
-  in.utime = transport::RealtimeMicros();
+  in.utime = realtime::RealtimeMicros();
   force_model_t msg = BuildForceModel(in);
   // The first model on the branch the device switched to answers the snap.
   if (switched_ && (msg.status == force_model_t::STATUS_REGULAR || msg.status == force_model_t::STATUS_NEAR_FOLD)) {
     msg.status = force_model_t::STATUS_SNAPPED;
   }
   std::string why;
-  if (!transport::Validate(msg, &why)) {
+  if (!messages::Validate(msg, &why)) {
     // BuildForceModel guarantees finiteness; this is the last line before the device.
     spdlog::error("server: refusing to publish an invalid force model: {}", why);
     msg = BuildForceModel(ForceModelInputs{in.mapping, in.model, in.u, Eigen::Vector3d::Zero(),
@@ -469,10 +469,10 @@ void Server::PublishShape() {
   in.snaps = snaps_since_reset_;
   in.knot = knot_watch_.name();
   in.seq = shape_seq_++;
-  in.utime = transport::RealtimeMicros();
+  in.utime = realtime::RealtimeMicros();
   thread_shape_t msg = BuildShape(in);
   std::string why;
-  if (!transport::Validate(msg, &why)) {
+  if (!messages::Validate(msg, &why)) {
     if (ShouldLog(&last_solve_error_log_us_)) spdlog::error("server: bad shape not sent: {}", why);
     return;
   }
@@ -488,7 +488,7 @@ void Server::PublishStatus() {
   const auto now = SteadyClock::now();
   const double dt = std::chrono::duration<double>(now - last_status_time_).count();
   const int64_t updates = updates_.load();
-  const transport::PercentileSummary window = status_window_.Compute();
+  const realtime::PercentileSummary window = status_window_.Compute();
   StatusInputs in;
   in.scene = session_->scene.name;
   in.method = session_->tracker->options().method;
@@ -506,7 +506,7 @@ void Server::PublishStatus() {
   in.knot_determinant = knot_watch_.determinant();
   in.max_update_hz = params_.max_update_hz > 0.0 ? params_.max_update_hz : session_->scene.max_update_hz;
   in.seq = status_seq_++;
-  in.utime = transport::RealtimeMicros();
+  in.utime = realtime::RealtimeMicros();
   solver_status_t msg = BuildSolverStatus(in);
   status_window_.Clear();
   updates_at_last_status_ = updates;
@@ -535,7 +535,7 @@ ServerStats Server::Stats() const {
   s.statuses_published = statuses_published_.load();
   s.publish_failures = publish_failures_.load();
   std::lock_guard<std::mutex> lock(info_mutex_);
-  const transport::PercentileSummary window = run_window_.Compute();
+  const realtime::PercentileSummary window = run_window_.Compute();
   s.solve_us_p50 = window.p50;
   s.solve_us_p99 = window.p99;
   const double span_s = 1e-6 * static_cast<double>(last_update_us_ - first_update_us_);
@@ -549,7 +549,7 @@ ServerStats Server::Stats() const {
     s.checkpoints = true;
     s.resumed = resumed_.load();
     s.checkpoint = checkpoint_writer_->Stats();
-    const transport::PercentileSummary offer = checkpoint_offer_us_.Compute();
+    const realtime::PercentileSummary offer = checkpoint_offer_us_.Compute();
     s.checkpoint_offer_us_p50 = offer.p50;
     s.checkpoint_offer_us_p99 = offer.p99;
   }

@@ -118,7 +118,7 @@ class Server {
   // One line for the end of the log: the same numbers as key=value pairs.
   std::string FinalReport() const;
 
-  const transport::Channels& channels() const { return channels_; }
+  const messages::Channels& channels() const { return channels_; }
   const std::string& lcm_url() const { return lcm_url_; }
   const ServerParams& params() const { return params_; }
   // This start's session epoch (new at each construction) and the key in use.
@@ -148,9 +148,9 @@ class Server {
   void ReceiveLoop();
   void SolveLoop();
   // Solve thread.
-  void SolveAndPublish(const std::vector<PoseSample>& poses);
+  void SolveAndPublish(const std::vector<ReceivedPose>& poses);
   // The force model of one grasp for the pose that moved it (its block of F and K).
-  void PublishGraspModel(const PoseSample& pose, int grasp, const Vec& u, const TrackResult* result,
+  void PublishGraspModel(const ReceivedPose& pose, int grasp, const Vec& u, const TrackResult* result,
                          double solve_us, bool first);
   void ApplyCommand(const command_t& command);
   // LOAD_SCENE off the solve thread (commands.cc): starts the loader; the solve loop polls
@@ -178,7 +178,7 @@ class Server {
   static constexpr size_t kMaxDevices = 64;
 
   ServerParams params_;
-  transport::Channels channels_;
+  messages::Channels channels_;
   auth::KeyLocation key_location_;
   bool key_created_ = false;
   auth::SessionKey key_;
@@ -213,7 +213,7 @@ class Server {
   bool switched_ = false;  // this update started on the branch a snap-ahead switch chose
   int8_t last_status_ = 0;
   double last_force_n_[3] = {0.0, 0.0, 0.0};
-  transport::SampleWindow status_window_{4096};  // solve µs since the last status
+  realtime::SampleWindow status_window_{4096};  // solve µs since the last status
   int64_t updates_at_last_status_ = 0;
   std::chrono::steady_clock::time_point last_status_time_;
 
@@ -225,7 +225,7 @@ class Server {
   std::atomic<int64_t> last_solve_error_log_us_{0};
   mutable std::mutex info_mutex_;  // guards the fields below
   std::string scene_name_, method_name_, last_command_message_;
-  transport::SampleWindow run_window_{kSolveWindow};
+  realtime::SampleWindow run_window_{kSolveWindow};
   int64_t first_update_us_ = 0, last_update_us_ = 0;  // steady clock
 
   // Checkpoints: the writer (null without --state-dir), and on the solve thread what the
@@ -234,7 +234,7 @@ class Server {
   std::atomic<bool> resumed_{false};
   int64_t checkpoint_seq_ = 0;
   int64_t checkpoint_updates_ = -1, checkpoint_commands_ = -1;
-  transport::SampleWindow checkpoint_offer_us_{4096};  // guarded by info_mutex_
+  realtime::SampleWindow checkpoint_offer_us_{4096};  // guarded by info_mutex_
 };
 
 }  // namespace snapthread::server

@@ -114,7 +114,7 @@ bool Server::ResumeFromCheckpoint() {
   const std::string start_scene = session_->scene.name;
   session_ = std::move(session);
   SetInfo(session_->scene.name, session_->tracker->options().method, nullptr);
-  const double age_s = 1e-6 * static_cast<double>(transport::RealtimeMicros() - saved.utime);
+  const double age_s = 1e-6 * static_cast<double>(realtime::RealtimeMicros() - saved.utime);
   spdlog::info("server: resumed from checkpoint of epoch {} ({}, taken {:.1f} s ago): scene '{}'{}, "
                "method {}{}, state on the saved branch (probe {:.6g}); this start's epoch is {}",
                Hex(saved.epoch), path, age_s, session_->scene.name,
@@ -133,7 +133,7 @@ void Server::OfferCheckpoint() {
   // A state that is not finite is never saved (the file would be refused anyway).
   if (!tracker.state().allFinite() || !tracker.control().allFinite()) return;
   Checkpoint c;
-  c.utime = transport::RealtimeMicros();
+  c.utime = realtime::RealtimeMicros();
   c.epoch = epoch_;
   c.seq = checkpoint_seq_++;
   c.scene_name = session_->scene.name;

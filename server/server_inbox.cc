@@ -4,12 +4,12 @@
 
 namespace snapthread::server {
 
-bool ServerInbox::PutPose(const PoseSample& pose) {
+bool ServerInbox::PutPose(const ReceivedPose& pose) {
   bool superseded = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     bool stored = false;
-    for (PoseSample& p : poses_) {
+    for (ReceivedPose& p : poses_) {
       if (p.state.grasp == pose.state.grasp) {
         p = pose;
         superseded = stored = true;

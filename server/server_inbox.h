@@ -23,7 +23,7 @@
 namespace snapthread::server {
 
 // A validated pose and when it arrived.
-struct PoseSample {
+struct ReceivedPose {
   device_state_t state;
   int64_t receive_utime = 0;  // server CLOCK_REALTIME, microseconds
 };
@@ -39,7 +39,7 @@ class ServerInbox {
 
   // Stores the pose as the newest of its grasp. True when it superseded a pose nobody
   // took, or was dropped (kMaxGrasps) (the caller counts it as a dropped pose).
-  bool PutPose(const PoseSample& pose);
+  bool PutPose(const ReceivedPose& pose);
   // Queues a command. False when the queue is full (the command is refused).
   bool PushCommand(const command_t& command);
   // Wakes the solve thread for good.
@@ -47,7 +47,7 @@ class ServerInbox {
 
   struct Taken {
     bool stop = false;
-    std::vector<PoseSample> poses;  // the newest of each grasp, in order of arrival
+    std::vector<ReceivedPose> poses;  // the newest of each grasp, in order of arrival
     std::vector<command_t> commands;
   };
   // Blocks until a pose or command is pending, stop was requested, or `deadline`;
@@ -57,7 +57,7 @@ class ServerInbox {
  private:
   std::mutex mutex_;
   std::condition_variable cv_;
-  std::vector<PoseSample> poses_;
+  std::vector<ReceivedPose> poses_;
   std::deque<command_t> commands_;
   bool stop_ = false;
 };

@@ -139,7 +139,7 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
   }
   m.status = ClassifyStatus(&r);
   // The one force-model check (messages/validate.cc); on failure the device renders zero.
-  if (!transport::Validate(m, nullptr)) {
+  if (!messages::Validate(m, nullptr)) {
     ZeroForceModel(&m);
     m.status = force_model_t::STATUS_INVALID;
   }

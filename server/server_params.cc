@@ -26,7 +26,7 @@ bool IsKnownLogLevel(const std::string& level) {
 
 bool ServerParams::IsValid(std::string* error) const {
   if (scene_path.empty()) return Fail(error, "--scene: a scene file is required");
-  if (!transport::IsValidSessionName(session)) {
+  if (!messages::IsValidSessionName(session)) {
     return Fail(error, "--session: '" + session + "' is not a valid session name ([A-Za-z0-9_]+)");
   }
   // LCM refuses channel names longer than 63 bytes at publish time (logging "channel

@@ -12,11 +12,11 @@
 namespace snapthread::server {
 
 // LCM channel names are at most 63 bytes; the longest channel suffix is 14 bytes.
-inline constexpr size_t kMaxSessionLength = transport::kMaxSessionNameLength;
+inline constexpr size_t kMaxSessionLength = messages::kMaxSessionNameLength;
 
 struct ServerParams {
   // LCM provider URL. Empty: the environment's LCM_DEFAULT_URL if set, else the loopback
-  // multicast default udpm://239.255.76.67:7667?ttl=0 (transport::ResolveLcmUrl).
+  // multicast default udpm://239.255.76.67:7667?ttl=0 (messages::ResolveLcmUrl).
   std::string lcm_url;
   // Channel prefix: the server listens on <session>_DEVICE_STATE and <session>_COMMAND
   // and publishes <session>_FORCE_MODEL, _SHAPE and _SOLVER_STATUS. [A-Za-z0-9_]+,

@@ -4,11 +4,11 @@
 
 namespace snapthread::server {
 
-int64_t UpdateCap::Hold(std::vector<PoseSample>* poses) {
+int64_t UpdateCap::Hold(std::vector<ReceivedPose>* poses) {
   int64_t superseded = 0;
-  for (PoseSample& pose : *poses) {
+  for (ReceivedPose& pose : *poses) {
     auto same = std::find_if(held_.begin(), held_.end(),
-                             [&](const PoseSample& h) { return h.state.grasp == pose.state.grasp; });
+                             [&](const ReceivedPose& h) { return h.state.grasp == pose.state.grasp; });
     if (same == held_.end()) {
       held_.push_back(std::move(pose));
     } else {
@@ -24,7 +24,7 @@ UpdateCap::Clock::time_point UpdateCap::Wake() const {
   return held_.empty() ? Clock::time_point::max() : next_;
 }
 
-bool UpdateCap::Release(double rate_hz, Clock::time_point now, std::vector<PoseSample>* out) {
+bool UpdateCap::Release(double rate_hz, Clock::time_point now, std::vector<ReceivedPose>* out) {
   if (held_.empty() || (rate_hz > 0.0 && now < next_)) return false;
   out->swap(held_);
   held_.clear();

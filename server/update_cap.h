@@ -15,14 +15,14 @@ class UpdateCap {
  public:
   using Clock = std::chrono::steady_clock;
   // Holds poses (moved from); returns how many held ones they superseded.
-  int64_t Hold(std::vector<PoseSample>* poses);
+  int64_t Hold(std::vector<ReceivedPose>* poses);
   // When the held poses may be solved (time_point::max() when none is held).
   Clock::time_point Wake() const;
   // The held poses into *out when their slot has come at rate_hz (<= 0: no cap).
-  bool Release(double rate_hz, Clock::time_point now, std::vector<PoseSample>* out);
+  bool Release(double rate_hz, Clock::time_point now, std::vector<ReceivedPose>* out);
 
  private:
-  std::vector<PoseSample> held_;
+  std::vector<ReceivedPose> held_;
   Clock::time_point next_{};
 };
 

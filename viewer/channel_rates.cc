@@ -38,7 +38,7 @@ std::string ChannelRateMonitor::RateReport(double interval_s) {
     const double kbps = interval_s > 0 ? (total.bytes - before.bytes) / interval_s / 1000.0 : 0.0;
     // A channel name from the network is hostile text: escaped (a valid one is unchanged).
     std::snprintf(line, sizeof line, "%-32s %9.1f Hz %9.1f kB/s  total %lld\n",
-                  transport::EscapeForDisplay(channel, 63).c_str(),
+                  messages::EscapeForDisplay(channel, 63).c_str(),
                   hz, kbps, static_cast<long long>(total.messages));
     out += line;
   }

@@ -15,14 +15,14 @@ GraspPublisher::GraspPublisher(lcm::LCM* lcm, const std::string& session,
                                const DeviceMapping& mapping, const auth::SessionKey* key,
                                std::function<int64_t()> epoch)
     : lcm_(lcm),
-      channel_(transport::Channels(session).device_state),
+      channel_(messages::Channels(session).device_state),
       mapping_(mapping),
       key_(key),
       epoch_(std::move(epoch)) {}
 
 bool GraspPublisher::Publish(const Eigen::Vector3d& model_position, bool held) {
   device_state_t msg;
-  msg.utime = transport::MonotonicMicros();  // device poses carry CLOCK_MONOTONIC
+  msg.utime = realtime::MonotonicMicros();  // device poses carry CLOCK_MONOTONIC
   msg.seq = ++seq_;
   msg.device_id = "viewer-mouse";
   const Eigen::Vector3d p = messages::ModelPointToDevice(mapping_, model_position);
@@ -30,7 +30,7 @@ bool GraspPublisher::Publish(const Eigen::Vector3d& model_position, bool held) {
   msg.orientation[0] = 1.0;  // identity: grip direction +x
   msg.orientation[1] = msg.orientation[2] = msg.orientation[3] = 0.0;
   msg.buttons = held ? 1 : 0;
-  if (!transport::Validate(msg, nullptr)) return false;  // e.g. a non-finite drag target
+  if (!messages::Validate(msg, nullptr)) return false;  // e.g. a non-finite drag target
   if (key_ != nullptr &&
       !auth::Sign(&msg, channel_, epoch_ ? epoch_() : 0, auth_seq_.Next(), *key_)) {
     return false;

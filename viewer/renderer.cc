@@ -363,7 +363,7 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
   std::string text;
   // Strings of messages (scene, model, method, knot) are hostile text: escaped and cut short,
   // so no newline, control byte or long string can forge or push away HUD lines.
-  const auto shown = [](const std::string& t) { return transport::EscapeForDisplay(t, 40); };
+  const auto shown = [](const std::string& t) { return messages::EscapeForDisplay(t, 40); };
   std::snprintf(line, sizeof line, "snapthread  session %s\n", shown(info.session).c_str());
   text += line;
   if (s.has_shape) {

@@ -16,8 +16,8 @@ SessionReceiver::SessionReceiver(lcm::LCM* lcm, const std::string& session,
                                  const auth::SessionKey* key)
     : lcm_(lcm),
       key_(key),
-      shape_channel_(transport::Channels(session).shape),
-      status_channel_(transport::Channels(session).solver_status) {
+      shape_channel_(messages::Channels(session).shape),
+      status_channel_(messages::Channels(session).solver_status) {
   lcm::Subscription* shapes =
       messages::Subscribe<&SessionReceiver::OnShape>(lcm_, shape_channel_, this);
   lcm::Subscription* statuses =

@@ -61,7 +61,7 @@ class SessionReceiver {
   static constexpr int kShapeQueue = 240;
 
   // Subscribes on `lcm` (which must be good()). Call Start() to begin handling.
-  // `session` must be a valid session name (transport::Channels throws otherwise).
+  // `session` must be a valid session name (messages::Channels throws otherwise).
   // With a key (which must outlive the receiver) statuses are taken only with a valid
   // MAC and fresh sequence (their epoch adopted) and shapes only with a valid MAC, that
   // epoch and a fresh sequence (docs/security.md); nullptr checks nothing (tests).

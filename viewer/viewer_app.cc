@@ -170,7 +170,7 @@ std::optional<auth::SessionKey> LoadViewerKey(const ViewerOptions& options) {
 bool LcmOpened(const lcm::LCM& lcm, const ViewerOptions& options) {
   if (lcm.good()) return true;
   std::fprintf(stderr, "snapthread-viewer: cannot open LCM at %s. %s\n", options.lcm_url.c_str(),
-               transport::LcmStartHint(options.lcm_url).c_str());
+               messages::LcmStartHint(options.lcm_url).c_str());
   return false;
 }
 
@@ -202,7 +202,7 @@ int RunPrintRates(const ViewerOptions& options) {
   }
   // Final totals in a fixed format that scripts (the two-host test) parse.
   for (const auto& [channel, count] : monitor.Totals()) {
-    std::printf("TOTAL %s %lld\n", transport::EscapeForDisplay(channel).c_str(),
+    std::printf("TOTAL %s %lld\n", messages::EscapeForDisplay(channel).c_str(),
                 static_cast<long long>(count.messages));
   }
   std::printf("REJECTED %lld\n", static_cast<long long>(checked.auth_rejected()));

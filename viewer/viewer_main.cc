@@ -58,10 +58,10 @@ int main(int argc, char** argv) {
     }
   }
   // A receiver: a kernel buffer that rides out seconds off the CPU (lcm_url.h).
-  o.lcm_url = snapthread::transport::WithReceiveBuffer(snapthread::transport::ResolveLcmUrl(o.lcm_url));
-  if (!snapthread::transport::IsValidSessionName(o.session)) {
+  o.lcm_url = snapthread::messages::WithReceiveBuffer(snapthread::messages::ResolveLcmUrl(o.lcm_url));
+  if (!snapthread::messages::IsValidSessionName(o.session)) {
     std::fprintf(stderr, "snapthread-viewer: bad --session %s (expected [A-Za-z0-9_]+)\n",
-                 snapthread::transport::EscapeForDisplay(o.session).c_str());
+                 snapthread::messages::EscapeForDisplay(o.session).c_str());
     return snapthread::viewer::kExitSetupFailed;
   }
   if (o.grasp_mode && o.scene_path.empty()) {

@@ -7,7 +7,7 @@ namespace snapthread::viewer {
 
 struct ViewerOptions {
   std::string session = "SNAPTHREAD";  // channel prefix: <session>_SHAPE, ...
-  std::string lcm_url;  // resolved by transport::ResolveLcmUrl (flag, env, default)
+  std::string lcm_url;  // resolved by messages::ResolveLcmUrl (flag, env, default)
   int width = 1280;   // window size, pixels
   int height = 720;
   std::string screenshot_path;  // non-empty: headless screenshot mode

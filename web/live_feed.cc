@@ -45,9 +45,9 @@ LiveFeed::LiveFeed(const std::string& lcm_url, const std::string& session,
                    const auth::SessionKey& key, PublishFn publish)
     : lcm_(lcm_url), key_(key), publish_(std::move(publish)) {
   if (!lcm_.good()) {
-    throw std::runtime_error("cannot open LCM at " + lcm_url + ". " + transport::LcmStartHint(lcm_url));
+    throw std::runtime_error("cannot open LCM at " + lcm_url + ". " + messages::LcmStartHint(lcm_url));
   }
-  const transport::Channels channels(session);
+  const messages::Channels channels(session);
   // Shapes come at ~60 Hz and force models at the update rate; LCM's default queue of 30
   // would drop bursts while this thread is off the CPU, so give them seconds of room.
   // (messages::Subscribe, not lcm_.subscribe: see messages/subscribe.h.)
@@ -151,7 +151,7 @@ void LiveFeed::OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& chan
   }
   Msg msg;
   std::string why;
-  if (!transport::DecodeAndValidate(rbuf, &msg, &why)) {
+  if (!messages::DecodeAndValidate(rbuf, &msg, &why)) {
     malformed_++;
     return;
   }

@@ -1,6 +1,6 @@
 // The bridge's LCM side in live mode: subscribes to <SESSION>_SHAPE, _FORCE_MODEL,
 // _SOLVER_STATUS and _DEVICE_STATUS, vets every message as the viewer does (the MAC with
-// the session key over the bytes received, first; then transport::DecodeAndValidate; then
+// the session key over the bytes received, first; then messages::DecodeAndValidate; then
 // the server epoch learned from an authenticated solver status and a strictly increasing
 // auth_seq per sender) and hands each accepted one, as JSON, to `publish`. Per-sender
 // state (a device's sequence floor) is made only for a message whose MAC passed, and the

@@ -34,7 +34,7 @@ bool Classify(const std::string& channel, FeedKind* kind, std::string* session) 
 
 template <class Msg>
 bool Decode(const lcm::LogEvent& e, Msg* msg) {
-  return transport::DecodeAndValidate(e.data, e.datalen, msg, nullptr);
+  return messages::DecodeAndValidate(e.data, e.datalen, msg, nullptr);
 }
 
 // The session of the log's first shape channel ("" when none).

@@ -76,7 +76,7 @@ int RunWeb(WebOptions o) {
       const ReplayPosition p = replay->position();
       // The log's session name is the log's text: shown escaped.
       std::printf("snapthread-web: replaying %s: session %s, %lld shapes over %.1f s (last seq %lld)\n",
-                  o.log_path.c_str(), transport::EscapeForDisplay(replay->session()).c_str(), static_cast<long long>(p.shape_count),
+                  o.log_path.c_str(), messages::EscapeForDisplay(replay->session()).c_str(), static_cast<long long>(p.shape_count),
                   p.duration_s, static_cast<long long>(p.last_seq));
     } else {
       key.emplace(auth::LoadKey(auth::ResolveKeyPath(o.key_path)));
@@ -106,7 +106,7 @@ int RunWeb(WebOptions o) {
                                                  : o.bind;
   std::printf("snapthread-web: serving %s of session %s at http://%s:%u/%s\n",
               replay ? "a replay" : "the live view",
-              transport::EscapeForDisplay(replay ? replay->session() : o.session).c_str(),
+              messages::EscapeForDisplay(replay ? replay->session() : o.session).c_str(),
               host.c_str(), server->port(), o.token.empty() ? "" : ("?token=" + o.token).c_str());
   std::fflush(stdout);
 

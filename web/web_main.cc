@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "snapthread-web: --max-rate-hz and --duration-s must be finite numbers\n");
     return 1;
   }
-  if (!snapthread::transport::IsValidSessionName(o.session)) {
+  if (!snapthread::messages::IsValidSessionName(o.session)) {
     std::fprintf(stderr, "snapthread-web: bad --session '%s' (expected [A-Za-z0-9_]+)\n",
                  o.session.c_str());
     return 1;
@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
     }
   }
   // A receiver: a kernel buffer that rides out seconds off the CPU (lcm_url.h).
-  o.lcm_url = snapthread::transport::WithReceiveBuffer(snapthread::transport::ResolveLcmUrl(o.lcm_url));
+  o.lcm_url = snapthread::messages::WithReceiveBuffer(snapthread::messages::ResolveLcmUrl(o.lcm_url));
   // In replay the session comes from the log unless --session was given.
   if (!o.log_path.empty() && app.count("--session") == 0 && std::getenv("SNAPTHREAD_SESSION") == nullptr) {
     o.session.clear();

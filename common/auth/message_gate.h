@@ -5,7 +5,7 @@
 // rejected_messages), logs filter.TakeLogLine() and never uses a refused message.
 //
 // `data`/`size` are the received LCM buffer (rbuf->data, rbuf->data_size) and `decoded`
-// its exact decoding (no trailing bytes; transport::DecodeAndValidate). Allocation-free
+// its exact decoding (no trailing bytes; messages::DecodeAndValidate). Allocation-free
 // after the first message of each size; never throws.
 #pragma once
 

@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-namespace snapthread::transport {
+namespace snapthread::messages {
 
 bool IsValidSessionName(const std::string& session) {
   if (session.empty() || session.size() > kMaxSessionNameLength) return false;
@@ -64,4 +64,4 @@ Channels::Channels(const std::string& session_name) : session(session_name) {
   command = session + "_COMMAND";
 }
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::messages

@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-namespace snapthread::transport {
+namespace snapthread::messages {
 
 inline constexpr const char* kDefaultSession = "SNAPTHREAD";
 
@@ -48,4 +48,4 @@ bool IsValidChannelName(std::string_view name);
 // shown; a longer text ends in "...[N bytes]". A valid channel name comes back unchanged.
 std::string EscapeForDisplay(std::string_view text, size_t max_bytes = 128);
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::messages

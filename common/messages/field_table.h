@@ -18,7 +18,7 @@
 #include <string>
 #include <type_traits>
 
-namespace snapthread::transport {
+namespace snapthread::messages {
 
 // Largest string accepted in any message field, bytes.
 inline constexpr size_t kMaxStringBytes = 4096;
@@ -261,4 +261,4 @@ Field<T> With(Field<T> f, bool (*rule)(const T&, std::string*)) {
   return f;
 }
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::messages

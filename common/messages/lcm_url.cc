@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <fstream>
 
-namespace snapthread::transport {
+namespace snapthread::messages {
 
 std::string ResolveLcmUrl(const std::string& flag_value) {
   if (!flag_value.empty()) return flag_value;
@@ -37,4 +37,4 @@ std::string LcmStartHint(const std::string& url) {
   return "check the LCM URL (e.g. udpm://239.255.76.67:7667?ttl=0 or memq://)";
 }
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::messages

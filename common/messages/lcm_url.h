@@ -3,7 +3,7 @@
 
 #include <string>
 
-namespace snapthread::transport {
+namespace snapthread::messages {
 
 // Loopback multicast with ttl=0: the embedded one-machine default (never leaves the host).
 inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
@@ -35,4 +35,4 @@ std::string WithReceiveBuffer(const std::string& url, int bytes = kReceiverBuffe
 // A one-line hint for a failed LCM start (e.g. the multicast route for udpm).
 std::string LcmStartHint(const std::string& url);
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::messages

@@ -5,7 +5,7 @@
 #include <limits>
 #include <span>
 
-namespace snapthread::transport {
+namespace snapthread::messages {
 namespace {
 
 constexpr int64_t kInt32Max = std::numeric_limits<int32_t>::max();
@@ -264,4 +264,4 @@ bool Validate(const solver_status_t& msg, std::string* why) { return ValidateByT
 bool Validate(const device_status_t& msg, std::string* why) { return ValidateByTable(msg, why); }
 bool Validate(const command_t& msg, std::string* why) { return ValidateByTable(msg, why); }
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::messages

@@ -17,7 +17,7 @@
 #include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
 
-namespace snapthread::transport {
+namespace snapthread::messages {
 
 // Largest thread_shape_t the service accepts (positions are 24 bytes per node).
 inline constexpr int kMaxShapeNodes = 100000;
@@ -103,4 +103,4 @@ bool DecodeAndValidate(const lcm::ReceiveBuffer* buf, T* out, std::string* why) 
   return DecodeAndValidate(buf->data, static_cast<int>(buf->data_size), out, why);
 }
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::messages

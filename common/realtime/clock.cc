@@ -2,7 +2,7 @@
 
 #include <time.h>
 
-namespace snapthread::transport {
+namespace snapthread::realtime {
 namespace {
 int64_t Micros(clockid_t id) {
   timespec ts{};
@@ -14,4 +14,4 @@ int64_t Micros(clockid_t id) {
 int64_t MonotonicMicros() { return Micros(CLOCK_MONOTONIC); }
 int64_t RealtimeMicros() { return Micros(CLOCK_REALTIME); }
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::realtime

@@ -4,11 +4,11 @@
 
 #include <cstdint>
 
-namespace snapthread::transport {
+namespace snapthread::realtime {
 
 // CLOCK_MONOTONIC in microseconds. Async-signal-safe and allocation-free.
 int64_t MonotonicMicros();
 // CLOCK_REALTIME in microseconds.
 int64_t RealtimeMicros();
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::realtime

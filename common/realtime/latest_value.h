@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <type_traits>
 
-namespace snapthread::transport {
+namespace snapthread::realtime {
 
 template <class T>
 class LatestValue {
@@ -70,4 +70,4 @@ class LatestValue {
   alignas(64) std::atomic<uint64_t> writes_{0};
 };
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::realtime

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace snapthread::transport {
+namespace snapthread::realtime {
 
 SampleWindow::SampleWindow(size_t capacity) {
   if (capacity == 0) throw std::invalid_argument("SampleWindow capacity must be positive");
@@ -47,4 +47,4 @@ PercentileSummary SampleWindow::Compute() const {
   return s;
 }
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::realtime

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace snapthread::transport {
+namespace snapthread::realtime {
 
 struct PercentileSummary {
   size_t count = 0;  // samples in the window
@@ -43,4 +43,4 @@ class SampleWindow {
   uint64_t total_ = 0;
 };
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::realtime

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <type_traits>
 
-namespace snapthread::transport {
+namespace snapthread::realtime {
 
 template <class T, size_t N>
 class SpscRing {
@@ -67,4 +67,4 @@ class SpscRing {
   alignas(64) T slots_[N]{};
 };
 
-}  // namespace snapthread::transport
+}  // namespace snapthread::realtime

@@ -91,7 +91,7 @@ class Flooder {
     }
   }
 
-  transport::Channels channels_;
+  messages::Channels channels_;
   lcm::LCM lcm_;
   std::thread thread_;
   std::atomic<bool> stop_{false};

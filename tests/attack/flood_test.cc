@@ -84,7 +84,7 @@ class StatusWatch {
   }
   void OnDevice(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     device_status_t st;
-    if (!transport::DecodeAndValidate(rbuf, &st, nullptr) || !Genuine(rbuf, channel)) return;
+    if (!messages::DecodeAndValidate(rbuf, &st, nullptr) || !Genuine(rbuf, channel)) return;
     std::lock_guard<std::mutex> lock(mutex_);
     ++now_.device_statuses;
     now_.models_received = st.models_received;
@@ -93,7 +93,7 @@ class StatusWatch {
   }
   void OnServer(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     solver_status_t st;
-    if (!transport::DecodeAndValidate(rbuf, &st, nullptr) || !Genuine(rbuf, channel)) return;
+    if (!messages::DecodeAndValidate(rbuf, &st, nullptr) || !Genuine(rbuf, channel)) return;
     std::lock_guard<std::mutex> lock(mutex_);
     ++now_.server_statuses;
     now_.updates = st.updates;
@@ -101,7 +101,7 @@ class StatusWatch {
     if (now_.scenes.find(st.scene + ";") == std::string::npos) now_.scenes += st.scene + ";";
   }
 
-  transport::Channels channels_;
+  messages::Channels channels_;
   const auth::SessionKey* key_;
   lcm::LCM lcm_{kUrl};
   std::atomic<bool> stop_{false};

@@ -102,7 +102,7 @@ struct Recorded {
   int64_t models_after = -1;                 // and last after
 };
 
-Recorded ReadLog(const std::string& path, const transport::Channels& ch, int64_t after_us) {
+Recorded ReadLog(const std::string& path, const messages::Channels& ch, int64_t after_us) {
   Recorded r;
   lcm::LogFile log(path, "r");
   if (!log.good()) return r;
@@ -123,7 +123,7 @@ TEST(LcmFragmentsTest, EveryReceivingBinarySurvivesAndCountsMalformedDatagrams) 
   const std::string dir = tmp.path();
   const std::string bin = BinDir();
   const std::string session = UniqueSession("FRAG");
-  const transport::Channels channels(session);
+  const messages::Channels channels(session);
   const std::string scene = ScenePath("curve2d_snap.yaml");
   const std::string log = dir + "/session.lcmlog";
   const std::string shot = dir + "/viewer.png";

@@ -349,7 +349,7 @@ TEST_P(ReportInjectionTest, RunsNoCommandDrawsTheGenuineSessionAndEscapesTheName
   EXPECT_EQ(rows, genuine_models);
 
   // The name is shown escaped, never raw, and the text output is one printable line per item.
-  const std::string escaped = transport::EscapeForDisplay(h.channel);
+  const std::string escaped = messages::EscapeForDisplay(h.channel);
   EXPECT_NE(Line(summary, "channel " + escaped + " ").find("messages " + std::to_string(hostile_logged) + " "),
             std::string::npos) << summary;
   EXPECT_NE(r.out.find("channel " + escaped + " "), std::string::npos);
@@ -472,8 +472,8 @@ TEST(ReportInjectionViewerTest, PrintRatesShowsHostileChannelNamesEscaped) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(PrintableLines(r.out)) << r.out;
   for (const std::string& channel : hostile) {
-    SCOPED_TRACE(transport::EscapeForDisplay(channel));
-    EXPECT_NE(r.out.find("TOTAL " + transport::EscapeForDisplay(channel) + " "), std::string::npos)
+    SCOPED_TRACE(messages::EscapeForDisplay(channel));
+    EXPECT_NE(r.out.find("TOTAL " + messages::EscapeForDisplay(channel) + " "), std::string::npos)
         << r.out;
     EXPECT_EQ(r.out.find(channel), std::string::npos) << "raw name printed";
   }
@@ -484,12 +484,12 @@ TEST(ReportInjectionViewerTest, PrintRatesShowsHostileChannelNamesEscaped) {
 TEST(ChannelGrammarTest, AcceptsTheProjectsNamesAndRefusesEverythingElse) {
   for (const std::string& ok : std::vector<std::string>{"LAB1_FORCE_MODEL", "SNAPTHREAD_DEVICE_STATUS", "LCM_SELF_TEST",
                                "a.b:c/d-e", std::string(63, 'S')}) {
-    EXPECT_TRUE(transport::IsValidChannelName(ok)) << ok;
-    EXPECT_EQ(transport::EscapeForDisplay(ok), ok);
+    EXPECT_TRUE(messages::IsValidChannelName(ok)) << ok;
+    EXPECT_EQ(messages::EscapeForDisplay(ok), ok);
   }
-  for (const Hostile& h : HostileChannels()) EXPECT_FALSE(transport::IsValidChannelName(h.channel));
+  for (const Hostile& h : HostileChannels()) EXPECT_FALSE(messages::IsValidChannelName(h.channel));
   for (const std::string& bad : std::vector<std::string>{"", std::string(64, 'S'), "A B", "A\tB", "\xc3\xa4", "A\\B"}) {
-    EXPECT_FALSE(transport::IsValidChannelName(bad)) << transport::EscapeForDisplay(bad);
+    EXPECT_FALSE(messages::IsValidChannelName(bad)) << messages::EscapeForDisplay(bad);
   }
 }
 
@@ -497,13 +497,13 @@ TEST(ChannelGrammarTest, EscapingIsPrintableOneLineAndKeepsBytesApart) {
   std::set<std::string> seen;
   for (int b = 0; b < 256; ++b) {
     const std::string one(1, char(b));
-    const std::string shown = transport::EscapeForDisplay("x" + one + "y");
+    const std::string shown = messages::EscapeForDisplay("x" + one + "y");
     EXPECT_TRUE(PrintableLines(shown) && shown.find('\n') == std::string::npos) << b;
     for (char c : std::string("'\"`$;|# ,")) EXPECT_EQ(shown.find(c), std::string::npos) << b;
     EXPECT_TRUE(seen.insert(shown).second) << "two bytes escape alike: " << shown;
   }
-  EXPECT_EQ(transport::EscapeForDisplay("\\x41"), "\\x5cx41");  // a backslash is escaped too
-  const std::string shown = transport::EscapeForDisplay(std::string(900, 'B'));
+  EXPECT_EQ(messages::EscapeForDisplay("\\x41"), "\\x5cx41");  // a backslash is escaped too
+  const std::string shown = messages::EscapeForDisplay(std::string(900, 'B'));
   EXPECT_EQ(shown, std::string(128, 'B') + "...[900 bytes]");
 }
 

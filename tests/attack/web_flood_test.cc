@@ -84,7 +84,7 @@ class Flooder {
     }
   }
 
-  transport::Channels channels_;
+  messages::Channels channels_;
   std::thread thread_;
   std::atomic<bool> running_{true};
   std::atomic<int64_t> sent_{0};

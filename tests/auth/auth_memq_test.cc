@@ -43,7 +43,7 @@ class Device {
 
   void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     solver_status_t msg;
-    if (!transport::DecodeAndValidate(rbuf, &msg, nullptr)) return;
+    if (!messages::DecodeAndValidate(rbuf, &msg, nullptr)) return;
     if (Admit(rbuf->data, rbuf->data_size, msg, channel, *key_, &status_filter_) == Reason::kAccepted) {
       model_filter_.SetEpoch(status_filter_.epoch());
     }
@@ -51,7 +51,7 @@ class Device {
 
   void OnModel(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     force_model_t msg;
-    if (!transport::DecodeAndValidate(rbuf, &msg, nullptr)) {
+    if (!messages::DecodeAndValidate(rbuf, &msg, nullptr)) {
       ++malformed_;
       return;
     }
@@ -100,7 +100,7 @@ class Server {
 
   void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     device_state_t pose;
-    if (!transport::DecodeAndValidate(rbuf, &pose, nullptr)) return;
+    if (!messages::DecodeAndValidate(rbuf, &pose, nullptr)) return;
     if (Admit(rbuf->data, rbuf->data_size, pose, channel, *key_, &pose_filter_) != Reason::kAccepted) {
       return;
     }

@@ -196,14 +196,14 @@ TEST(BadPacketTest, ALiveServerRefusesAndCountsEveryBadPoseAndCommand) {
   std::filesystem::create_symlink("/etc/passwd", scenes + "/passwd.yaml");
 
   const std::string session = test_support::UniqueSession("BADPKT_S");
-  const transport::Channels ch(session);
+  const messages::Channels ch(session);
   LiveProcess server({test_support::BinDir() + "/snapthread-server", "--scene", scenes + "/zeeman.yaml",
                       "--scene-dir", scenes, "--session", session, "--lcm-url", test_support::kLoopbackLcmUrl,
                       "--status-rate-hz", "50", "--summary", dir.path() + "/summary.json"},
                      dir.path() + "/server.log", ch.solver_status);
   server.read_status = [](const lcm::ReceiveBuffer* rbuf, int64_t* count, int64_t* epoch) {
     solver_status_t st;
-    if (!transport::DecodeAndValidate(rbuf->data, static_cast<int>(rbuf->data_size), &st, nullptr)) return false;
+    if (!messages::DecodeAndValidate(rbuf->data, static_cast<int>(rbuf->data_size), &st, nullptr)) return false;
     *count = st.rejected_messages;
     *epoch = st.epoch;
     return true;
@@ -278,7 +278,7 @@ TEST(BadPacketTest, ALiveServerRefusesAndCountsEveryBadPoseAndCommand) {
 // cases' models are the only ones, signed with model_seq() from the test's thread.
 class FakeServer {
  public:
-  FakeServer(const transport::Channels& ch, lcm::LCM* lcm, const auth::SessionKey* key)
+  FakeServer(const messages::Channels& ch, lcm::LCM* lcm, const auth::SessionKey* key)
       : ch_(ch), lcm_(lcm), key_(key), epoch_(auth::NewEpoch()) {
     messages::Subscribe<&FakeServer::OnPose>(lcm_, ch_.device_state, this);
   }
@@ -308,7 +308,7 @@ class FakeServer {
   void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     device_state_t pose;
     if (!answering_.load()) return;
-    if (!transport::DecodeAndValidate(rbuf->data, static_cast<int>(rbuf->data_size), &pose, nullptr)) return;
+    if (!messages::DecodeAndValidate(rbuf->data, static_cast<int>(rbuf->data_size), &pose, nullptr)) return;
     force_model_t m{};
     m.seq = ++model_seq_;
     m.device_seq = pose.seq;
@@ -321,7 +321,7 @@ class FakeServer {
     lcm_->publish(ch_.force_model, last_bytes_.data(), static_cast<unsigned>(last_bytes_.size()));
   }
 
-  transport::Channels ch_;
+  messages::Channels ch_;
   lcm::LCM* lcm_;
   const auth::SessionKey* key_;
   int64_t epoch_;
@@ -342,14 +342,14 @@ TEST(BadPacketTest, ALiveDeviceRefusesAndCountsEveryBadForceModel) {
   std::ofstream(scene) << "model: zeeman\ngrasp:\n  start: [0, 2.5]\n  path: [[-2, 3.0], [2, 1.5]]\n"
                           "device:\n  model_units_per_metre: 100\n  model_origin: [0, 2.5, 0]\n";
   const std::string session = test_support::UniqueSession("BADPKT_D");
-  const transport::Channels ch(session);
+  const messages::Channels ch(session);
   LiveProcess device({test_support::BinDir() + "/snapthread-device", "--backend", "sim-path", "--scene", scene,
                       "--session", session, "--lcm-url", test_support::kLoopbackLcmUrl, "--no-rt", "--duration",
                       "60", "--speed-m-per-s", "0.02"},
                      dir.path() + "/device.log", ch.device_status);
   device.read_status = [](const lcm::ReceiveBuffer* rbuf, int64_t* count, int64_t* epoch) {
     device_status_t st;
-    if (!transport::DecodeAndValidate(rbuf->data, static_cast<int>(rbuf->data_size), &st, nullptr)) return false;
+    if (!messages::DecodeAndValidate(rbuf->data, static_cast<int>(rbuf->data_size), &st, nullptr)) return false;
     *count = st.models_rejected;
     *epoch = st.epoch;
     return true;

@@ -226,12 +226,12 @@ bool SignInto(Msg* m, const char* channel, const auth::SessionKey& key, int64_t 
 }
 
 // What a receiver does with a packet on kChannel: exact decode (else dropped before the
-// gate, as transport::DecodeAndValidate refuses it), then Admit. *offered says whether the
+// gate, as messages::DecodeAndValidate refuses it), then Admit. *offered says whether the
 // gate saw it; the model's expectation is checked and applied.
 template <class Msg>
 Reason Offer(State& st, const std::vector<uint8_t>& bytes, bool* offered) {
   Msg decoded;
-  *offered = transport::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &decoded, nullptr);
+  *offered = messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &decoded, nullptr);
   if (!*offered) {
     // Never handed to the gate; the MAC check must still be safe on any bytes.
     (void)auth::VerifyEncoded(bytes.data(), bytes.size(), kChannel, Key());
@@ -304,7 +304,7 @@ void ForceModelStep(Script& in, State& st) {
   if (!SignInto(&m, kChannel, Key(), epoch, seq, &s)) return;
   if (flip >= 224) s.bytes[in.U16() % s.bytes.size()] ^= static_cast<uint8_t>(1u + in.U8() % 255u);
   force_model_t decoded;
-  if (!transport::DecodeAndValidate(s.bytes.data(), static_cast<int>(s.bytes.size()), &decoded, nullptr)) return;
+  if (!messages::DecodeAndValidate(s.bytes.data(), static_cast<int>(s.bytes.size()), &decoded, nullptr)) return;
   const bool mac_ok = auth::VerifyEncoded(s.bytes.data(), s.bytes.size(), kChannel, Key());
   const bool echoed = st.poses.Contains(decoded.epoch, decoded.device_seq, decoded.device_utime);
   // No false echo: the window only knows poses that were recorded.

@@ -21,7 +21,7 @@ template <class T>
 void Check(const uint8_t* data, size_t size) {
   T msg;
   std::string why;
-  if (!transport::DecodeAndValidate(data, static_cast<int>(size), &msg, &why)) {
+  if (!messages::DecodeAndValidate(data, static_cast<int>(size), &msg, &why)) {
     if (why.empty()) std::abort();  // a rejection always names its reason
     return;
   }

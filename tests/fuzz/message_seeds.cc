@@ -17,7 +17,7 @@ using namespace snapthread;
 template <class T>
 bool Write(const std::string& dir, int type_byte, const char* name, const T& msg) {
   std::string why;
-  if (!transport::Validate(msg, &why)) {
+  if (!messages::Validate(msg, &why)) {
     std::fprintf(stderr, "message_seeds: %s seed is invalid: %s\n", name, why.c_str());
     return false;
   }

@@ -133,7 +133,7 @@ class SessionListener {
     return *v;
   }
   lcm::LCM lcm_;
-  transport::Channels channels_;
+  messages::Channels channels_;
   const test_support::SessionKeyFile* key_ = nullptr;
   auth::AuthSequence auth_seq_;
   int64_t seq_ = 0;

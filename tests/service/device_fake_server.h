@@ -76,7 +76,7 @@ class FakeServer {
  private:
   void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     device_state_t pose;
-    if (!transport::DecodeAndValidate(rbuf, &pose, nullptr)) return;
+    if (!messages::DecodeAndValidate(rbuf, &pose, nullptr)) return;
     poses_.fetch_add(1);
     force_model_t m{};
     m.utime = 0;
@@ -106,7 +106,7 @@ class FakeServer {
     if (lcm_.publish(channels_.solver_status, &st) == 0) statuses_sent_.fetch_add(1);
   }
 
-  transport::Channels channels_;
+  messages::Channels channels_;
   lcm::LCM lcm_;
   const auth::SessionKey* key_;
   int64_t epoch_;

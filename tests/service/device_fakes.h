@@ -80,7 +80,7 @@ class SpringServer {
   void SignWith(const auth::SessionKey* key, int64_t epoch, const std::string& session) {
     key_ = key;
     epoch_ = epoch;
-    channels_ = transport::Channels(session);
+    channels_ = messages::Channels(session);
   }
 
   force_model_t ModelFor(const device_state_t& s) {
@@ -158,7 +158,7 @@ class SpringServer {
   const auth::SessionKey* key_ = nullptr;
   int64_t epoch_ = 0;
   auth::AuthSequence auth_seq_{0};
-  transport::Channels channels_{transport::kDefaultSession};
+  messages::Channels channels_{messages::kDefaultSession};
 };
 
 }  // namespace snapthread::device::testing

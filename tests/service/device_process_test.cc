@@ -105,7 +105,7 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   const std::string& dir = scoped.path();
   const std::string session = UniqueSession("DEVTEST_SPRING");
   const std::string scene = WriteScene(dir);
-  const transport::Channels channels(session);
+  const messages::Channels channels(session);
 
   auto server = std::make_unique<FakeServer>(session, &key_file.key());
   ASSERT_TRUE(server->good()) << "udpm on loopback unavailable: " << kUrl;
@@ -307,7 +307,7 @@ class Listener {
  private:
   void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     device_state_t m;
-    if (!transport::DecodeAndValidate(rbuf, &m, nullptr)) {
+    if (!messages::DecodeAndValidate(rbuf, &m, nullptr)) {
       ++bad;
       return;
     }
@@ -318,14 +318,14 @@ class Listener {
   }
   void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     device_status_t m;
-    if (!transport::DecodeAndValidate(rbuf, &m, nullptr)) {
+    if (!messages::DecodeAndValidate(rbuf, &m, nullptr)) {
       ++bad;
       return;
     }
     last_status = m;
     ++statuses;
   }
-  transport::Channels channels_;
+  messages::Channels channels_;
   lcm::LCM lcm_;
   std::thread thread_;
   std::atomic<bool> stop_{false};

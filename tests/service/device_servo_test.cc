@@ -48,7 +48,7 @@ TEST(DeviceServoTickTest, PublishesEveryKthPoseWithConsecutiveSeq) {
     g_clock_us += 1000;
     rig.tick->Tick(g_clock_us, 3);
   }
-  PoseSample p;
+  PoseToPublish p;
   int n = 0;
   int64_t expected_seq = 0;
   while (rig.poses->TryPop(&p)) {
@@ -92,7 +92,7 @@ TEST(DeviceServoTickTest, OutOfWorkspacePosesAreNeverPublished) {
       EXPECT_EQ(rig.tick->last_output().force_n[1], 0.0);
     }
   }
-  PoseSample p;
+  PoseToPublish p;
   int published = 0;
   while (rig.poses->TryPop(&p)) {
     EXPECT_LE(std::abs(p.position_m[0]), 0.05 + 1e-12);

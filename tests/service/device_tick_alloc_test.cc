@@ -122,7 +122,7 @@ uint64_t RunTicks(HapticDevice* device, int ticks, bool wrench = false, SnapAhea
       models->Write(m);
     }
     if (i % 100 == 0 && i < 1000) {
-      PoseSample p;
+      PoseToPublish p;
       TraceRow r;
       int32_t l;
       while (poses->TryPop(&p)) {}
@@ -213,7 +213,7 @@ TEST(DeviceServoTickAllocationTest, DeviceClientTickNeverAllocates) {
 }
 
 TEST(DeviceMallocGuardTest, SampleWindowPushAndComputeNeverAllocate) {
-  transport::SampleWindow window(1000);
+  realtime::SampleWindow window(1000);
   window.Compute();  // warm-up
   long allocations = 0;
   {

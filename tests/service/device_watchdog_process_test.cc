@@ -134,12 +134,12 @@ TEST(DeviceWatchdogProcessTest, StoppedServoThreadZeroesTheRenderedForceWithin10
     int status = 0;
     ASSERT_EQ(waitpid(servo, &status, __WALL), servo);
     ASSERT_TRUE(WIFSTOPPED(status));
-    const int64_t stopped_us = transport::MonotonicMicros();
+    const int64_t stopped_us = realtime::MonotonicMicros();
     // Watch the render thread's output for 100 ms while the servo stays stopped.
     bool late_force = false;
-    const int64_t watch_end = transport::MonotonicMicros() + 100000;
+    const int64_t watch_end = realtime::MonotonicMicros() + 100000;
     uint64_t renders_at_start = 0;
-    while (transport::MonotonicMicros() < watch_end) {
+    while (realtime::MonotonicMicros() < watch_end) {
       if (ReadRendered(*record, &s)) {
         if (renders_at_start == 0) renders_at_start = s.renders;
         // Any render more than 10 ms after the last command must be zero.

@@ -161,7 +161,7 @@ TEST(SimRendererTest, RecordsWhenTheOutputTurnedZero) {
 // 10 ms of the last command, and stay zero.
 TEST(DeviceWatchdogTest, StoppedServoLoopZeroesTheRenderedForceWithin10Ms) {
   SimPathDevice device(ScriptedPath({{0.0, 0.0, 0.0}, {0.01, 0.0, 0.0}}, 0.01),
-                       &transport::MonotonicMicros);
+                       &realtime::MonotonicMicros);
   ASSERT_TRUE(device.Open(nullptr));
   std::string error;
   ASSERT_TRUE(device.StartRenderer("", &error)) << error;
@@ -180,7 +180,7 @@ TEST(DeviceWatchdogTest, StoppedServoLoopZeroesTheRenderedForceWithin10Ms) {
       LocalModel m;
       m.status = force_model_t::STATUS_REGULAR;
       m.f0_n[1] = 1.0;
-      m.receive_us = transport::MonotonicMicros();
+      m.receive_us = realtime::MonotonicMicros();
       models.Write(m);
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }

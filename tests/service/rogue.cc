@@ -127,7 +127,7 @@ class Rogue {
   }
 
   lcm::LCM lcm_;
-  snapthread::transport::Channels channels_;
+  snapthread::messages::Channels channels_;
   std::mt19937 rng_;
   int64_t newest_utime_ = 0;
   int64_t model_seq_ = 0, status_seq_ = 0, pose_seq_ = 0, sent_ = 0, poses_answered_ = 0;

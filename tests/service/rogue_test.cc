@@ -95,7 +95,7 @@ class Watcher {
  private:
   void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     solver_status_t st;
-    if (!transport::DecodeAndValidate(rbuf, &st, nullptr)) return;
+    if (!messages::DecodeAndValidate(rbuf, &st, nullptr)) return;
     if (st.epoch == excluded_epoch_.load()) return;
     if (auth::Admit(rbuf->data, rbuf->data_size, st, channel, *key_, &status_filter_) !=
         auth::Reason::kAccepted) {
@@ -113,7 +113,7 @@ class Watcher {
   }
   void OnModel(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     force_model_t m;
-    if (!transport::DecodeAndValidate(rbuf, &m, nullptr)) return;
+    if (!messages::DecodeAndValidate(rbuf, &m, nullptr)) return;
     if (m.epoch == excluded_epoch_.load()) return;
     if (m.epoch != status_filter_.epoch() || status_filter_.epoch() == 0) return;
     if (!auth::VerifyEncoded(rbuf->data, rbuf->data_size, channel, *key_)) return;
@@ -121,7 +121,7 @@ class Watcher {
     ++genuine_models_;
   }
 
-  transport::Channels channels_;
+  messages::Channels channels_;
   const auth::SessionKey* key_;
   lcm::LCM lcm_{kUrl};
   auth::FreshnessFilter status_filter_{"status", auth::FreshnessFilter::EpochPolicy::kAdopt};

@@ -127,7 +127,7 @@ TEST(ServerMessagesTest, PlanarForceModelUnitsAndPlane) {
   EXPECT_EQ(m.has_torque, 0);
   for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(m.u0[i], in.position_m[i]);
   std::string why;
-  EXPECT_TRUE(transport::Validate(m, &why)) << why;
+  EXPECT_TRUE(messages::Validate(m, &why)) << why;
 }
 
 TEST(ServerMessagesTest, GripTorque) {
@@ -206,9 +206,9 @@ TEST(ServerMessagesTest, NonFiniteResultBecomesInvalidZeroModel) {
     in.position_m = Eigen::Vector3d(0.01, 0.0, 0.0);
     in.result = &r;
     const force_model_t m = BuildForceModel(in);
-    EXPECT_TRUE(transport::Validate(m, nullptr)) << "variant " << variant;
+    EXPECT_TRUE(messages::Validate(m, nullptr)) << "variant " << variant;
     std::string why;
-    EXPECT_TRUE(transport::Validate(m, &why)) << why;
+    EXPECT_TRUE(messages::Validate(m, &why)) << why;
     // A NaN residual says the state itself is not finite (issue 13: NaN or inf rows are
     // failed, never a force model), even where the force happened to be finite.
     EXPECT_EQ(m.status, force_model_t::STATUS_INVALID) << "variant " << variant;
@@ -258,7 +258,7 @@ TEST(ServerMessagesTest, ShapeCountsMatchAndValidate) {
   EXPECT_EQ(s.num_frames, 0);  // material frames are the rod's alone
   EXPECT_TRUE(s.frames.empty());
   std::string why;
-  EXPECT_TRUE(transport::Validate(s, &why)) << why;
+  EXPECT_TRUE(messages::Validate(s, &why)) << why;
 }
 
 // Issue 14 item 3: the rod's shape carries one frame row per edge, m1 and the twist
@@ -310,7 +310,7 @@ TEST(ServerMessagesTest, RodShapeCarriesMaterialFramesAndTwistDensity) {
   in.u = u;
   in.x = model->InitialState(u);
   std::string why;
-  EXPECT_TRUE(transport::Validate(s, &why)) << why;
+  EXPECT_TRUE(messages::Validate(s, &why)) << why;
   // A state that does not fit the model gets no frames (and no nodes).
   in.x = Vec::Zero(3);
   EXPECT_EQ(BuildShape(in).num_frames, 0);

@@ -29,7 +29,7 @@ inline constexpr std::chrono::seconds kWait{20};
 // on the server's receive thread (the server spins the shared LCM instance).
 class Probe {
  public:
-  Probe(lcm::LCM* lcm, const transport::Channels& ch) : lcm_(lcm) {
+  Probe(lcm::LCM* lcm, const messages::Channels& ch) : lcm_(lcm) {
     subs_.push_back(messages::Subscribe<&Probe::OnModel>(lcm, ch.force_model, this));
     subs_.push_back(messages::Subscribe<&Probe::OnShape>(lcm, ch.shape, this));
     subs_.push_back(messages::Subscribe<&Probe::OnStatus>(lcm, ch.solver_status, this));
@@ -81,7 +81,7 @@ class Probe {
   void Keep(const lcm::ReceiveBuffer* rbuf, std::vector<T>* kept) {
     T msg;
     std::string why;
-    const bool ok = transport::DecodeAndValidate(rbuf, &msg, &why);
+    const bool ok = messages::DecodeAndValidate(rbuf, &msg, &why);
     std::lock_guard<std::mutex> lock(mutex_);
     if (!ok) {
       ++invalid_;

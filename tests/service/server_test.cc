@@ -410,7 +410,7 @@ TEST_F(ServerTest, CommandsResetSetMethodLoadScene) {
 
 TEST_F(ServerTest, BadPacketsAreCountedAndDropped) {
   StartServer("curve2d_snap.yaml");
-  const transport::Channels& ch = server_->channels();
+  const messages::Channels& ch = server_->channels();
   int bad = 0;
 
   auto encode = [](const auto& msg) {
@@ -512,7 +512,7 @@ TEST_F(ServerTest, FarPosesNeverPublishNaN) {
   }
   EXPECT_EQ(probe_->models().size(), static_cast<size_t>(seq));
   EXPECT_EQ(probe_->invalid(), 0);
-  for (const auto& m : probe_->models()) EXPECT_TRUE(transport::Validate(m, nullptr));
+  for (const auto& m : probe_->models()) EXPECT_TRUE(messages::Validate(m, nullptr));
 }
 
 }  // namespace

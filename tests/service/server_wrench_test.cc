@@ -116,7 +116,7 @@ class RodWrench {
 
   // One pose: device metres and the device rotation vector.
   force_model_t Solve(const V3& position_m, const V3& rotation) {
-    PoseSample pose{};
+    ReceivedPose pose{};
     pose.state = device_state_t{};
     for (int k = 0; k < 3; ++k) pose.state.position[k] = position_m[k];
     const Eigen::Vector4d q = so3::ExpQuaternion(rotation);

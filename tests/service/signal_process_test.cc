@@ -155,11 +155,11 @@ class StatusListener {
     return last_;
   }
   lcm::LCM& lcm() { return lcm_; }
-  const transport::Channels& channels() const { return channels_; }
+  const messages::Channels& channels() const { return channels_; }
 
  private:
   lcm::LCM lcm_;
-  transport::Channels channels_;
+  messages::Channels channels_;
   std::mutex mutex_;
   test_support::ArrivalLog times_;
   solver_status_t last_{};

@@ -101,7 +101,7 @@ class RodPublisher {
   const int64_t epoch_ = auth::NewEpoch();
   auth::AuthSequence auth_seq_;
   lcm::LCM lcm_{kLoopbackLcmUrl};
-  const transport::Channels channels_;
+  const messages::Channels channels_;
   const double tau_;
   std::atomic<bool> running_{true};
   std::thread thread_;

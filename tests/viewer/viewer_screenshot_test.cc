@@ -82,8 +82,8 @@ class ShapePublisher {
   // `decorate` adds to each shape (grasps, contacts) before it is signed.
   ShapePublisher(const std::string& session, bool with_garbage, int8_t status = 0,
                  std::function<void(thread_shape_t*)> decorate = {})
-      : channel_(transport::Channels(session).shape),
-        status_channel_(transport::Channels(session).solver_status),
+      : channel_(messages::Channels(session).shape),
+        status_channel_(messages::Channels(session).solver_status),
         garbage_(with_garbage),
         status_(status),
         decorate_(std::move(decorate)) {}
@@ -428,7 +428,7 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
   {
     lcm::LogFile log(log_path, "w");
     ASSERT_TRUE(log.good());
-    const std::string channel = transport::Channels(session).shape;
+    const std::string channel = messages::Channels(session).shape;
     const int64_t epoch = auth::NewEpoch();
     auth::AuthSequence auth_seq;
     for (int k = 0; k < 400; ++k) {  // 8 s of shapes at 50 Hz, a signed status before each
@@ -436,13 +436,13 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
       st.seq = k;
       st.scene = "test-arc";
       st.method = "newton";
-      ASSERT_TRUE(auth::Sign(&st, transport::Channels(session).solver_status, epoch,
+      ASSERT_TRUE(auth::Sign(&st, messages::Channels(session).solver_status, epoch,
                              auth_seq.Next(), key_file.key()));
       std::vector<uint8_t> status_buf(st.getEncodedSize());
       st.encode(status_buf.data(), 0, int(status_buf.size()));
       lcm::LogEvent se;
       se.timestamp = 1700000000000000 + k * 20000 - 1;
-      se.channel = transport::Channels(session).solver_status;
+      se.channel = messages::Channels(session).solver_status;
       se.datalen = int32_t(status_buf.size());
       se.data = status_buf.data();
       ASSERT_EQ(log.writeEvent(&se), 0);
@@ -490,7 +490,7 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
 class PoseCollector {
  public:
   explicit PoseCollector(const std::string& session) {
-    messages::Subscribe<&PoseCollector::On>(lcm_, transport::Channels(session).device_state, this);
+    messages::Subscribe<&PoseCollector::On>(lcm_, messages::Channels(session).device_state, this);
     thread_ = std::thread([this] {
       while (running_) lcm_.handleTimeout(20);
     });

@@ -24,7 +24,7 @@ TEST(LiveFeed, PassesOnlyMessagesSignedWithTheSessionKey) {
   const auth::SessionKey key = auth::SessionKey::Generate();
   const auth::SessionKey other = auth::SessionKey::Generate();
   const std::string session = test_support::UniqueSession("WEBFEED");
-  const transport::Channels channels(session);
+  const messages::Channels channels(session);
   std::mutex mutex;
   std::string last_shape;
   LiveFeed feed(test_support::kLoopbackLcmUrl, session, key, [&](FeedKind k, Text t) {
@@ -71,7 +71,7 @@ TEST(LiveFeed, PassesOnlyMessagesSignedWithTheSessionKey) {
 TEST(LiveFeed, ForgedDeviceIdsTakeNoPlaceOfTheGenuineDevice) {
   const auth::SessionKey key = auth::SessionKey::Generate();
   const std::string session = test_support::UniqueSession("WEBIDS");
-  const transport::Channels channels(session);
+  const messages::Channels channels(session);
   std::mutex mutex;
   std::string last_device;
   LiveFeed feed(test_support::kLoopbackLcmUrl, session, key, [&](FeedKind k, Text t) {
@@ -114,7 +114,7 @@ TEST(LiveFeed, ForgedDeviceIdsTakeNoPlaceOfTheGenuineDevice) {
 TEST(LiveFeed, ABurstOfForceModelsIsCountedWholeAndPublishedUpToTheNewest) {
   const auth::SessionKey key = auth::SessionKey::Generate();
   const std::string session = test_support::UniqueSession("WEBBURST");
-  const transport::Channels channels(session);
+  const messages::Channels channels(session);
   std::mutex mutex;
   int published = 0;
   std::string last_model;

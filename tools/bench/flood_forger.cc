@@ -43,7 +43,7 @@ template <class Msg>
 bool Add(Msg msg, const std::string& channel, int64_t epoch, const auth::SessionKey& key,
          std::vector<std::pair<std::string, std::vector<uint8_t>>>* out, std::string* error) {
   std::string why;
-  if (!auth::Sign(&msg, channel, epoch, int64_t{1} << 62, key) || !transport::Validate(msg, &why)) {
+  if (!auth::Sign(&msg, channel, epoch, int64_t{1} << 62, key) || !messages::Validate(msg, &why)) {
     *error = "forged message for " + channel + " is not valid: " + why;
     return false;
   }
@@ -62,7 +62,7 @@ ForgedFlood::~ForgedFlood() { Stop(); }
 bool ForgedFlood::Start(std::string* error) {
   if (thread_.joinable()) return true;
   try {
-    const transport::Channels ch(options_.session);
+    const messages::Channels ch(options_.session);
     auth::InitSodium();
     const auth::SessionKey key = auth::SessionKey::Generate();  // not the session's
     auto prepared = std::make_unique<Prepared>();

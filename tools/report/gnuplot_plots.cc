@@ -23,7 +23,7 @@ constexpr char kPreamble[] =
 // quote, backquote, newline or other gnuplot syntax), else a fixed placeholder. The review's
 // session is one already (InferSession, --session), so this is the second wall.
 std::string SessionLabel(const std::string& session) {
-  return transport::IsValidSessionName(session) ? session : "unnamed session";
+  return messages::IsValidSessionName(session) ? session : "unnamed session";
 }
 
 // Runs one script; on success the PNG must exist and be non-empty.

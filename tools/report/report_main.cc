@@ -32,11 +32,11 @@ int main(int argc, char** argv) {
                  "refuse a log larger than this (split long sessions: snapthread-logger --max-bytes)")
       ->capture_default_str()->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
-  if (!session.empty() && !snapthread::transport::IsValidSessionName(session)) {
+  if (!session.empty() && !snapthread::messages::IsValidSessionName(session)) {
     std::fprintf(stderr, "snapthread-report: bad --session %s: expected 1 to %zu characters of "
                          "[A-Za-z0-9_]\n",
-                 snapthread::transport::EscapeForDisplay(session).c_str(),
-                 snapthread::transport::kMaxSessionNameLength);
+                 snapthread::messages::EscapeForDisplay(session).c_str(),
+                 snapthread::messages::kMaxSessionNameLength);
     return 1;
   }
   {

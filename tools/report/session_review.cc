@@ -18,7 +18,7 @@ constexpr size_t kMaxRememberedPoses = 20000;
 
 // Text from the log (channel names, method and knot strings) as it may appear in the
 // summary and in CSV cells: escaped (no comma, quote, newline or control byte survives).
-std::string Shown(const std::string& text) { return transport::EscapeForDisplay(text); }
+std::string Shown(const std::string& text) { return messages::EscapeForDisplay(text); }
 
 std::string TypeOf(const std::string& channel, const std::string& session) {
   if (channel.rfind(session + "_", 0) != 0) return "";
@@ -48,7 +48,7 @@ Stats Percentiles(std::vector<double> v) {
 template <class T>
 bool Decode(const lcm::LogEvent& e, T* msg, ChannelStats* c) {
   std::string why;
-  if (transport::DecodeAndValidate(e.data, e.datalen, msg, &why)) return true;
+  if (messages::DecodeAndValidate(e.data, e.datalen, msg, &why)) return true;
   if (c->rejected++ == 0) c->first_rejection = why;
   return false;
 }
@@ -71,7 +71,7 @@ std::string InferSession(const std::map<std::string, int64_t>& channel_counts) {
         // Only a name of the session grammar can be a session: a channel such as
         // LAB1_';system "id"#_FORCE_MODEL is a foreign channel, counted and shown escaped.
         const std::string session = channel.substr(0, channel.size() - s.size());
-        if (transport::IsValidSessionName(session)) per_session[session] += n;
+        if (messages::IsValidSessionName(session)) per_session[session] += n;
       }
     }
   }
@@ -281,7 +281,7 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
       << " messages (" << unlisted_bytes_ << " bytes), not listed\n";
   }
   int invalid_names = 0;
-  for (const auto& [name, c] : channels_) invalid_names += !transport::IsValidChannelName(name);
+  for (const auto& [name, c] : channels_) invalid_names += !messages::IsValidChannelName(name);
   if (invalid_names > 0) {
     s << "channel names outside the channel grammar [A-Za-z0-9_.:/-]{1,63}: " << invalid_names
       << " (shown escaped, \\xNN per byte; never taken as a session)\n";

@@ -44,7 +44,7 @@ struct KnotRow { double t_s; std::string knot; int determinant; int contacts; };
 struct RoundTripRow { double t_s; double loop_us; double server_us; };
 
 // Picks the session with the most messages among channels named <SESSION>_<KNOWN SUFFIX>
-// whose <SESSION> is a valid session name (transport::IsValidSessionName); "" when there is
+// whose <SESSION> is a valid session name (messages::IsValidSessionName); "" when there is
 // none. A hostile channel name is never chosen, however busy.
 std::string InferSession(const std::map<std::string, int64_t>& channel_counts);
 

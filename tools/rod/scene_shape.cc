@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   app.add_option("--rate-hz", rate_hz, "shapes per second")->capture_default_str()
       ->check(CLI::Range(1.0, 200.0));
   return RunTool("snapthread-scene-shape", app, argc, argv, [&]() -> int {
-    transport::Channels{session};  // refuses a --session outside [A-Za-z0-9_] before the sweep
+    messages::Channels{session};  // refuses a --session outside [A-Za-z0-9_] before the sweep
     std::vector<SceneOverride> overrides;
     for (const auto& s : sets) overrides.push_back(ParseOverride(s));
     const Scene scene = LoadScene(scene_file, overrides);
@@ -61,9 +61,9 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
 
     const auth::SessionKey key = auth::LoadKey(auth::ResolveKeyPath(key_path));
-    lcm::LCM lcm(transport::ResolveLcmUrl(lcm_url));
+    lcm::LCM lcm(messages::ResolveLcmUrl(lcm_url));
     if (!lcm.good()) throw std::runtime_error("cannot open LCM");
-    const transport::Channels channels(session);
+    const messages::Channels channels(session);
     const int64_t epoch = auth::NewEpoch();
     auth::AuthSequence auth_seq;
     server::ShapeInputs in;
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
     for (int64_t seq = 0;; ++seq) {
       if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > duration_s) break;
       solver_status_t st{};
-      st.utime = transport::RealtimeMicros();
+      st.utime = realtime::RealtimeMicros();
       st.seq = seq;
       st.scene = scene.name;
       st.method = scene.solver.method;
@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
         lcm.publish(channels.solver_status, &st);
       }
       in.seq = seq;
-      in.utime = transport::RealtimeMicros();
+      in.utime = realtime::RealtimeMicros();
       thread_shape_t shape = server::BuildShape(in);
       if (auth::Sign(&shape, channels.shape, epoch, auth_seq.Next(), key)) {
         lcm.publish(channels.shape, &shape);
