@@ -338,28 +338,8 @@ int ReportSummary(const DeviceClientOptions& o, DeviceClient& client, const LcmD
   return kExitOk;
 }
 
-}  // namespace
-
-int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
-  CLI::App app{"snapthread-device: 1 kHz haptic device client (servo loop, local force model, "
-               "safety) for a snapthread session"};
-  app.add_option("--backend", o->backend, "sim-path | virtual-hand | phantom | delta")
-      ->check(CLI::IsMember(KnownBackends()))
-      ->capture_default_str();
-  app.add_option("--scene", o->scene_file, "scene YAML (device mapping, limits, grasp path)")
-      ->check(CLI::ExistingFile);
-  app.add_option("--grasp", o->grasp, "the scene grasp this device holds (a scene with grasps:; default: the first)");
-  app.add_option("--path-csv", o->path_csv, "scripted path CSV x,y[,z] in metres (instead of the scene's)")
-      ->check(CLI::ExistingFile);
-  app.add_option("--session", o->session, "session name, [A-Za-z0-9_]+")->capture_default_str();
-  app.add_option("--lcm-url", o->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or udpm loopback)");
-  app.add_option("--duration", o->duration_s, "seconds to run, 0 = until SIGINT/SIGTERM")
-      ->check(CLI::Range(0.0, 1e7))
-      ->capture_default_str();
-  app.add_option("--rate-hz", o->rate_hz, "servo rate")->check(CLI::Range(100.0, 10000.0))->capture_default_str();
-  app.add_option("--publish-divisor", o->publish_divisor, "publish every k-th pose")
-      ->check(CLI::Range(1, 1000))
-      ->capture_default_str();
+// The watchdog, path-speed and torque options of ParseDeviceClientArgs.
+void AddSafetyOptions(CLI::App& app, DeviceClientOptions* o) {
   app.add_option("--model-timeout-ms", o->model_timeout_ms, "fade the force when the model is older")
       ->check(CLI::Range(1.0, 10000.0))
       ->capture_default_str();
@@ -384,6 +364,31 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
                  "bound on the rotational stiffness of a 6-DoF model, N m/rad")
       ->check(CLI::Range(0.0, 1e3))
       ->capture_default_str();
+}
+
+}  // namespace
+
+int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
+  CLI::App app{"snapthread-device: 1 kHz haptic device client (servo loop, local force model, "
+               "safety) for a snapthread session"};
+  app.add_option("--backend", o->backend, "sim-path | virtual-hand | phantom | delta")
+      ->check(CLI::IsMember(KnownBackends()))
+      ->capture_default_str();
+  app.add_option("--scene", o->scene_file, "scene YAML (device mapping, limits, grasp path)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--grasp", o->grasp, "the scene grasp this device holds (a scene with grasps:; default: the first)");
+  app.add_option("--path-csv", o->path_csv, "scripted path CSV x,y[,z] in metres (instead of the scene's)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--session", o->session, "session name, [A-Za-z0-9_]+")->capture_default_str();
+  app.add_option("--lcm-url", o->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or udpm loopback)");
+  app.add_option("--duration", o->duration_s, "seconds to run, 0 = until SIGINT/SIGTERM")
+      ->check(CLI::Range(0.0, 1e7))
+      ->capture_default_str();
+  app.add_option("--rate-hz", o->rate_hz, "servo rate")->check(CLI::Range(100.0, 10000.0))->capture_default_str();
+  app.add_option("--publish-divisor", o->publish_divisor, "publish every k-th pose")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  AddSafetyOptions(app, o);
   bool no_rt = false;
   app.add_flag("--no-rt", no_rt, "do not try SCHED_FIFO / mlockall");
   bool no_snap_ahead = false;
