@@ -7,26 +7,17 @@
 // Watchdog: Open arms the controller's own (dhdSetWatchdog, in units of 125 us) at
 // StaleCommand::kDefaultLimitUs, so the controller drops the force if the servo thread
 // stops commanding (stalled, or the process stopped). Also untested: no SDK here.
+// The device is one class local to delta_device.cc: callers need only the HapticDevice
+// interface, and this header stays free of the SDK's.
 #pragma once
+
+#include <memory>
 
 #include "haptic_device.h"
 
 namespace snapthread::device {
 
-class DeltaDevice final : public HapticDevice {
- public:
-  DeltaDevice();
-  ~DeltaDevice() override;
-
-  bool Open(std::string* error) override;
-  const DeviceCapabilities& capabilities() const override { return caps_; }
-  bool Read(DeviceState* state) override;
-  bool Command(const double force_n[3], const double torque_nm[3]) override;
-  void Close() override;
-
- private:
-  DeviceCapabilities caps_;
-  int id_ = -1;
-};
+// A Force Dimension device, closed: Open connects to the first one DHD finds.
+std::unique_ptr<HapticDevice> MakeDeltaDevice();
 
 }  // namespace snapthread::device

@@ -25,8 +25,6 @@
 #include "safety.h"
 #include "scene/scene.h"
 #include "scripted_path.h"
-#include "sim_path_device.h"
-#include "virtual_hand_device.h"
 
 namespace snapthread::device {
 namespace {
@@ -94,28 +92,254 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
   return true;
 }
 
-}  // namespace
+// "Go on" from a step that may end the program with an exit code.
+constexpr int kContinue = -1;
 
-int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
-  CLI::App app{"snapthread-device: 1 kHz haptic device client (servo loop, local force model, "
-               "safety) for a snapthread session"};
-  app.add_option("--backend", o->backend, "sim-path | virtual-hand | phantom | delta")
-      ->check(CLI::IsMember(KnownBackends()))
-      ->capture_default_str();
-  app.add_option("--scene", o->scene_file, "scene YAML (device mapping, limits, grasp path)")
-      ->check(CLI::ExistingFile);
-  app.add_option("--grasp", o->grasp, "the scene grasp this device holds (a scene with grasps:; default: the first)");
-  app.add_option("--path-csv", o->path_csv, "scripted path CSV x,y[,z] in metres (instead of the scene's)")
-      ->check(CLI::ExistingFile);
-  app.add_option("--session", o->session, "session name, [A-Za-z0-9_]+")->capture_default_str();
-  app.add_option("--lcm-url", o->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or udpm loopback)");
-  app.add_option("--duration", o->duration_s, "seconds to run, 0 = until SIGINT/SIGTERM")
-      ->check(CLI::Range(0.0, 1e7))
-      ->capture_default_str();
-  app.add_option("--rate-hz", o->rate_hz, "servo rate")->check(CLI::Range(100.0, 10000.0))->capture_default_str();
-  app.add_option("--publish-divisor", o->publish_divisor, "publish every k-th pose")
-      ->check(CLI::Range(1, 1000))
-      ->capture_default_str();
+void PrintError(const std::string& what) { std::fprintf(stderr, "snapthread-device: %s\n", what.c_str()); }
+
+// What RunDeviceClient sets up before the transport: the key, the scene and its grasp,
+// the backend (built, not open).
+struct ClientSetup {
+  std::optional<auth::SessionKey> key;
+  std::optional<Scene> scene;
+  int grasp = 0;
+  BackendConfig config;
+  Backend backend;
+};
+
+// The session name and the ranges CLI11's checks let through ("nan" fails no
+// comparison): kExitBadArguments naming the flag, or kContinue.
+int CheckOptions(const DeviceClientOptions& o) {
+  if (!messages::IsValidSessionName(o.session)) {
+    std::fprintf(stderr, "snapthread-device: --session '%s': expected [A-Za-z0-9_]+\n",
+                 o.session.c_str());
+    return kExitBadArguments;
+  }
+  const struct {
+    const char* flag;
+    bool ok;
+  } ranges[] = {
+      {"--rate-hz", o.rate_hz >= 100.0 && o.rate_hz <= 10000.0},
+      {"--publish-divisor", o.publish_divisor >= 1},
+      {"--trace-divisor", o.trace_divisor >= 1},
+      {"--model-timeout-ms", o.model_timeout_ms > 0.0 && std::isfinite(o.model_timeout_ms)},
+      {"--fade-ms", o.fade_ms > 0.0 && std::isfinite(o.fade_ms)},
+      {"--speed-m-per-s", o.speed_m_per_s > 0.0 && std::isfinite(o.speed_m_per_s)},
+      {"--duration", o.duration_s >= 0.0 && std::isfinite(o.duration_s)},
+      {"--angular-speed-deg-per-s", o.angular_speed_deg_per_s > 0.0 && std::isfinite(o.angular_speed_deg_per_s)},
+      {"--max-torque-nm", o.max_torque_nm >= 0.0 && std::isfinite(o.max_torque_nm)},
+      {"--max-torque-rate", o.max_torque_rate_nm_per_s > 0.0 && std::isfinite(o.max_torque_rate_nm_per_s)},
+      {"--max-torque-stiffness",
+       o.max_torque_stiffness_nm_per_rad >= 0.0 && std::isfinite(o.max_torque_stiffness_nm_per_rad)},
+  };
+  for (const auto& range : ranges) {
+    if (!range.ok) {
+      std::fprintf(stderr, "snapthread-device: %s: out of range (see --help)\n", range.flag);
+      return kExitBadArguments;
+    }
+  }
+  return kContinue;
+}
+
+// The session key: without it nothing the server sends can be trusted.
+int LoadSessionKey(const DeviceClientOptions& o, ClientSetup* setup) {
+  try {
+    const auth::KeyLocation where = auth::ResolveKeyPath(o.key_path);
+    setup->key.emplace(auth::LoadKey(where));
+    spdlog::info("device: session key {} ({}), key id {}", where.path, where.origin, setup->key->Id());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-device: --key: %s\n", e.what());
+    return kExitBadArguments;
+  }
+  return kContinue;
+}
+
+// --scene and --grasp: the scene (if any) and the index of the grasp this device holds.
+int LoadSceneAndGrasp(const DeviceClientOptions& o, ClientSetup* setup) {
+  if (!o.scene_file.empty()) {
+    try {
+      setup->scene = LoadScene(o.scene_file);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "snapthread-device: --scene: %s\n", e.what());
+      return kExitBadArguments;
+    }
+  }
+  if (o.grasp.empty()) return kContinue;
+  const std::optional<Scene>& scene = setup->scene;
+  setup->grasp = scene ? FindGrasp(*scene, o.grasp) : -1;
+  if (setup->grasp >= 0) return kContinue;
+  if (!scene) {
+    PrintError("--grasp: needs --scene (the scene names the grasps)");
+    return kExitBadArguments;
+  }
+  std::string names;
+  for (const SceneGrasp& g : scene->grasps) names += (names.empty() ? "" : ", ") + g.name;
+  PrintError("--grasp: no grasp '" + o.grasp + "' in the scene (its grasps: " +
+             (names.empty() ? "one, unnamed" : names) + ")");
+  return kExitBadArguments;
+}
+
+// The scripted path (--path-csv, or the scene's grasp path for a simulated backend) and
+// the backend (--backend), built but not open.
+int MakeConfiguredBackend(const DeviceClientOptions& o, ClientSetup* setup) {
+  BackendConfig& config = setup->config;
+  config.name = o.backend;
+  try {
+    if (!o.path_csv.empty()) {
+      config.path = ScriptedPath::FromCsv(o.path_csv, o.speed_m_per_s);
+    } else if (setup->scene && BackendNeedsPath(o.backend)) {
+      config.path = ScriptedPath::FromScene(*setup->scene, o.speed_m_per_s, setup->grasp,
+                                            o.angular_speed_deg_per_s * 3.141592653589793 / 180.0);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-device: %s: %s\n",
+                 o.path_csv.empty() ? "--scene" : "--path-csv", e.what());
+    return kExitBadArguments;
+  }
+  std::string error;
+  setup->backend = MakeBackend(config, &error);
+  if (!setup->backend.device) {
+    std::fprintf(stderr, "snapthread-device: --backend %s: %s\n", o.backend.c_str(), error.c_str());
+    return kExitBadArguments;
+  }
+  return kContinue;
+}
+
+// Opens the device and, with --sim-render-file, starts a simulated backend's render
+// thread (a real device renders in hardware: refused).
+int OpenDevice(const DeviceClientOptions& o, const Backend& backend) {
+  std::string error;
+  if (!backend.device->Open(&error)) {
+    std::fprintf(stderr, "snapthread-device: backend %s failed to open: %s\n", o.backend.c_str(),
+                 error.c_str());
+    return kExitRuntimeFailure;
+  }
+  if (o.sim_render_file.empty()) return kContinue;
+  bool started = false;
+  if (backend.renderer != nullptr) {
+    started = backend.renderer->Start(o.sim_render_file, &error);
+  } else {
+    error = "only the simulated backends (sim-path, virtual-hand) have a render thread";
+  }
+  if (!started) {
+    std::fprintf(stderr, "snapthread-device: --sim-render-file: %s\n", error.c_str());
+    backend.device->Close();
+    return kExitBadArguments;
+  }
+  return kContinue;
+}
+
+// The safety limits: the device's, tightened by the scene's grasp mapping, with the
+// options' torque, watchdog and rate settings. False with *error when they are invalid.
+bool MakeLimits(const DeviceClientOptions& o, const ClientSetup& setup, const DeviceCapabilities& caps,
+                SafetyLimits* limits, std::string* error) {
+  const DeviceMapping mapping = setup.scene ? GraspDeviceMapping(*setup.scene, setup.grasp) : DeviceMapping{};
+  limits->max_torque_nm = o.max_torque_nm;  // LimitsFrom keeps it under the device's own
+  *limits = LimitsFrom(caps, setup.scene ? &mapping : nullptr, *limits);
+  limits->max_torque_rate_nm_per_s = o.max_torque_rate_nm_per_s;
+  limits->max_torque_stiffness_nm_per_rad = o.max_torque_stiffness_nm_per_rad;
+  limits->model_timeout_s = 1e-3 * o.model_timeout_ms;
+  limits->fade_time_s = 1e-3 * o.fade_ms;
+  limits->tick_period_s = 1.0 / o.rate_hz;
+  return limits->IsValid(error);
+}
+
+// The client's configuration from the options, the device and the scene (limits already
+// in cc->limits).
+void FillClientConfig(const DeviceClientOptions& o, const ClientSetup& setup, const DeviceCapabilities& caps,
+                      DeviceClientConfig* cc) {
+  cc->device_id = o.backend == caps.model_name ? o.backend : o.backend + ":" + caps.model_name;
+  // Each hand is its own sender (the server keeps one sequence filter per device id).
+  if (setup.scene && !setup.scene->grasps.empty()) cc->grasp = setup.scene->grasps[setup.grasp].name;
+  if (!cc->grasp.empty()) cc->device_id += "@" + cc->grasp;
+  cc->device_has_orientation = caps.has_orientation;
+  cc->device_torque_output = caps.has_torque_output;
+  cc->tick.publish_divisor = o.publish_divisor;
+  cc->tick.trace_divisor = o.trace_divisor;
+  cc->loop.rate_hz = o.rate_hz;
+  cc->loop.realtime = o.realtime;
+  cc->trace_file = o.trace_file;
+  cc->key = &*setup.key;
+  cc->session = o.session;
+  cc->snap_ahead = o.snap_ahead;
+}
+
+void LogStart(const DeviceClientOptions& o, const std::string& url, const DeviceClientConfig& cc,
+              const DeviceCapabilities& caps) {
+  const SafetyLimits& limits = cc.limits;
+  spdlog::info("device: {} session {} on {}; limits |F| <= {} N, stiffness <= {} N/m, "
+               "slew {} N/s, timeout {} ms, fade {} ms, workspace {} m; orientation {}, torque {}",
+               cc.device_id, o.session, url, limits.max_force_n, limits.max_stiffness_n_per_m,
+               limits.max_force_rate_n_per_s, 1e3 * limits.model_timeout_s,
+               1e3 * limits.fade_time_s, limits.workspace_radius_m,
+               caps.has_orientation ? "sensed" : "not sensed",
+               caps.has_torque_output
+                   ? fmt::format("|τ| <= {} N m, slew {} N m/s, stiffness <= {} N m/rad", limits.max_torque_nm,
+                                 limits.max_torque_rate_nm_per_s, limits.max_torque_stiffness_nm_per_rad)
+                   : std::string("not rendered"));
+}
+
+// The open device's client configuration (limits checked, the path's reach warned
+// about, the start logged); the device closed and kExitBadArguments on invalid limits.
+int ConfigureClient(const DeviceClientOptions& o, const ClientSetup& setup, const std::string& url,
+                    DeviceClientConfig* cc) {
+  HapticDevice& device = *setup.backend.device;
+  const DeviceCapabilities caps = device.capabilities();
+  std::string error;
+  if (!MakeLimits(o, setup, caps, &cc->limits, &error)) {
+    PrintError(error);
+    device.Close();
+    return kExitBadArguments;
+  }
+  const SafetyLimits& limits = cc->limits;
+  const std::optional<ScriptedPath>& path = setup.config.path;
+  if (path && path->max_radius_m() > limits.workspace_radius_m) {
+    spdlog::warn("device: the scripted path reaches {:.3f} m from the origin, beyond the "
+                 "workspace radius {:.3f} m: those poses get zero force and are not published",
+                 path->max_radius_m(), limits.workspace_radius_m);
+  }
+  FillClientConfig(o, setup, caps, cc);
+  LogStart(o, url, *cc, caps);
+  return kContinue;
+}
+
+// Runs the client until the duration elapses or SIGINT / SIGTERM arrives, then fades the
+// force to zero within the safety ramp (fade_time_s) before the servo loop stops.
+void RunUntilStopped(const DeviceClientOptions& o, double fade_time_s, DeviceClient* client) {
+  g_stop_requested.store(false);
+  InstallSignalHandlers();
+  std::string notes;
+  client->Start(&notes);
+  if (!notes.empty()) spdlog::warn("{}", notes);
+  if (o.realtime && client->realtime_active()) spdlog::info("servo: SCHED_FIFO active");
+  const int64_t start_us = client->start_us();
+  while (!g_stop_requested.load()) {
+    if (o.duration_s > 0.0 && Seconds(realtime::MonotonicMicros() - start_us) >= o.duration_s) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (!client->FadeOut(fade_time_s + 0.3)) {
+    spdlog::warn("device: the force did not fade to zero within {} ms; stopping anyway",
+                 1e3 * fade_time_s + 300.0);
+  }
+  client->Stop();
+}
+
+// The run's summary: logged, and written to --summary (kExitRuntimeFailure when it
+// cannot be).
+int ReportSummary(const DeviceClientOptions& o, DeviceClient& client, const LcmDeviceTransport& lcm) {
+  DeviceClientSummary summary = client.Summary(realtime::MonotonicMicros());
+  summary.statuses_superseded = lcm.statuses_superseded();
+  summary.statuses_oversized = lcm.statuses_oversized();
+  LogSummary(summary);
+  if (!o.summary_file.empty() && !WriteSummaryJson(o.summary_file, o, summary)) {
+    std::fprintf(stderr, "snapthread-device: --summary: cannot write %s\n", o.summary_file.c_str());
+    return kExitRuntimeFailure;
+  }
+  return kExitOk;
+}
+
+// The watchdog, path-speed and torque options of ParseDeviceClientArgs.
+void AddSafetyOptions(CLI::App& app, DeviceClientOptions* o) {
   app.add_option("--model-timeout-ms", o->model_timeout_ms, "fade the force when the model is older")
       ->check(CLI::Range(1.0, 10000.0))
       ->capture_default_str();
@@ -140,6 +364,31 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
                  "bound on the rotational stiffness of a 6-DoF model, N m/rad")
       ->check(CLI::Range(0.0, 1e3))
       ->capture_default_str();
+}
+
+}  // namespace
+
+int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
+  CLI::App app{"snapthread-device: 1 kHz haptic device client (servo loop, local force model, "
+               "safety) for a snapthread session"};
+  app.add_option("--backend", o->backend, "sim-path | virtual-hand | phantom | delta")
+      ->check(CLI::IsMember(KnownBackends()))
+      ->capture_default_str();
+  app.add_option("--scene", o->scene_file, "scene YAML (device mapping, limits, grasp path)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--grasp", o->grasp, "the scene grasp this device holds (a scene with grasps:; default: the first)");
+  app.add_option("--path-csv", o->path_csv, "scripted path CSV x,y[,z] in metres (instead of the scene's)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--session", o->session, "session name, [A-Za-z0-9_]+")->capture_default_str();
+  app.add_option("--lcm-url", o->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or udpm loopback)");
+  app.add_option("--duration", o->duration_s, "seconds to run, 0 = until SIGINT/SIGTERM")
+      ->check(CLI::Range(0.0, 1e7))
+      ->capture_default_str();
+  app.add_option("--rate-hz", o->rate_hz, "servo rate")->check(CLI::Range(100.0, 10000.0))->capture_default_str();
+  app.add_option("--publish-divisor", o->publish_divisor, "publish every k-th pose")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  AddSafetyOptions(app, o);
   bool no_rt = false;
   app.add_flag("--no-rt", no_rt, "do not try SCHED_FIFO / mlockall");
   bool no_snap_ahead = false;
@@ -178,92 +427,13 @@ int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
 
 int RunDeviceClient(const DeviceClientOptions& o) {
   spdlog::set_level(spdlog::level::from_str(o.log_level));
-  if (!messages::IsValidSessionName(o.session)) {
-    std::fprintf(stderr, "snapthread-device: --session '%s': expected [A-Za-z0-9_]+\n",
-                 o.session.c_str());
-    return kExitBadArguments;
-  }
-  // Also what CLI11's range checks let through: "nan" fails no comparison.
-  const struct {
-    const char* flag;
-    bool ok;
-  } ranges[] = {
-      {"--rate-hz", o.rate_hz >= 100.0 && o.rate_hz <= 10000.0},
-      {"--publish-divisor", o.publish_divisor >= 1},
-      {"--trace-divisor", o.trace_divisor >= 1},
-      {"--model-timeout-ms", o.model_timeout_ms > 0.0 && std::isfinite(o.model_timeout_ms)},
-      {"--fade-ms", o.fade_ms > 0.0 && std::isfinite(o.fade_ms)},
-      {"--speed-m-per-s", o.speed_m_per_s > 0.0 && std::isfinite(o.speed_m_per_s)},
-      {"--duration", o.duration_s >= 0.0 && std::isfinite(o.duration_s)},
-      {"--angular-speed-deg-per-s", o.angular_speed_deg_per_s > 0.0 && std::isfinite(o.angular_speed_deg_per_s)},
-      {"--max-torque-nm", o.max_torque_nm >= 0.0 && std::isfinite(o.max_torque_nm)},
-      {"--max-torque-rate", o.max_torque_rate_nm_per_s > 0.0 && std::isfinite(o.max_torque_rate_nm_per_s)},
-      {"--max-torque-stiffness",
-       o.max_torque_stiffness_nm_per_rad >= 0.0 && std::isfinite(o.max_torque_stiffness_nm_per_rad)},
-  };
-  for (const auto& range : ranges) {
-    if (!range.ok) {
-      std::fprintf(stderr, "snapthread-device: %s: out of range (see --help)\n", range.flag);
-      return kExitBadArguments;
-    }
-  }
+  // Configuration, in this order; bad input ends the program with kExitBadArguments.
+  ClientSetup setup;
+  if (const int code = CheckOptions(o); code != kContinue) return code;
+  if (const int code = LoadSessionKey(o, &setup); code != kContinue) return code;
+  if (const int code = LoadSceneAndGrasp(o, &setup); code != kContinue) return code;
+  if (const int code = MakeConfiguredBackend(o, &setup); code != kContinue) return code;
 
-  // ---- the session key: without it nothing the server sends can be trusted -------------
-  std::optional<auth::SessionKey> key;
-  try {
-    const auth::KeyLocation where = auth::ResolveKeyPath(o.key_path);
-    key.emplace(auth::LoadKey(where));
-    spdlog::info("device: session key {} ({}), key id {}", where.path, where.origin, key->Id());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "snapthread-device: --key: %s\n", e.what());
-    return kExitBadArguments;
-  }
-
-  // ---- configuration: scene, path, backend, limits (bad input -> exit 2) --------------
-  std::optional<Scene> scene;
-  if (!o.scene_file.empty()) {
-    try {
-      scene = LoadScene(o.scene_file);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "snapthread-device: --scene: %s\n", e.what());
-      return kExitBadArguments;
-    }
-  }
-  int grasp = 0;
-  if (!o.grasp.empty()) {
-    grasp = scene ? FindGrasp(*scene, o.grasp) : -1;
-    if (grasp < 0) {
-      std::string names;
-      if (scene)
-        for (const SceneGrasp& g : scene->grasps) names += (names.empty() ? "" : ", ") + g.name;
-      std::fprintf(stderr, "snapthread-device: --grasp: %s\n",
-                   scene ? ("no grasp '" + o.grasp + "' in the scene (its grasps: " + (names.empty() ? "one, unnamed" : names) + ")").c_str()
-                         : "needs --scene (the scene names the grasps)");
-      return kExitBadArguments;
-    }
-  }
-  BackendConfig config;
-  config.name = o.backend;
-  try {
-    if (!o.path_csv.empty()) {
-      config.path = ScriptedPath::FromCsv(o.path_csv, o.speed_m_per_s);
-    } else if (scene && BackendNeedsPath(o.backend)) {
-      config.path = ScriptedPath::FromScene(*scene, o.speed_m_per_s, grasp,
-                                            o.angular_speed_deg_per_s * 3.141592653589793 / 180.0);
-    }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "snapthread-device: %s: %s\n",
-                 o.path_csv.empty() ? "--scene" : "--path-csv", e.what());
-    return kExitBadArguments;
-  }
-  std::string error;
-  std::unique_ptr<HapticDevice> device = MakeDevice(config, &error);
-  if (!device) {
-    std::fprintf(stderr, "snapthread-device: --backend %s: %s\n", o.backend.c_str(), error.c_str());
-    return kExitBadArguments;
-  }
-
-  // ---- transport ------------------------------------------------------------------------
   const std::string url =
       messages::WithReceiveBuffer(messages::ResolveLcmUrl(o.lcm_url), messages::kServiceBufferBytes);
   LcmDeviceTransport lcm(url, o.session);
@@ -272,111 +442,22 @@ int RunDeviceClient(const DeviceClientOptions& o) {
                  url.c_str(), messages::LcmStartHint(url).c_str());
     return kExitRuntimeFailure;
   }
-
-  if (!device->Open(&error)) {
-    std::fprintf(stderr, "snapthread-device: backend %s failed to open: %s\n", o.backend.c_str(),
-                 error.c_str());
-    return kExitRuntimeFailure;
-  }
-  if (!o.sim_render_file.empty()) {
-    bool started = false;
-    if (auto* sim = dynamic_cast<SimPathDevice*>(device.get())) {
-      started = sim->StartRenderer(o.sim_render_file, &error);
-    } else if (auto* hand = dynamic_cast<VirtualHandDevice*>(device.get())) {
-      started = hand->StartRenderer(o.sim_render_file, &error);
-    } else {
-      error = "only the simulated backends (sim-path, virtual-hand) have a render thread";
-    }
-    if (!started) {
-      std::fprintf(stderr, "snapthread-device: --sim-render-file: %s\n", error.c_str());
-      device->Close();
-      return kExitBadArguments;
-    }
-  }
-  const DeviceCapabilities caps = device->capabilities();
+  if (const int code = OpenDevice(o, setup.backend); code != kContinue) return code;
   DeviceClientConfig cc;
-  const DeviceMapping mapping = scene ? GraspDeviceMapping(*scene, grasp) : DeviceMapping{};
-  cc.limits.max_torque_nm = o.max_torque_nm;  // LimitsFrom keeps it under the device's own
-  cc.limits = LimitsFrom(caps, scene ? &mapping : nullptr, cc.limits);
-  cc.limits.max_torque_rate_nm_per_s = o.max_torque_rate_nm_per_s;
-  cc.limits.max_torque_stiffness_nm_per_rad = o.max_torque_stiffness_nm_per_rad;
-  cc.limits.model_timeout_s = 1e-3 * o.model_timeout_ms;
-  cc.limits.fade_time_s = 1e-3 * o.fade_ms;
-  cc.limits.tick_period_s = 1.0 / o.rate_hz;
-  if (!cc.limits.IsValid(&error)) {
-    std::fprintf(stderr, "snapthread-device: %s\n", error.c_str());
-    device->Close();
-    return kExitBadArguments;
-  }
-  const SafetyLimits& limits = cc.limits;
-  if (config.path && config.path->max_radius_m() > limits.workspace_radius_m) {
-    spdlog::warn("device: the scripted path reaches {:.3f} m from the origin, beyond the "
-                 "workspace radius {:.3f} m: those poses get zero force and are not published",
-                 config.path->max_radius_m(), limits.workspace_radius_m);
-  }
-  cc.device_id = o.backend == caps.model_name ? o.backend : o.backend + ":" + caps.model_name;
-  // Each hand is its own sender (the server keeps one sequence filter per device id).
-  if (scene && !scene->grasps.empty()) cc.grasp = scene->grasps[grasp].name;
-  if (!cc.grasp.empty()) cc.device_id += "@" + cc.grasp;
-  cc.device_has_orientation = caps.has_orientation;
-  cc.device_torque_output = caps.has_torque_output;
-  cc.tick.publish_divisor = o.publish_divisor;
-  cc.tick.trace_divisor = o.trace_divisor;
-  cc.loop.rate_hz = o.rate_hz;
-  cc.loop.realtime = o.realtime;
-  cc.trace_file = o.trace_file;
-  cc.key = &*key;
-  cc.session = o.session;
-  cc.snap_ahead = o.snap_ahead;
-  spdlog::info("device: {} session {} on {}; limits |F| <= {} N, stiffness <= {} N/m, "
-               "slew {} N/s, timeout {} ms, fade {} ms, workspace {} m; orientation {}, torque {}",
-               cc.device_id, o.session, url, limits.max_force_n, limits.max_stiffness_n_per_m,
-               limits.max_force_rate_n_per_s, 1e3 * limits.model_timeout_s,
-               1e3 * limits.fade_time_s, limits.workspace_radius_m,
-               caps.has_orientation ? "sensed" : "not sensed",
-               caps.has_torque_output
-                   ? fmt::format("|τ| <= {} N m, slew {} N m/s, stiffness <= {} N m/rad", limits.max_torque_nm,
-                                 limits.max_torque_rate_nm_per_s, limits.max_torque_stiffness_nm_per_rad)
-                   : std::string("not rendered"));
+  if (const int code = ConfigureClient(o, setup, url, &cc); code != kContinue) return code;
 
-  // ---- run until the duration elapses or a signal arrives -------------------------------
+  HapticDevice& device = *setup.backend.device;
   std::unique_ptr<DeviceClient> client;
   try {
-    client = std::make_unique<DeviceClient>(device.get(), &lcm, cc);
+    client = std::make_unique<DeviceClient>(&device, &lcm, cc);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "snapthread-device: %s\n", e.what());
-    device->Close();
+    PrintError(e.what());
+    device.Close();
     return kExitRuntimeFailure;
   }
-  g_stop_requested.store(false);
-  InstallSignalHandlers();
-  std::string notes;
-  client->Start(&notes);
-  if (!notes.empty()) spdlog::warn("{}", notes);
-  if (o.realtime && client->realtime_active()) spdlog::info("servo: SCHED_FIFO active");
-  const int64_t start_us = client->start_us();
-  while (!g_stop_requested.load()) {
-    if (o.duration_s > 0.0 && Seconds(realtime::MonotonicMicros() - start_us) >= o.duration_s) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  // Fade to zero within the safety ramp before the servo loop stops (issue 12 item 5).
-  if (!client->FadeOut(cc.limits.fade_time_s + 0.3)) {
-    spdlog::warn("device: the force did not fade to zero within {} ms; stopping anyway",
-                 1e3 * cc.limits.fade_time_s + 300.0);
-  }
-  client->Stop();
-  device->Close();
-
-  // ---- summary ---------------------------------------------------------------------------
-  DeviceClientSummary summary = client->Summary(realtime::MonotonicMicros());
-  summary.statuses_superseded = lcm.statuses_superseded();
-  summary.statuses_oversized = lcm.statuses_oversized();
-  LogSummary(summary);
-  if (!o.summary_file.empty() && !WriteSummaryJson(o.summary_file, o, summary)) {
-    std::fprintf(stderr, "snapthread-device: --summary: cannot write %s\n", o.summary_file.c_str());
-    return kExitRuntimeFailure;
-  }
-  return kExitOk;
+  RunUntilStopped(o, cc.limits.fade_time_s, client.get());
+  device.Close();
+  return ReportSummary(o, *client, lcm);
 }
 
 }  // namespace snapthread::device

@@ -1,7 +1,9 @@
 #include "device_factory.h"
 
-#include "sim_path_device.h"
+#include <utility>
+
 #include "realtime/clock.h"
+#include "sim_path_device.h"
 #if SNAPTHREAD_HAVE_PHANTOM
 #include "phantom_device.h"
 #endif
@@ -28,42 +30,52 @@ bool BackendNeedsPath(const std::string& name) {
   return name == "sim-path" || name == "virtual-hand";
 }
 
-std::unique_ptr<HapticDevice> MakeDevice(const BackendConfig& config, std::string* error) {
+namespace {
+
+// A simulated backend with its render thread.
+template <typename Device, typename... Args>
+Backend Simulated(Args&&... args) {
+  auto device = std::make_unique<Device>(std::forward<Args>(args)...);
+  SimRenderer* renderer = &device->renderer();
+  return Backend{std::move(device), renderer};
+}
+
+}  // namespace
+
+Backend MakeBackend(const BackendConfig& config, std::string* error) {
   const MicrosClock clock = config.clock ? config.clock : &realtime::MonotonicMicros;
   if (BackendNeedsPath(config.name) && !config.path) {
     if (error) *error = "backend " + config.name + " needs a path (--scene or --path-csv)";
-    return nullptr;
+    return {};
   }
-  if (config.name == "sim-path") return std::make_unique<SimPathDevice>(*config.path, clock);
-  if (config.name == "virtual-hand") {
-    return std::make_unique<VirtualHandDevice>(*config.path, config.hand, clock);
-  }
+  if (config.name == "sim-path") return Simulated<SimPathDevice>(*config.path, clock);
+  if (config.name == "virtual-hand") return Simulated<VirtualHandDevice>(*config.path, config.hand, clock);
   if (config.name == "phantom") {
 #if SNAPTHREAD_HAVE_PHANTOM
-    return std::make_unique<PhantomDevice>();
+    return Backend{MakePhantomDevice()};
 #else
     if (error) {
       *error = "backend phantom was not built: OpenHaptics (HD/hd.h, libHD) was not found "
                "when CMake configured this build";
     }
-    return nullptr;
+    return {};
 #endif
   }
   if (config.name == "delta") {
 #if SNAPTHREAD_HAVE_DELTA
-    return std::make_unique<DeltaDevice>();
+    return Backend{MakeDeltaDevice()};
 #else
     if (error) {
       *error = "backend delta was not built: the Force Dimension SDK (dhdc.h, libdhd) was "
                "not found when CMake configured this build";
     }
-    return nullptr;
+    return {};
 #endif
   }
   if (error) {
     *error = "unknown backend '" + config.name + "' (expected sim-path, virtual-hand, phantom or delta)";
   }
-  return nullptr;
+  return {};
 }
 
 }  // namespace snapthread::device

@@ -1,5 +1,6 @@
 // Builds a HapticDevice backend by name. Real backends exist only when CMake found
-// their SDK (see device_client/CMakeLists.txt).
+// their SDK (see device_client/CMakeLists.txt). What the program needs of a backend
+// beyond the HapticDevice interface comes with it (Backend), so no caller casts.
 #pragma once
 
 #include <memory>
@@ -10,6 +11,7 @@
 #include "haptic_device.h"
 #include "scripted_path.h"
 #include "sim_clock.h"
+#include "sim_renderer.h"
 #include "virtual_hand_device.h"
 
 namespace snapthread::device {
@@ -27,8 +29,16 @@ std::vector<std::string> KnownBackends();
 std::vector<std::string> BuiltBackends();
 bool BackendNeedsPath(const std::string& name);
 
-// Null with *error set for an unknown name, a backend not built into this binary, or a
-// simulated backend without a path.
-std::unique_ptr<HapticDevice> MakeDevice(const BackendConfig& config, std::string* error);
+// What MakeBackend built.
+struct Backend {
+  std::unique_ptr<HapticDevice> device;
+  // A simulated backend's render thread (its "firmware", sim_renderer.h; owned by the
+  // device, not started); null for a real device, which renders in hardware.
+  SimRenderer* renderer = nullptr;
+};
+
+// device null with *error set for an unknown name, a backend not built into this binary,
+// or a simulated backend without a path.
+Backend MakeBackend(const BackendConfig& config, std::string* error);
 
 }  // namespace snapthread::device

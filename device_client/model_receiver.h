@@ -13,9 +13,9 @@
 #include "auth/freshness_filter.h"
 #include "auth/pose_echo_window.h"
 #include "auth/session_key.h"
+#include "local_model.h"
 #include "model_order.h"
 #include "realtime/percentiles.h"
-#include "safety.h"
 #include "servo_loop.h"
 
 namespace snapthread::device {

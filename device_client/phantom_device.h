@@ -8,39 +8,18 @@
 // would remove it. The callback is this backend's watchdog: it renders zero once the last
 // command is older than StaleCommand::kDefaultLimitUs (a stalled servo thread), instead of
 // the last force forever. OpenHaptics has no watchdog of its own to arm.
+// The device is one class local to phantom_device.cc: callers need only the HapticDevice
+// interface, and this header stays free of the SDK's.
 #pragma once
 
-#include <atomic>
-
-#include <HD/hd.h>
+#include <memory>
 
 #include "haptic_device.h"
-#include "realtime/latest_value.h"
-#include "stale_command.h"
 
 namespace snapthread::device {
 
-class PhantomDevice final : public HapticDevice {
- public:
-  PhantomDevice();
-  ~PhantomDevice() override;
-
-  bool Open(std::string* error) override;
-  const DeviceCapabilities& capabilities() const override { return caps_; }
-  bool Read(DeviceState* state) override;
-  bool Command(const double force_n[3], const double torque_nm[3]) override;
-  void Close() override;
-
- private:
-  static HDCallbackCode HDCALLBACK ServoCallback(void* self);
-
-  DeviceCapabilities caps_;
-  HHD handle_ = HD_INVALID_HANDLE;
-  HDSchedulerHandle callback_ = HD_INVALID_HANDLE;
-  realtime::LatestValue<DeviceState> state_;  // HD thread -> servo thread
-  StaleCommand command_;                       // servo thread -> HD thread
-  std::atomic<bool> fault_{false};
-  bool open_ = false;
-};
+// A PHANToM / Touch, closed: Open initialises the default HD device and starts the HD
+// scheduler with this backend's callback.
+std::unique_ptr<HapticDevice> MakePhantomDevice();
 
 }  // namespace snapthread::device

@@ -1,28 +1,23 @@
 #include "sim_path_device.h"
 
+#include <utility>
+
 namespace snapthread::device {
 
 SimPathDevice::SimPathDevice(ScriptedPath path, MicrosClock clock)
-    : path_(std::move(path)), clock_(clock) {
+    : SimulatedDevice(std::move(path), clock, "sim-path") {
   // Generous limits: a simulated device is limited by the scene's DeviceMapping.
-  caps_.model_name = "sim-path";
   caps_.max_force_n = 10.0;
   caps_.max_stiffness_n_per_m = 2000.0;
   caps_.max_linear_damping_n_per_m_per_s = 20.0;
-  caps_.workspace_radius_m = 0.25;
-  caps_.max_velocity_m_per_s = 2.0;
-  // It follows the path's orientation (a rod scene's roll) and keeps the commanded
-  // torque (last_torque_nm) as a real wrist would render it: a torque-output device.
-  caps_.has_orientation = true;
+  // It keeps the commanded torque (last_torque_nm) as a real wrist would render it: a
+  // torque-output device.
   caps_.has_torque_output = true;
   caps_.max_torque_nm = 1.0;
 }
 
 bool SimPathDevice::Open(std::string* error) {
-  if (clock_ == nullptr) {
-    if (error) *error = "sim-path: no clock";
-    return false;
-  }
+  if (!HasClock(error)) return false;
   open_ = true;
   start_us_ = -1;
   return true;

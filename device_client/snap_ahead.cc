@@ -9,51 +9,6 @@
 
 namespace snapthread::device {
 
-bool PrepareFold(const force_model_t& msg, const SafetyLimits& limits, LocalModel* out,
-                 bool* clamped, std::string* why) {
-  out->has_fold = false;
-  if (msg.has_fold == 0) return true;
-  auto bad = [&](const char* what) {
-    if (why) *why = std::string("fold: ") + what;
-    return false;
-  };
-  if (msg.has_fold != 1 || msg.fold_id <= 0) return bad("has_fold must be 0 or 1 and fold_id > 0");
-  double n2 = 0.0, r2 = 0.0, q2 = 0.0;
-  bool finite = std::isfinite(msg.fold_curvature);
-  for (int i = 0; i < 3; ++i) {
-    n2 += msg.fold_normal[i] * msg.fold_normal[i];
-    r2 += msg.fold_normal_r[i] * msg.fold_normal_r[i];
-    finite = finite && std::isfinite(msg.fold_point[i]) && std::isfinite(msg.fold_normal[i]) &&
-             std::isfinite(msg.fold_normal_r[i]) && std::isfinite(msg.post_u0[i]) &&
-             std::isfinite(msg.post_f0[i]) && std::isfinite(msg.post_torque0[i]);
-    for (int j = 0; j < 3; ++j) finite = finite && std::isfinite(msg.post_K[i][j]);
-  }
-  for (double q : msg.fold_q) {
-    q2 += q * q;
-    finite = finite && std::isfinite(q);
-  }
-  if (!finite) return bad("not finite");
-  if (std::abs(std::sqrt(n2 + r2) - 1.0) > 1e-6) return bad("(fold_normal, fold_normal_r) is not a unit vector");
-  if (std::abs(std::sqrt(q2) - 1.0) > 1e-6) return bad("fold_q is not a unit quaternion");
-  bool post_clamped = false;
-  if (!ClampStiffness(msg.post_K, limits, out->post_K_n_per_m, &post_clamped, why)) return false;
-  *clamped = *clamped || post_clamped;
-  out->has_fold = true;
-  out->fold_id = msg.fold_id;
-  out->fold_curvature_per_m = msg.fold_curvature;
-  out->has_fold_rotation = r2 > 0.0;
-  for (int i = 0; i < 4; ++i) out->fold_q[i] = msg.fold_q[i];
-  for (int i = 0; i < 3; ++i) {
-    out->fold_point_m[i] = msg.fold_point[i];
-    out->fold_normal[i] = msg.fold_normal[i];
-    out->fold_normal_r[i] = msg.fold_normal_r[i];
-    out->post_u0_m[i] = msg.post_u0[i];
-    out->post_f0_n[i] = msg.post_f0[i];
-    out->post_torque0_nm[i] = out->has_torque ? msg.post_torque0[i] : 0.0;
-  }
-  return true;
-}
-
 double FoldSide(const LocalModel& model, const double position_m[3], const double orientation[4]) {
   double w[3], a = 0.0, n2 = 0.0;
   for (int i = 0; i < 3; ++i) {

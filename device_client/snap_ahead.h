@@ -1,4 +1,4 @@
-// Snap-ahead on the device (issue 17): the server sends, with a force model near a fold,
+// Snap-ahead on the device: the server sends, with a force model near a fold,
 // the fold boundary (point, unit normal, curvature; device metres) and the local model of
 // the equilibrium past it. Each servo tick SnapAhead checks which side of the boundary
 // the hand is on; at the tick it crosses, it renders the post-snap model (the safety
@@ -17,25 +17,16 @@
 // arrives that answers a pose sent after the switch (the server had the switch then);
 // models answering earlier poses are from the old branch and are not rendered.
 //
+// The fold arrives checked (PrepareModel refuses a model with a bad fold, local_model.h).
 // Servo thread only (Select); no allocation, no locks, no logging.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
-#include <string>
 
-#include "safety.h"
-#include "snapthread/force_model_t.hpp"
+#include "local_model.h"
 
 namespace snapthread::device {
-
-// Off the servo thread, from PrepareModel: copies and checks a force model's fold
-// (finite, unit normal, positive id; messages::Validate checked the message already)
-// and clamps the post-snap K's stiffness like K. A message without a fold leaves
-// out->has_fold false. False (with *why) when the fold is not usable: the whole model
-// is refused, so a bad fold never reaches the servo.
-bool PrepareFold(const force_model_t& msg, const SafetyLimits& limits, LocalModel* out,
-                 bool* clamped, std::string* why);
 
 // Which side of model's fold boundary the pose (position_m, orientation (w, x, y, z);
 // null: the identity) is on: a - (curvature / 2) |w_perp|^2, >= 0 past the fold; -1 a

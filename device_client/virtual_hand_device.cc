@@ -2,31 +2,25 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace snapthread::device {
 
 VirtualHandDevice::VirtualHandDevice(ScriptedPath path, VirtualHandParams params,
                                      MicrosClock clock)
-    : path_(std::move(path)), params_(params), clock_(clock) {
-  caps_.model_name = "virtual-hand";
+    : SimulatedDevice(std::move(path), clock, "virtual-hand"), params_(params) {
   caps_.max_force_n = 8.0;
   // Semi-implicit Euler of the mass at 1 kHz is stable for w dt < 2; keep w dt <= 0.3:
   // k_max = m (0.3 / dt)^2 = 0.1 * 300^2 = 9000 N/m. The device claims far less, like a
   // desktop device, so the safety clamp is what acts.
   caps_.max_stiffness_n_per_m = 1500.0;
   caps_.max_linear_damping_n_per_m_per_s = 10.0;
-  caps_.workspace_radius_m = 0.25;
-  caps_.max_velocity_m_per_s = 2.0;
-  // The hand turns as the path says (no rotational dynamics: it renders no torque).
-  caps_.has_orientation = true;
+  // No rotational dynamics: it renders no torque.
   caps_.has_torque_output = false;
 }
 
 bool VirtualHandDevice::Open(std::string* error) {
-  if (clock_ == nullptr) {
-    if (error) *error = "virtual-hand: no clock";
-    return false;
-  }
+  if (!HasClock(error)) return false;
   if (!(params_.mass_kg > 0.0) || !(params_.spring_n_per_m >= 0.0) ||
       !(params_.max_substep_s > 0.0)) {
     if (error) *error = "virtual-hand: mass and substep must be positive, spring >= 0";

@@ -31,6 +31,7 @@ namespace {
 
 using testing::DeviceProcess;
 using testing::FakeServer;
+using testing::WriteDeviceScene;
 
 // A multicast group and port of this test alone: the flood would otherwise fill the socket
 // buffers of every other test's processes on the shared group (they would lose datagrams).
@@ -98,15 +99,6 @@ class Flooder {
   std::atomic<uint64_t> statuses_{0}, models_{0}, huge_{0};
 };
 
-std::string WriteScene(const std::string& dir) {
-  const std::string path = dir + "/scene.yaml";
-  std::ofstream f(path);
-  f << "name: device_flood_test\nmodel: zeeman\n"
-       "grasp:\n  start: [0, 2.5]\n  path: [[-2, 3.0], [2, 1.5]]\n"
-       "device:\n  model_units_per_metre: 100\n  model_origin: [0, 2.5, 0]\n";
-  return path;
-}
-
 TEST(DeviceFloodAttackTest, GenuineStatusesAndModelsGetThroughAFloodOfForgedOnes) {
   const test_support::SessionKeyFile key_file;  // SNAPTHREAD_KEY_FILE for the device
   const test_support::ScopedTempDir scoped("device_flood");
@@ -118,9 +110,10 @@ TEST(DeviceFloodAttackTest, GenuineStatusesAndModelsGetThroughAFloodOfForgedOnes
   ASSERT_TRUE(flood.good()) << "udpm on loopback unavailable";
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   const double duration_s = 4.0;
+  const std::string scene = WriteDeviceScene(dir, "device_flood_test");
   const uint64_t flood_at_device_start = flood.statuses();
   DeviceProcess device({test_support::BinDir() + "/snapthread-device", "--backend", "sim-path",
-                        "--scene", WriteScene(dir), "--session", session, "--lcm-url",
+                        "--scene", scene, "--session", session, "--lcm-url",
                         kFloodUrl, "--duration", std::to_string(duration_s),
                         "--speed-m-per-s", "0.04", "--no-rt", "--log-level", "warn",
                         "--summary", dir + "/summary.json"},

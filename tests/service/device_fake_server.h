@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -29,6 +30,18 @@ namespace snapthread::device::testing {
 
 inline constexpr double kSpringNPerM = 40.0;
 inline constexpr double kNegativeStiffnessNPerM = 25.0;
+
+// Writes <dir>/scene.yaml, the scene the device's process tests drive (named `name`): the
+// zeeman model, its grasp on the path from (-2, 3) to (2, 1.5) model units = (-2, 0.5) cm
+// to (2, -1) cm on the device. Returns its path.
+inline std::string WriteDeviceScene(const std::string& dir, const std::string& name) {
+  const std::string path = dir + "/scene.yaml";
+  std::ofstream f(path);
+  f << "name: " << name << "\nmodel: zeeman\n"
+       "grasp:\n  start: [0, 2.5]\n  path: [[-2, 3.0], [2, 1.5]]\n"
+       "device:\n  model_units_per_metre: 100\n  model_origin: [0, 2.5, 0]\n";
+  return path;
+}
 
 // A child process with stdout/stderr in <prefix>.out / <prefix>.err.
 class DeviceProcess : public test_support::ChildProcess {

@@ -43,6 +43,7 @@ namespace {
 
 using testing::DeviceProcess;
 using testing::FakeServer;
+using testing::WriteDeviceScene;
 using testing::kNegativeStiffnessNPerM;
 using testing::kSpringNPerM;
 constexpr const char* kUrl = test_support::kLoopbackLcmUrl;
@@ -82,16 +83,6 @@ std::vector<TraceSample> ReadTrace(const std::string& path, std::string* header)
   return rows;
 }
 
-std::string WriteScene(const std::string& dir) {
-  const std::string path = dir + "/scene.yaml";
-  std::ofstream f(path);
-  // Path from (-2, 3) to (2, 1.5) model units = (-2, 0.5) cm to (2, -1) cm on the device.
-  f << "name: device_process_test\nmodel: zeeman\n"
-       "grasp:\n  start: [0, 2.5]\n  path: [[-2, 3.0], [2, 1.5]]\n"
-       "device:\n  model_units_per_metre: 100\n  model_origin: [0, 2.5, 0]\n";
-  return path;
-}
-
 void SleepUntil(std::chrono::steady_clock::time_point t0, double s) {
   std::this_thread::sleep_until(t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                          std::chrono::duration<double>(s)));
@@ -104,7 +95,7 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   const test_support::ScopedTempDir scoped("device_test");
   const std::string& dir = scoped.path();
   const std::string session = UniqueSession("DEVTEST_SPRING");
-  const std::string scene = WriteScene(dir);
+  const std::string scene = WriteDeviceScene(dir, "device_process_test");
   const messages::Channels channels(session);
 
   auto server = std::make_unique<FakeServer>(session, &key_file.key());
@@ -340,10 +331,11 @@ TEST(DeviceProcessTest, SigtermStopsCleanlyAndPublishesPosesAndStatus) {
   const std::string session = UniqueSession("DEVTEST_TERM");
   Listener listener(session);
   ASSERT_TRUE(listener.good());
-  DeviceProcess device({bin, "--backend", "virtual-hand", "--scene", WriteScene(dir), "--session",
-                  session, "--lcm-url", kUrl, "--duration", "0", "--no-rt",
-                  "--publish-divisor", "4", "--summary", dir + "/summary.json"},
-                 dir + "/device");
+  const std::string scene = WriteDeviceScene(dir, "device_process_test");
+  DeviceProcess device({bin, "--backend", "virtual-hand", "--scene", scene, "--session", session,
+                        "--lcm-url", kUrl, "--duration", "0", "--no-rt", "--publish-divisor", "4",
+                        "--summary", dir + "/summary.json"},
+                       dir + "/device");
   ASSERT_TRUE(device.started());
   std::this_thread::sleep_for(std::chrono::milliseconds(2500));
   device.Signal(SIGTERM);
@@ -379,7 +371,7 @@ TEST(DeviceProcessTest, BadArgumentsExitTwoNamingTheArgument) {
   ASSERT_FALSE(bin.empty());
   const test_support::ScopedTempDir scoped("device_test");
   const std::string& dir = scoped.path();
-  const std::string scene = WriteScene(dir);
+  const std::string scene = WriteDeviceScene(dir, "device_process_test");
   struct Case {
     std::vector<std::string> args;
     std::string mention;
@@ -412,9 +404,10 @@ TEST(DeviceProcessTest, LcmFailureExitsOneWithUrlAndHint) {
   const test_support::ScopedTempDir scoped("device_test");
   const std::string& dir = scoped.path();
   const std::string url = "udpm://239.255.76.67:99999999?ttl=0";
-  DeviceProcess p({bin, "--backend", "sim-path", "--scene", WriteScene(dir), "--lcm-url", url, "--no-rt",
-             "--duration", "1"},
-            dir + "/lcmfail");
+  const std::string scene = WriteDeviceScene(dir, "device_process_test");
+  DeviceProcess p({bin, "--backend", "sim-path", "--scene", scene, "--lcm-url", url, "--no-rt",
+                   "--duration", "1"},
+                  dir + "/lcmfail");
   ASSERT_TRUE(p.started());
   EXPECT_EQ(p.ExitCode(10.0), 1);
   const std::string err = p.Err();

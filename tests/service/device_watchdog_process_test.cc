@@ -37,15 +37,7 @@ namespace {
 
 using testing::DeviceProcess;
 using testing::FakeServer;
-
-std::string WriteScene(const std::string& dir) {
-  const std::string path = dir + "/scene.yaml";
-  std::ofstream f(path);
-  f << "name: device_watchdog_process_test\nmodel: zeeman\n"
-       "grasp:\n  start: [0, 2.5]\n  path: [[-2, 3.0], [2, 1.5]]\n"
-       "device:\n  model_units_per_metre: 100\n  model_origin: [0, 2.5, 0]\n";
-  return path;
-}
+using testing::WriteDeviceScene;
 
 std::string Slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -99,8 +91,9 @@ TEST(DeviceWatchdogProcessTest, StoppedServoThreadZeroesTheRenderedForceWithin10
   FakeServer server(session, &key_file.key());
   ASSERT_TRUE(server.good()) << "udpm on loopback unavailable";
   const std::string bin = test_support::BinDir() + "/snapthread-device";
-  DeviceProcess device({bin, "--backend", "sim-path", "--scene", WriteScene(dir), "--session",
-                        session, "--lcm-url", test_support::kLoopbackLcmUrl, "--duration", "8",
+  const std::string scene = WriteDeviceScene(dir, "device_watchdog_process_test");
+  DeviceProcess device({bin, "--backend", "sim-path", "--scene", scene, "--session", session,
+                        "--lcm-url", test_support::kLoopbackLcmUrl, "--duration", "8",
                         "--speed-m-per-s", "0.04", "--no-rt", "--log-level", "warn",
                         "--sim-render-file", render_file, "--summary", dir + "/summary.json"},
                        dir + "/device");

@@ -164,7 +164,7 @@ TEST(DeviceWatchdogTest, StoppedServoLoopZeroesTheRenderedForceWithin10Ms) {
                        &realtime::MonotonicMicros);
   ASSERT_TRUE(device.Open(nullptr));
   std::string error;
-  ASSERT_TRUE(device.StartRenderer("", &error)) << error;
+  ASSERT_TRUE(device.renderer().Start("", &error)) << error;
   SafetyLimits limits;
   limits.fade_time_s = 0.02;
   ForceSafety safety(limits, true, true);

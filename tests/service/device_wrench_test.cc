@@ -282,38 +282,51 @@ TEST(DeviceWrenchSafetyTest, SimPathRollsAndKeepsTheCommandedTorque) {
   EXPECT_EQ(device.last_torque_nm()[2], 0.01);
 }
 
-// The one envelope the force and the torque both go through (LimitVector): the norm
-// clamp, then the slew limit from the last output, a non-finite input aimed at zero
-// through the slew limit, and last updated to the output.
-TEST(DeviceEnvelopeTest, LimitVectorClampsSlewsAndNeverPassesNonFinite) {
-  double last[3] = {0.0, 0.0, 0.0};
+// The one envelope the force and the torque both go through (VectorLimiter, limiter.h):
+// the norm clamp, then the slew limit from the last output, a non-finite input aimed at
+// zero through the slew limit, and last updated to the output.
+TEST(DeviceEnvelopeTest, VectorLimiterClampsSlewsAndNeverPassesNonFinite) {
+  VectorLimiter limiter(3.0, 1.0);
   double v[3] = {6.0, 8.0, 0.0};  // |v| = 10 > 3: clamped to (1.8, 2.4, 0), then slewed by 1
-  Limited l = LimitVector(v, 3.0, 1.0, last);
+  LimitVerdict l = limiter.Apply(v);
   EXPECT_TRUE(l.clamped);
   EXPECT_TRUE(l.slew_limited);
   EXPECT_FALSE(l.nonfinite);
   EXPECT_NEAR(v[0], 0.6, 1e-15);
   EXPECT_NEAR(v[1], 0.8, 1e-15);
-  for (int k = 0; k < 3; ++k) EXPECT_EQ(last[k], v[k]);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(limiter.last()[k], v[k]);
   // Within both limits: passed as it is.
   double w[3] = {1.0, 1.2, 0.1};
-  l = LimitVector(w, 3.0, 1.0, last);
+  l = limiter.Apply(w);
   EXPECT_FALSE(l.clamped || l.slew_limited || l.nonfinite);
   EXPECT_EQ(w[0], 1.0);
   EXPECT_EQ(w[2], 0.1);
   // NaN and inf: no direction to keep; the output walks to zero at the slew limit.
+  VectorLimiter tight(3.0, 0.5);
+  for (int i = 0; i < 4; ++i) {  // |(1, 1.2, 0.1)| = 1.56: reached in four steps of 0.5
+    double start[3] = {1.0, 1.2, 0.1};
+    tight.Apply(start);
+  }
+  ASSERT_EQ(tight.last()[0], 1.0);
+  ASSERT_EQ(tight.last()[1], 1.2);
+  ASSERT_EQ(tight.last()[2], 0.1);
   double bad[3] = {kNaN, 1.0, std::numeric_limits<double>::infinity()};
-  l = LimitVector(bad, 3.0, 0.5, last);
+  l = tight.Apply(bad);
   EXPECT_TRUE(l.clamped);
   EXPECT_TRUE(l.slew_limited);
   EXPECT_FALSE(l.nonfinite);
   const double before = std::sqrt(1.0 + 1.44 + 0.01);
   EXPECT_NEAR(Norm(bad), before - 0.5, 1e-12);
   for (double x : bad) EXPECT_TRUE(std::isfinite(x));
-  // Overflowing arithmetic cannot leak: a huge finite last and a huge step.
-  double huge_last[3] = {1e308, 1e308, 0.0};
-  double huge[3] = {-1e308, -1e308, 0.0};
-  l = LimitVector(huge, 1e308, 1e308, huge_last);
+  // Overflowing arithmetic cannot leak: a huge finite last and a huge step (the step's
+  // square and |v - last|² overflow).
+  VectorLimiter huge_limiter(1e308, 1e308);
+  double huge_last[3] = {9e153, 9e153, 0.0};
+  EXPECT_FALSE(huge_limiter.Apply(huge_last).clamped);
+  ASSERT_EQ(huge_limiter.last()[0], 9e153);
+  double huge[3] = {-9e153, -9e153, 0.0};
+  l = huge_limiter.Apply(huge);
+  EXPECT_FALSE(l.nonfinite);
   for (double x : huge) EXPECT_TRUE(std::isfinite(x));
 }
 
