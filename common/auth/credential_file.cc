@@ -11,18 +11,18 @@ namespace snapthread::auth {
 namespace {
 
 PrivateFileNaming CredentialNaming(const std::string& path) {
-  PrivateFileNaming file;
-  file.path = path;
-  file.named = "credential " + path;
-  file.thing = "credential";
-  file.flag = "--credential";
-  file.default_name = "snapthread.cred";
-  file.point_at = "point --credential at the credential file issued by snapthread-keygen --role";
-  file.make_command = "snapthread-keygen --role ROLE --credential";
-  file.missing_message = "no credential at " + path +
-                         ". Fix: issue one on the server host (snapthread-keygen --role ROLE "
-                         "--credential FILE) and copy it here with scp -p";
-  return file;
+  return {
+      .path = path,
+      .named = "credential " + path,
+      .thing = "credential",
+      .flag = "--credential",
+      .default_name = "snapthread.cred",
+      .point_at = "point --credential at the credential file issued by snapthread-keygen --role",
+      .make_command = "snapthread-keygen --role ROLE --credential",
+      .missing_message = "no credential at " + path +
+                             ". Fix: issue one on the server host (snapthread-keygen --role ROLE "
+                             "--credential FILE) and copy it here with scp -p",
+  };
 }
 
 // Wipes a buffer that held a credential's text (its secrets) on every way out.

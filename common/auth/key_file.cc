@@ -30,21 +30,21 @@ std::string HomeDir(const EnvLookup& env) {
 
 // The session key as a private file (auth/private_file.h): its name and fixes.
 PrivateFileNaming KeyNaming(const KeyLocation& where) {
-  PrivateFileNaming file;
-  file.path = where.path;
-  file.named = "session key " + where.path + " (" + where.origin + ")";
-  file.thing = "key";
-  file.flag = "--key";
-  file.default_name = "session.key";
-  file.point_at = "point --key or SNAPTHREAD_KEY_FILE at the 32-byte key file made by snapthread-keygen";
-  file.make_command = "snapthread-keygen --key";
-  file.missing_message =
-      "no session key at " + where.path + " (" + where.origin + ")" +
-      ". Fix: make it with `snapthread-keygen --key " + ShellQuoted(where.path) +
-      "` (or start snapthread-server once with --create-key), or copy the session's key here "
-      "with scp -p; a missing key is never made silently (a typo would give a new key); see "
-      "docs/security.md";
-  return file;
+  return {
+      .path = where.path,
+      .named = "session key " + where.path + " (" + where.origin + ")",
+      .thing = "key",
+      .flag = "--key",
+      .default_name = "session.key",
+      .point_at = "point --key or SNAPTHREAD_KEY_FILE at the 32-byte key file made by snapthread-keygen",
+      .make_command = "snapthread-keygen --key",
+      .missing_message =
+          "no session key at " + where.path + " (" + where.origin + ")" +
+          ". Fix: make it with `snapthread-keygen --key " + ShellQuoted(where.path) +
+          "` (or start snapthread-server once with --create-key), or copy the session's key here "
+          "with scp -p; a missing key is never made silently (a typo would give a new key); see "
+          "docs/security.md",
+  };
 }
 
 // Runs `body`, turning the shared file rules' refusals into KeyFileError.

@@ -16,18 +16,18 @@ constexpr const char* kFix = "one entry a line: 'device NAME', 'operator NAME' o
 }
 
 PrivateFileNaming ListNaming(const std::string& path) {
-  PrivateFileNaming file;
-  file.path = path;
-  file.named = "revocation list " + path;
-  file.thing = "revocation list";
-  file.flag = "--revocations";
-  file.default_name = "revoked";
-  file.point_at = "point --revocations at a text file of revoked devices, operators and key ids";
-  file.make_command = "install -m 600 /dev/null";
-  file.missing_message = "no revocation list at " + path +
-                         ". Fix: create it (install -m 600 /dev/null " + ShellQuoted(path) +
-                         ") or leave the option out";
-  return file;
+  return {
+      .path = path,
+      .named = "revocation list " + path,
+      .thing = "revocation list",
+      .flag = "--revocations",
+      .default_name = "revoked",
+      .point_at = "point --revocations at a text file of revoked devices, operators and key ids",
+      .make_command = "install -m 600 /dev/null",
+      .missing_message = "no revocation list at " + path +
+                             ". Fix: create it (install -m 600 /dev/null " + ShellQuoted(path) +
+                             ") or leave the option out",
+  };
 }
 
 // A name looked up without building a std::string (IsRevoked allocates nothing): compared
