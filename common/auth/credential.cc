@@ -16,6 +16,8 @@ constexpr std::array<std::string_view, kFieldCount> kFieldNames = {
     "role", "name", "expires", "root_id", "key_id", "server_public_key", "read_key", "secret"};
 
 constexpr std::string_view kHeader = "snapthread-credential ";
+// More than the longest text FormatCredential makes (about 400 bytes).
+constexpr std::size_t kMaxFormattedBytes = 1024;
 constexpr const char* kReissue =
     "issue a new credential on the server host (snapthread-keygen --role ...) and copy it "
     "here with scp -p; a credential is never edited by hand";
@@ -221,15 +223,29 @@ Credential IssueCredential(const SessionKey& root, Role role, std::string_view n
 }
 
 std::string FormatCredential(const Credential& c) {
-  std::string text = std::string(kHeader) + std::to_string(kCredentialFormatVersion) + "\n";
-  text += "role " + std::string(RoleToString(c.role)) + "\n";
-  if (RoleIsNamed(c.role)) text += "name " + c.name + "\n";
-  text += "expires " + ExpiryText(c.expires_unix_s) + "\n";
-  text += "root_id " + KeyIdToHex(c.root_id) + "\n";
-  text += "key_id " + KeyIdToHex(c.key_id) + "\n";
-  text += "server_public_key " + ToHex(c.server_public_key.data(), c.server_public_key.size()) + "\n";
-  if (c.read_key) text += "read_key " + ToHex(c.read_key->data(), SessionKey::kBytes) + "\n";
-  if (c.secret) text += "secret " + ToHex(c.secret->data(), SessionKey::kBytes) + "\n";
+  // Reserved once and hex written in place: no reallocation or temporary leaves a copy of
+  // a secret in freed memory (the caller wipes `text`).
+  std::string text;
+  text.reserve(kMaxFormattedBytes);
+  auto line = [&](std::string_view word, std::string_view value) {
+    text.append(word).append(" ").append(value).append("\n");
+  };
+  auto hex_line = [&](std::string_view word, const uint8_t* bytes, std::size_t size) {
+    text.append(word).append(" ");
+    const std::size_t at = text.size();
+    text.resize(at + 2 * size + 1);
+    sodium_bin2hex(text.data() + at, 2 * size + 1, bytes, size);
+    text.back() = '\n';
+  };
+  text.append(kHeader).append(std::to_string(kCredentialFormatVersion)).append("\n");
+  line("role", RoleToString(c.role));
+  if (RoleIsNamed(c.role)) line("name", c.name);
+  line("expires", ExpiryText(c.expires_unix_s));
+  hex_line("root_id", c.root_id.data(), c.root_id.size());
+  hex_line("key_id", c.key_id.data(), c.key_id.size());
+  hex_line("server_public_key", c.server_public_key.data(), c.server_public_key.size());
+  if (c.read_key) hex_line("read_key", c.read_key->data(), SessionKey::kBytes);
+  if (c.secret) hex_line("secret", c.secret->data(), SessionKey::kBytes);
   return text;
 }
 
