@@ -9,7 +9,8 @@
 // owned by the user running snapthread, is exactly 32 bytes that neither group nor others
 // may read or write (as ssh does for private keys), and sits in a directory that neither
 // group nor others may write and that belongs to the user or root. Every refusal names
-// the file and the fix. These run at start-up and throw KeyFileError.
+// the file and the fix (the rules every private file follows: auth/private_file.h). These
+// run at start-up and throw KeyFileError.
 #pragma once
 
 #include <functional>
