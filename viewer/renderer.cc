@@ -179,11 +179,14 @@ void Renderer::AppendText(const std::string& text, float x, float y, float scale
   }
 }
 
-void Renderer::BuildChart(const SessionSnapshot& s, int width, int height) {
-  const PixelRect r = MakeHudLayout(width, height).chart;
-  const float x0 = float(r.x), y0 = float(r.y), x1 = float(r.x + r.width),
-              y1 = float(r.y + r.height);
+std::array<float, 4> Renderer::AppendPanel(const PixelRect& r) {
+  const float x0 = float(r.x), y0 = float(r.y), x1 = float(r.x + r.width), y1 = float(r.y + r.height);
   AppendRect(x0, y0, x1, y1, {0.05f, 0.05f, 0.07f});
+  return {x0, y0, x1, y1};
+}
+
+void Renderer::BuildChart(const SessionSnapshot& s, int width, int height) {
+  const auto [x0, y0, x1, y1] = AppendPanel(MakeHudLayout(width, height).chart);
   const Rgb frame(0.45f, 0.45f, 0.5f);
   AppendLine(x0, y0, x1, y0, frame);
   AppendLine(x1, y0, x1, y1, frame);
@@ -261,10 +264,7 @@ void Renderer::AppendMaterialTube(const thread_shape_t& shape, const std::vector
 }
 
 void Renderer::BuildTwistLegend(const Rgb& base, int width, int height) {
-  const PixelRect r = MakeHudLayout(width, height).legend;
-  const float x0 = float(r.x), y0 = float(r.y), x1 = float(r.x + r.width),
-              y1 = float(r.y + r.height);
-  AppendRect(x0, y0, x1, y1, {0.05f, 0.05f, 0.07f});
+  const auto [x0, y0, x1, y1] = AppendPanel(MakeHudLayout(width, height).legend);
   const Rgb text(0.8f, 0.8f, 0.8f);
   char line[160];
   std::snprintf(line, sizeof line, "twist: full colour at 1 turn/L = %.3g rad/unit",
