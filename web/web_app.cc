@@ -69,7 +69,7 @@ int RunWeb(WebOptions o) {
     files = std::make_shared<const PageFiles>(o.page_dir);
     if (!o.log_path.empty()) {
       // Set below, once the hub exists: the feed publishes to it.
-      replay = std::make_unique<ReplayFeed>(o.log_path, o.session,
+      replay = std::make_unique<ReplayFeed>(o.log_path, o.common.session,
                                             [&hub](FeedKind k, Text t) { hub->Publish(k, std::move(t)); });
       hub = std::make_shared<Hub>(io, "replay", replay->session(), [&replay] { return replay->counts(); });
       hub->SetCommandHandler([&replay](const std::string& c) { return replay->Command(c); });
@@ -79,9 +79,9 @@ int RunWeb(WebOptions o) {
                   o.log_path.c_str(), messages::EscapeForDisplay(replay->session()).c_str(), static_cast<long long>(p.shape_count),
                   p.duration_s, static_cast<long long>(p.last_seq));
     } else {
-      key.emplace(auth::LoadKey(auth::ResolveKeyPath(o.key_path)));
-      hub = std::make_shared<Hub>(io, "live", o.session, [&live] { return live->counts(); });
-      live = std::make_unique<LiveFeed>(o.lcm_url, o.session, *key,
+      key.emplace(auth::LoadKey(auth::ResolveKeyPath(o.common.key_path)));
+      hub = std::make_shared<Hub>(io, "live", o.common.session, [&live] { return live->counts(); });
+      live = std::make_unique<LiveFeed>(o.lcm_url, o.common.session, *key,
                                         [&hub](FeedKind k, Text t) { hub->Publish(k, std::move(t)); });
     }
   } catch (const std::exception& e) {
@@ -106,7 +106,7 @@ int RunWeb(WebOptions o) {
                                                  : o.bind;
   std::printf("snapthread-web: serving %s of session %s at http://%s:%u/%s\n",
               replay ? "a replay" : "the live view",
-              messages::EscapeForDisplay(replay ? replay->session() : o.session).c_str(),
+              messages::EscapeForDisplay(replay ? replay->session() : o.common.session).c_str(),
               host.c_str(), server->port(), o.token.empty() ? "" : ("?token=" + o.token).c_str());
   std::fflush(stdout);
 

@@ -22,7 +22,7 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags, const CommonFlagSet& set)
         flags->session_from_environment = true;
       }
     }
-    app->add_option("--session", flags->session, help + ")")->capture_default_str();
+    app->add_option("--session", flags->session, help + ")" + set.session_note)->capture_default_str();
   }
   if (set.lcm_url) {
     app->add_option(set.lcm_url_names, flags->lcm_url,
@@ -32,7 +32,7 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags, const CommonFlagSet& set)
   if (set.key) {
     app->add_option("--key", flags->key_path,
                     "session key file (default: $" + std::string(auth::kKeyFileEnv) +
-                        ", else $XDG_CONFIG_HOME/snapthread/session.key); snapthread-keygen makes it" +
+                        ", else $XDG_CONFIG_HOME/snapthread/session.key or ~/.config/snapthread/session.key)" +
                         set.key_note);
   }
   if (set.log_level) {

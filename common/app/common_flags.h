@@ -36,8 +36,9 @@ struct CommonFlagSet {
   bool session_from_environment = false;
   // The --lcm-url option's names: snapthread-logger adds lcm-logger's "-l".
   std::string lcm_url_names = "--lcm-url";
-  // Appended to --key's help, e.g. "; not needed with --log".
+  // Appended to --key's and --session's help, e.g. "; not needed with --log".
   std::string key_note;
+  std::string session_note;
 };
 
 // spdlog's level names, the values --log-level accepts.
