@@ -49,6 +49,8 @@ class Renderer {
   void AppendLine(float x0, float y0, float x1, float y1, const Rgb& color);
   // A HUD panel's dark background; returns its corners {x0, y0, x1, y1} in pixels.
   std::array<float, 4> AppendPanel(const PixelRect& r);
+  // The thread, clamp, grasps, grip direction, force arrows and contacts of a shape.
+  void BuildShape(const thread_shape_t& shape, const FrameInfo& info);
   void BuildChart(const SessionSnapshot& s, int width, int height);
   void AppendForceArrow(const Eigen::Vector3d& at, const Eigen::Vector3d& f, double extent,
                         double radius);
