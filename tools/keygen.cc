@@ -6,22 +6,25 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/common_flags.h"
 #include "auth/key_file.h"
 #include "tool_main.h"
 
 int main(int argc, char** argv) {
   using namespace snapthread::auth;
   CLI::App app{"snapthread-keygen: make the session key shared by the server, device and viewers"};
-  std::string key_path, host = "LAB_PC";
+  snapthread::app::CommonFlags common;  // --key only
+  snapthread::app::CommonFlagSet key_only;
+  key_only.session = false;
+  key_only.lcm_url = false;
+  snapthread::app::AddCommonFlags(&app, &common, key_only);
+  std::string host = "LAB_PC";
   bool force = false, show_id = false;
-  app.add_option("--key", key_path,
-                 "key file (default: $SNAPTHREAD_KEY_FILE, else "
-                 "$XDG_CONFIG_HOME/snapthread/session.key or ~/.config/snapthread/session.key)");
   app.add_flag("--force", force, "replace an existing key (copy the new one to every machine)");
   app.add_flag("--id", show_id, "check the existing key and print its id (compare on both machines)");
   app.add_option("--host", host, "ssh name of the other machine, for the printed scp command");
   const auto run = [&]() -> int {
-    const KeyLocation where = ResolveKeyPath(key_path);
+    const KeyLocation where = ResolveKeyPath(common.key_path);
     if (show_id) {
       std::printf("%s: key id %s (%s)\n", where.path.c_str(), LoadKey(where).Id().c_str(),
                   where.origin.c_str());
@@ -38,7 +41,7 @@ int main(int argc, char** argv) {
                 host.c_str(), id.c_str());
     return 0;
   };
-  // Every error exits 1 (a bad key file is not a bad argument).
+  // Bad arguments exit 2, every other error 1 (a bad key file is not a bad argument).
   snapthread::ToolExitCodes codes;
   codes.invalid_argument_is_bad_input = false;
   return snapthread::RunTool("snapthread-keygen", app, argc, argv, run, codes);

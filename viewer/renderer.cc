@@ -179,11 +179,14 @@ void Renderer::AppendText(const std::string& text, float x, float y, float scale
   }
 }
 
-void Renderer::BuildChart(const SessionSnapshot& s, int width, int height) {
-  const PixelRect r = MakeHudLayout(width, height).chart;
-  const float x0 = float(r.x), y0 = float(r.y), x1 = float(r.x + r.width),
-              y1 = float(r.y + r.height);
+std::array<float, 4> Renderer::AppendPanel(const PixelRect& r) {
+  const float x0 = float(r.x), y0 = float(r.y), x1 = float(r.x + r.width), y1 = float(r.y + r.height);
   AppendRect(x0, y0, x1, y1, {0.05f, 0.05f, 0.07f});
+  return {x0, y0, x1, y1};
+}
+
+void Renderer::BuildChart(const SessionSnapshot& s, int width, int height) {
+  const auto [x0, y0, x1, y1] = AppendPanel(MakeHudLayout(width, height).chart);
   const Rgb frame(0.45f, 0.45f, 0.5f);
   AppendLine(x0, y0, x1, y0, frame);
   AppendLine(x1, y0, x1, y1, frame);
@@ -261,10 +264,7 @@ void Renderer::AppendMaterialTube(const thread_shape_t& shape, const std::vector
 }
 
 void Renderer::BuildTwistLegend(const Rgb& base, int width, int height) {
-  const PixelRect r = MakeHudLayout(width, height).legend;
-  const float x0 = float(r.x), y0 = float(r.y), x1 = float(r.x + r.width),
-              y1 = float(r.y + r.height);
-  AppendRect(x0, y0, x1, y1, {0.05f, 0.05f, 0.07f});
+  const auto [x0, y0, x1, y1] = AppendPanel(MakeHudLayout(width, height).legend);
   const Rgb text(0.8f, 0.8f, 0.8f);
   char line[160];
   std::snprintf(line, sizeof line, "twist: full colour at 1 turn/L = %.3g rad/unit",
@@ -287,78 +287,56 @@ void Renderer::BuildTwistLegend(const Rgb& base, int width, int height) {
   AppendText(line, x0 + 4, by1 + 15, 1.0f, text);
 }
 
-void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int width, int height,
-                    const FrameInfo& info) {
-  glViewport(0, 0, width, height);
-  glClearColor(kBackground[0], kBackground[1], kBackground[2], 1.0f);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  glUseProgram(program_);
-  scene_.Clear();
-  highlights_.Clear();
-  twist_legend_ = {};
-  overlay_triangles_.clear();
-  overlay_lines_.clear();
-
-  if (s.has_shape) {
-    const thread_shape_t& shape = s.shape;
-    std::vector<Point3> nodes;
-    nodes.reserve(shape.positions.size());
-    for (const auto& p : shape.positions) nodes.emplace_back(p[0], p[1], p[2]);
-    Eigen::Vector3d lo = nodes.front(), hi = nodes.front();
-    for (const auto& p : nodes) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    const double extent = std::max((hi - lo).norm(), 1e-3);
-    const double radius = 0.012 * extent;
-    // Threads (the registry's chains) and rods (shapes with material frames) are smooth
-    // curves through their nodes; the Zeeman and cusp "shapes" are linkages (rods between
-    // joints), drawn straight.
-    const ModelRegistration* model = FindModel(shape.model);
-    const bool framed = shape.num_frames > 0 && shape.num_frames + 1 == shape.num_nodes;
-    const bool smooth = framed || (model != nullptr && model->capabilities.chain.has_value());
-    const std::vector<Point3> path = CatmullRomCurve(nodes, smooth ? kSplineSamplesPerSegment : 1);
-    if (framed) {
-      AppendMaterialTube(shape, nodes, path, radius);
-    } else {
-      scene_.AppendTube(path, radius, kTubeSides, StatusColor(shape.status));
-    }
-    scene_.AppendSphere(nodes.front(), 2.2 * radius, {0.6f, 0.6f, 0.62f});  // clamp
-    const Eigen::Vector3d grasp(shape.grasp[0], shape.grasp[1], shape.grasp[2]);
-    // With named grasps every row is drawn (the first is the legacy grasp); otherwise the
-    // single grasp, which the mouse may be dragging.
-    if (shape.num_grasps == 0) {
-      scene_.AppendSphere(grasp, 2.0 * radius,
-                          info.dragging ? Rgb(1.0f, 1.0f, 0.5f) : GraspColor(0));
-    }
-    const Eigen::Vector3d d(shape.grip_direction[0], shape.grip_direction[1],
-                            shape.grip_direction[2]);
-    if (d.norm() > 1e-9) {
-      scene_.AppendArrow(grasp, grasp + 0.12 * extent * d.normalized(), 0.5 * radius,
-                         {0.8f, 0.4f, 0.9f});
-    }
-    // Force arrows: direction of the model force, length relative to the largest |F| seen,
-    // so the arrows stay readable for any scene's force scale.
-    if (shape.num_grasps == 0) {
-      AppendForceArrow(grasp, Eigen::Vector3d(shape.force[0], shape.force[1], shape.force[2]),
-                       extent, radius);
-    }
-    AppendGraspsAndContacts(shape, extent, radius);
+void Renderer::BuildShape(const thread_shape_t& shape, const FrameInfo& info) {
+  std::vector<Point3> nodes;
+  nodes.reserve(shape.positions.size());
+  for (const auto& p : shape.positions) nodes.emplace_back(p[0], p[1], p[2]);
+  Eigen::Vector3d lo = nodes.front(), hi = nodes.front();
+  for (const auto& p : nodes) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
   }
-
-  const double aspect = double(width) / height;
-  float mvp[16];
-  ToFloat(camera.Projection(aspect) * camera.View(), mvp);
-  const Eigen::Vector3d l = (camera.Eye() - camera.Target()).normalized();
-  const float light[3] = {float(l.x()), float(l.y()), float(l.z())};
-  glEnable(GL_DEPTH_TEST);
-  DrawVertices(scene_.vertices(), GL_TRIANGLES, mvp, light);
-  if (!highlights_.vertices().empty()) {
-    glClear(GL_DEPTH_BUFFER_BIT);
-    DrawVertices(highlights_.vertices(), GL_TRIANGLES, mvp, light);
+  const double extent = std::max((hi - lo).norm(), 1e-3);
+  const double radius = 0.012 * extent;
+  // Threads (the registry's chains) and rods (shapes with material frames) are smooth
+  // curves through their nodes; the Zeeman and cusp "shapes" are linkages (rods between
+  // joints), drawn straight.
+  const ModelRegistration* model = FindModel(shape.model);
+  const bool framed = shape.num_frames > 0 && shape.num_frames + 1 == shape.num_nodes;
+  const bool smooth = framed || (model != nullptr && model->capabilities.chain.has_value());
+  const std::vector<Point3> path = CatmullRomCurve(nodes, smooth ? kSplineSamplesPerSegment : 1);
+  if (framed) {
+    AppendMaterialTube(shape, nodes, path, radius);
+  } else {
+    scene_.AppendTube(path, radius, kTubeSides, StatusColor(shape.status));
   }
+  scene_.AppendSphere(nodes.front(), 2.2 * radius, {0.6f, 0.6f, 0.62f});  // clamp
+  const Eigen::Vector3d grasp(shape.grasp[0], shape.grasp[1], shape.grasp[2]);
+  // With named grasps every row is drawn (the first is the legacy grasp); otherwise the
+  // single grasp, which the mouse may be dragging.
+  if (shape.num_grasps == 0) {
+    scene_.AppendSphere(grasp, 2.0 * radius,
+                        info.dragging ? Rgb(1.0f, 1.0f, 0.5f) : GraspColor(0));
+  }
+  const Eigen::Vector3d d(shape.grip_direction[0], shape.grip_direction[1],
+                          shape.grip_direction[2]);
+  if (d.norm() > 1e-9) {
+    scene_.AppendArrow(grasp, grasp + 0.12 * extent * d.normalized(), 0.5 * radius,
+                       {0.8f, 0.4f, 0.9f});
+  }
+  // Force arrows: direction of the model force, length relative to the largest |F| seen,
+  // so the arrows stay readable for any scene's force scale.
+  if (shape.num_grasps == 0) {
+    AppendForceArrow(grasp, Eigen::Vector3d(shape.force[0], shape.force[1], shape.force[2]),
+                     extent, radius);
+  }
+  AppendGraspsAndContacts(shape, extent, radius);
+}
 
-  // Overlay in pixel coordinates (origin top-left, y down).
+namespace {
+
+// The HUD's text: session, shape, solver status, knot and grasp mode.
+std::string HudText(const SessionSnapshot& s, const FrameInfo& info) {
   char line[256];
   std::string text;
   // Strings of messages (scene, model, method, knot) are hostile text: escaped and cut short,
@@ -407,8 +385,40 @@ void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int wid
     text += line;
   }
   if (info.grasp_mode) text += info.dragging ? "GRASP: dragging\n" : "GRASP mode: drag the grasp\n";
+  return text;
+}
+
+}  // namespace
+
+void Renderer::Draw(const SessionSnapshot& s, const OrbitCamera& camera, int width, int height,
+                    const FrameInfo& info) {
+  glViewport(0, 0, width, height);
+  glClearColor(kBackground[0], kBackground[1], kBackground[2], 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glUseProgram(program_);
+  scene_.Clear();
+  highlights_.Clear();
+  twist_legend_ = {};
+  overlay_triangles_.clear();
+  overlay_lines_.clear();
+
+  if (s.has_shape) BuildShape(s.shape, info);
+
+  const double aspect = double(width) / height;
+  float mvp[16];
+  ToFloat(camera.Projection(aspect) * camera.View(), mvp);
+  const Eigen::Vector3d l = (camera.Eye() - camera.Target()).normalized();
+  const float light[3] = {float(l.x()), float(l.y()), float(l.z())};
+  glEnable(GL_DEPTH_TEST);
+  DrawVertices(scene_.vertices(), GL_TRIANGLES, mvp, light);
+  if (!highlights_.vertices().empty()) {
+    glClear(GL_DEPTH_BUFFER_BIT);
+    DrawVertices(highlights_.vertices(), GL_TRIANGLES, mvp, light);
+  }
+
+  // Overlay in pixel coordinates (origin top-left, y down).
   const Rgb text_color = s.has_shape ? StatusColor(s.shape.status) : Rgb(0.8f, 0.8f, 0.8f);
-  AppendText(text, 10.f, 10.f, 1.5f, text_color);
+  AppendText(HudText(s, info), 10.f, 10.f, 1.5f, text_color);
   BuildChart(s, width, height);
   if (twist_legend_.shown) BuildTwistLegend(StatusColor(s.shape.status), width, height);
 

@@ -5,11 +5,13 @@
 // rebuilt per frame (a few thousand vertices) and streamed in one buffer.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
 #include <epoxy/gl.h>
 
+#include "hud_layout.h"
 #include "marker_colors.h"
 #include "mesh_builder.h"
 #include "orbit_camera.h"
@@ -45,6 +47,10 @@ class Renderer {
   void AppendText(const std::string& text, float x, float y, float scale, const Rgb& color);
   void AppendRect(float x0, float y0, float x1, float y1, const Rgb& color);
   void AppendLine(float x0, float y0, float x1, float y1, const Rgb& color);
+  // A HUD panel's dark background; returns its corners {x0, y0, x1, y1} in pixels.
+  std::array<float, 4> AppendPanel(const PixelRect& r);
+  // The thread, clamp, grasps, grip direction, force arrows and contacts of a shape.
+  void BuildShape(const thread_shape_t& shape, const FrameInfo& info);
   void BuildChart(const SessionSnapshot& s, int width, int height);
   void AppendForceArrow(const Eigen::Vector3d& at, const Eigen::Vector3d& f, double extent,
                         double radius);

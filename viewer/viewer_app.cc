@@ -12,14 +12,13 @@
 #include <GLFW/glfw3.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "auth/key_file.h"
+#include "app/common_flags.h"
 #include "channel_rates.h"
 #include "messages/channels.h"
 #include "grasp_publisher.h"
 #include "png_writer.h"
 #include "renderer.h"
 #include "session_receiver.h"
-#include "stop_signals.h"
 #include "scene/scene.h"
 #include "models/registry.h"
 #include "messages/lcm_url.h"
@@ -156,15 +155,7 @@ bool SaveScreenshot(const std::string& path, int width, int height, std::string*
   return WritePngRgb(path, width, height, flipped, error);
 }
 
-// The session key, or nullopt after printing why it cannot be used (file and fix).
-std::optional<auth::SessionKey> LoadViewerKey(const ViewerOptions& options) {
-  try {
-    return auth::LoadKey(auth::ResolveKeyPath(options.key_path));
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "snapthread-viewer: --key: %s\n", e.what());
-    return std::nullopt;
-  }
-}
+constexpr const char* kProgram = "snapthread-viewer";
 
 // Whether the LCM at --lcm-url opened; if not, says so and how to start it.
 bool LcmOpened(const lcm::LCM& lcm, const ViewerOptions& options) {
@@ -174,22 +165,197 @@ bool LcmOpened(const lcm::LCM& lcm, const ViewerOptions& options) {
   return false;
 }
 
+// The scene of --grasp-mode (its device mapping), or nullopt after saying why not.
+std::optional<Scene> LoadGraspScene(const ViewerOptions& options) {
+  try {
+    return LoadScene(options.scene_path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-viewer: --grasp-mode needs a scene: %s\n", e.what());
+    return std::nullopt;
+  }
+}
+
+// GLFW and an OpenGL 3.3 core window with its context current, or nullptr after saying
+// why not (GLFW is terminated again then).
+GLFWwindow* OpenWindow(const ViewerOptions& options) {
+  glfwSetErrorCallback(&OnGlfwError);
+  if (!glfwInit()) {
+    std::fprintf(stderr, "snapthread-viewer: cannot initialise GLFW (no $DISPLAY? use xvfb-run): %s\n",
+                 g_glfw_error.c_str());
+    return nullptr;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_SAMPLES, options.screenshot_path.empty() ? 4 : 0);
+  const std::string title = "snapthread-viewer: " + options.common.session;
+  GLFWwindow* window =
+      glfwCreateWindow(options.width, options.height, title.c_str(), nullptr, nullptr);
+  if (window == nullptr) {
+    std::fprintf(stderr, "snapthread-viewer: cannot create an OpenGL 3.3 core window: %s\n",
+                 g_glfw_error.c_str());
+    glfwTerminate();
+    return nullptr;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(1);
+  std::fprintf(stderr, "snapthread-viewer: GL %s, %s; listening on %s_SHAPE at %s\n",
+               reinterpret_cast<const char*>(glGetString(GL_VERSION)),
+               reinterpret_cast<const char*>(glGetString(GL_RENDERER)), options.common.session.c_str(),
+               options.lcm_url.c_str());
+  return window;
+}
+
+// The mouse and keyboard callbacks, writing into `input`.
+void ConnectInput(GLFWwindow* window, InputState* input) {
+  glfwSetWindowUserPointer(window, input);
+  glfwSetMouseButtonCallback(window, &OnMouseButton);
+  glfwSetCursorPosCallback(window, &OnCursor);
+  glfwSetScrollCallback(window, &OnScroll);
+  glfwSetKeyCallback(window, &OnKey);
+}
+
+// Applies what a frame's snapshot and the input since the last frame ask of the camera
+// and the grasp: fit to the first shape (or on F), zoom, drag the grasp.
+void UpdateView(const SessionSnapshot& snap, int w, int h, GLFWwindow* window, GraspPublisher* grasp,
+                InputState* input) {
+  if (snap.has_shape) {
+    if (!input->fitted || input->request_fit) {
+      // Planar models face the camera as drawn in the seed; a 3-D thread starts from an
+      // oblique view so its depth is visible.
+      if (!input->fitted && !IsPlanarModel(snap.shape.model)) input->camera.SetAngles(0.5, 0.35);
+      FitToShape(snap.shape, w, h, &input->camera);
+      input->fitted = true;
+      input->request_fit = false;
+    }
+    input->grasp_model = Eigen::Vector3d(snap.shape.grasp[0], snap.shape.grasp[1], snap.shape.grasp[2]);
+    input->planar = IsPlanarModel(snap.shape.model);
+  }
+  if (input->scroll != 0) {
+    input->camera.Zoom(std::pow(0.9, input->scroll));
+    input->scroll = 0;
+  }
+  if (grasp != nullptr && input->dragging_grasp) {
+    if (auto target = DragTarget(window, *input)) grasp->Publish(*target, true);
+  }
+}
+
+// Writes the screenshot of the frame just drawn; returns the exit code.
+int WriteScreenshot(const ViewerOptions& options, const SessionSnapshot& snap, int w, int h) {
+  glFinish();
+  std::string error;
+  if (!SaveScreenshot(options.screenshot_path, w, h, &error)) {
+    std::fprintf(stderr, "snapthread-viewer: screenshot failed: %s\n", error.c_str());
+    return kExitSetupFailed;
+  }
+  std::printf("snapthread-viewer: wrote %s (%dx%d) after %lld shapes, %lld bad messages\n",
+              options.screenshot_path.c_str(), w, h, static_cast<long long>(snap.shapes_received),
+              static_cast<long long>(snap.bad_messages));
+  return kExitOk;
+}
+
+// The screenshot's shapes did not arrive by --timeout-s: says what did and where.
+int ReportScreenshotTimeout(const ViewerOptions& options, const SessionSnapshot& snap,
+                            const SessionReceiver& receiver, double elapsed) {
+  std::fprintf(stderr,
+               "snapthread-viewer: timeout after %.1f s: received %lld of %d shapes on "
+               "%s at %s (%lld bad messages%s%s). Is a server publishing with --session %s?\n",
+               elapsed, static_cast<long long>(snap.shapes_received), options.after_shapes,
+               receiver.shape_channel().c_str(), options.lcm_url.c_str(),
+               static_cast<long long>(snap.bad_messages), receiver.last_error().empty() ? "" : ", last: ",
+               receiver.last_error().c_str(), options.common.session.c_str());
+  return kExitTimeout;
+}
+
+// What a window (not a screenshot) saw, against the server's shape numbering.
+void PrintViewerTotals(const SessionReceiver& receiver) {
+  std::printf("snapthread-viewer: %lld shapes, %lld bad messages\n",
+              static_cast<long long>(receiver.shapes_received()),
+              static_cast<long long>(receiver.bad_messages()));
+  const ShapeSequence seq = receiver.shape_sequence();
+  std::printf("snapthread-viewer: shape seq %lld..%lld: %lld received, %lld missed\n",
+              static_cast<long long>(seq.first), static_cast<long long>(seq.highest),
+              static_cast<long long>(seq.received), static_cast<long long>(seq.Missed()));
+}
+
+// What the frame loop needs besides the options.
+struct FrameLoop {
+  GLFWwindow* window;
+  Renderer* renderer;
+  SessionReceiver* receiver;
+  GraspPublisher* grasp;  // null without --grasp-mode
+  app::StopSignals* stop;
+};
+
+// Draws frames until the window closes, a stop signal, --duration-s, or the screenshot
+// (written, or timed out); returns the exit code.
+int RunFrames(const ViewerOptions& options, const FrameLoop& loop) {
+  InputState input;
+  input.grasp_mode = options.grasp_mode;
+  ConnectInput(loop.window, &input);
+  const auto start = Clock::now();
+  const bool screenshot = !options.screenshot_path.empty();
+  const double frame_period_s = 1.0 / options.max_fps;
+  while (!glfwWindowShouldClose(loop.window) && !loop.stop->Requested()) {
+    const auto frame_start = Clock::now();
+    glfwPollEvents();
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(loop.window, &w, &h);
+    if (w <= 0 || h <= 0) {  // minimised
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      continue;
+    }
+    const SessionSnapshot snap = loop.receiver->Snapshot();
+    UpdateView(snap, w, h, loop.window, loop.grasp, &input);
+    const FrameInfo info{options.common.session, options.lcm_url, options.grasp_mode, input.dragging_grasp};
+    loop.renderer->Draw(snap, input.camera, w, h, info);
+    if (screenshot && snap.has_shape && snap.shapes_received >= options.after_shapes) {
+      return WriteScreenshot(options, snap, w, h);
+    }
+    glfwSwapBuffers(loop.window);
+    const double elapsed = Seconds(start);
+    if (screenshot && options.timeout_s > 0 && elapsed > options.timeout_s) {
+      return ReportScreenshotTimeout(options, snap, *loop.receiver, elapsed);
+    }
+    if (options.duration_s > 0 && elapsed > options.duration_s) break;
+    const double spent = Seconds(frame_start);
+    if (spent < frame_period_s) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(frame_period_s - spent));
+    }
+  }
+  if (!screenshot) PrintViewerTotals(*loop.receiver);
+  return kExitOk;
+}
+
+// The renderer in the window's context, then the frame loop; returns the exit code.
+int RunWindow(const ViewerOptions& options, GLFWwindow* window, SessionReceiver* receiver,
+              GraspPublisher* grasp, app::StopSignals* stop) {
+  Renderer renderer;
+  std::string error;
+  if (!renderer.Init(&error)) {
+    std::fprintf(stderr, "snapthread-viewer: %s\n", error.c_str());
+    return kExitSetupFailed;
+  }
+  return RunFrames(options, FrameLoop{window, &renderer, receiver, grasp, stop});
+}
+
 }  // namespace
 
-int RunPrintRates(const ViewerOptions& options) {
-  const std::optional<auth::SessionKey> key = LoadViewerKey(options);
+int RunPrintRates(const ViewerOptions& options, app::StopSignals* stop) {
+  const std::optional<auth::SessionKey> key = app::LoadSessionKey(options.common, kProgram);
   if (!key) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
   if (!LcmOpened(lcm, options)) return kExitSetupFailed;
-  ChannelRateMonitor monitor(&lcm, options.session + "_.*");
+  const std::string& session = options.common.session;
+  ChannelRateMonitor monitor(&lcm, session + "_.*");
   // Checks shapes and statuses on the same LCM (handled by this loop) to count refusals.
-  SessionReceiver checked(&lcm, options.session, &*key);
+  SessionReceiver checked(&lcm, session, &*key);
   const auto start = Clock::now();
   auto last_report = start;
-  std::printf("channel rates of session %s on %s (once per second)\n", options.session.c_str(),
-              options.lcm_url.c_str());
+  std::printf("channel rates of session %s on %s (once per second)\n", session.c_str(), options.lcm_url.c_str());
   std::fflush(stdout);
-  while ((options.duration_s <= 0 || Seconds(start) < options.duration_s) && !StopRequested()) {
+  while ((options.duration_s <= 0 || Seconds(start) < options.duration_s) && !stop->Requested()) {
     lcm.handleTimeout(50);
     const double since = Seconds(last_report);
     if (since >= 1.0) {
@@ -210,156 +376,29 @@ int RunPrintRates(const ViewerOptions& options) {
   return kExitOk;
 }
 
-int RunViewer(const ViewerOptions& options) {
+int RunViewer(const ViewerOptions& options, app::StopSignals* stop) {
   std::optional<Scene> scene;
   if (options.grasp_mode) {
-    try {
-      scene = LoadScene(options.scene_path);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "snapthread-viewer: --grasp-mode needs a scene: %s\n", e.what());
-      return kExitSetupFailed;
-    }
+    scene = LoadGraspScene(options);
+    if (!scene) return kExitSetupFailed;
   }
-  const std::optional<auth::SessionKey> key = LoadViewerKey(options);
+  const std::optional<auth::SessionKey> key = app::LoadSessionKey(options.common, kProgram);
   if (!key) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
   if (!LcmOpened(lcm, options)) return kExitSetupFailed;
-  SessionReceiver receiver(&lcm, options.session, &*key);
+  SessionReceiver receiver(&lcm, options.common.session, &*key);
   // Receiving starts before the window: GL start-up takes seconds on a loaded machine, and
   // LCM drops what the shape queue cannot hold meanwhile.
   receiver.Start();
   std::unique_ptr<GraspPublisher> grasp;
   if (scene) {
-    grasp = std::make_unique<GraspPublisher>(&lcm, options.session, scene->device, &*key,
+    grasp = std::make_unique<GraspPublisher>(&lcm, options.common.session, scene->device, &*key,
                                              [&receiver] { return receiver.epoch(); });
   }
-
-  glfwSetErrorCallback(&OnGlfwError);
-  if (!glfwInit()) {
-    std::fprintf(stderr, "snapthread-viewer: cannot initialise GLFW (no $DISPLAY? use xvfb-run): %s\n",
-                 g_glfw_error.c_str());
-    return kExitSetupFailed;
-  }
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  glfwWindowHint(GLFW_SAMPLES, options.screenshot_path.empty() ? 4 : 0);
-  const std::string title = "snapthread-viewer: " + options.session;
-  GLFWwindow* window =
-      glfwCreateWindow(options.width, options.height, title.c_str(), nullptr, nullptr);
-  if (window == nullptr) {
-    std::fprintf(stderr, "snapthread-viewer: cannot create an OpenGL 3.3 core window: %s\n",
-                 g_glfw_error.c_str());
-    glfwTerminate();
-    return kExitSetupFailed;
-  }
-  glfwMakeContextCurrent(window);
-  glfwSwapInterval(1);
-  std::fprintf(stderr, "snapthread-viewer: GL %s, %s; listening on %s_SHAPE at %s\n",
-               reinterpret_cast<const char*>(glGetString(GL_VERSION)),
-               reinterpret_cast<const char*>(glGetString(GL_RENDERER)), options.session.c_str(),
-               options.lcm_url.c_str());
-
-  int exit_code = kExitOk;
-  {
-    Renderer renderer;
-    std::string error;
-    if (!renderer.Init(&error)) {
-      std::fprintf(stderr, "snapthread-viewer: %s\n", error.c_str());
-      glfwDestroyWindow(window);
-      glfwTerminate();
-      return kExitSetupFailed;
-    }
-    InputState input;
-    input.grasp_mode = options.grasp_mode;
-    glfwSetWindowUserPointer(window, &input);
-    glfwSetMouseButtonCallback(window, &OnMouseButton);
-    glfwSetCursorPosCallback(window, &OnCursor);
-    glfwSetScrollCallback(window, &OnScroll);
-    glfwSetKeyCallback(window, &OnKey);
-
-    const auto start = Clock::now();
-    const bool screenshot = !options.screenshot_path.empty();
-    const double frame_period_s = 1.0 / options.max_fps;
-    while (!glfwWindowShouldClose(window) && !StopRequested()) {
-      const auto frame_start = Clock::now();
-      glfwPollEvents();
-      int w = 0, h = 0;
-      glfwGetFramebufferSize(window, &w, &h);
-      if (w <= 0 || h <= 0) {  // minimised
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        continue;
-      }
-      SessionSnapshot snap = receiver.Snapshot();
-      if (snap.has_shape) {
-        if (!input.fitted || input.request_fit) {
-          // Planar models face the camera as drawn in the seed; a 3-D thread starts from an
-          // oblique view so its depth is visible.
-          if (!input.fitted && !IsPlanarModel(snap.shape.model)) input.camera.SetAngles(0.5, 0.35);
-          FitToShape(snap.shape, w, h, &input.camera);
-          input.fitted = true;
-          input.request_fit = false;
-        }
-        input.grasp_model =
-            Eigen::Vector3d(snap.shape.grasp[0], snap.shape.grasp[1], snap.shape.grasp[2]);
-        input.planar = IsPlanarModel(snap.shape.model);
-      }
-      if (input.scroll != 0) {
-        input.camera.Zoom(std::pow(0.9, input.scroll));
-        input.scroll = 0;
-      }
-      if (grasp && input.dragging_grasp) {
-        if (auto target = DragTarget(window, input)) grasp->Publish(*target, true);
-      }
-      FrameInfo info{options.session, options.lcm_url, options.grasp_mode, input.dragging_grasp};
-      renderer.Draw(snap, input.camera, w, h, info);
-
-      if (screenshot && snap.has_shape && snap.shapes_received >= options.after_shapes) {
-        glFinish();
-        if (!SaveScreenshot(options.screenshot_path, w, h, &error)) {
-          std::fprintf(stderr, "snapthread-viewer: screenshot failed: %s\n", error.c_str());
-          exit_code = kExitSetupFailed;
-        } else {
-          std::printf("snapthread-viewer: wrote %s (%dx%d) after %lld shapes, %lld bad messages\n",
-                      options.screenshot_path.c_str(), w, h,
-                      static_cast<long long>(snap.shapes_received),
-                      static_cast<long long>(snap.bad_messages));
-        }
-        break;
-      }
-      glfwSwapBuffers(window);
-      const double elapsed = Seconds(start);
-      if (screenshot && options.timeout_s > 0 && elapsed > options.timeout_s) {
-        std::fprintf(stderr,
-                     "snapthread-viewer: timeout after %.1f s: received %lld of %d shapes on "
-                     "%s at %s (%lld bad messages%s%s). Is a server publishing with --session %s?\n",
-                     elapsed, static_cast<long long>(snap.shapes_received), options.after_shapes,
-                     receiver.shape_channel().c_str(), options.lcm_url.c_str(),
-                     static_cast<long long>(snap.bad_messages),
-                     receiver.last_error().empty() ? "" : ", last: ",
-                     receiver.last_error().c_str(), options.session.c_str());
-        exit_code = kExitTimeout;
-        break;
-      }
-      if (options.duration_s > 0 && elapsed > options.duration_s) break;
-      const double spent = Seconds(frame_start);
-      if (spent < frame_period_s) {
-        std::this_thread::sleep_for(std::chrono::duration<double>(frame_period_s - spent));
-      }
-    }
-    if (!screenshot) {
-      std::printf("snapthread-viewer: %lld shapes, %lld bad messages\n",
-                  static_cast<long long>(receiver.shapes_received()),
-                  static_cast<long long>(receiver.bad_messages()));
-      // Against the server's numbering: what was published while this viewer listened.
-      const ShapeSequence seq = receiver.shape_sequence();
-      std::printf("snapthread-viewer: shape seq %lld..%lld: %lld received, %lld missed\n",
-                  static_cast<long long>(seq.first), static_cast<long long>(seq.highest),
-                  static_cast<long long>(seq.received), static_cast<long long>(seq.Missed()));
-    }
-    receiver.Stop();
-  }
+  GLFWwindow* window = OpenWindow(options);
+  if (window == nullptr) return kExitSetupFailed;
+  const int exit_code = RunWindow(options, window, &receiver, grasp.get(), stop);
+  receiver.Stop();
   glfwDestroyWindow(window);
   glfwTerminate();
   return exit_code;

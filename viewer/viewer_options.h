@@ -3,11 +3,13 @@
 
 #include <string>
 
+#include "app/common_flags.h"
+
 namespace snapthread::viewer {
 
 struct ViewerOptions {
-  std::string session = "SNAPTHREAD";  // channel prefix: <session>_SHAPE, ...
-  std::string lcm_url;  // resolved by messages::ResolveLcmUrl (flag, env, default)
+  app::CommonFlags common;  // --session (env SNAPTHREAD_SESSION), --lcm-url, --key
+  std::string lcm_url;      // the URL opened: app::LcmUrl(common), with a receiver's buffer
   int width = 1280;   // window size, pixels
   int height = 720;
   std::string screenshot_path;  // non-empty: headless screenshot mode
@@ -18,7 +20,6 @@ struct ViewerOptions {
   double max_fps = 60.0;        // render at most this often (the machine may be shared)
   bool grasp_mode = false;      // mouse drag of the grasp publishes device_state_t
   std::string scene_path;       // needed by grasp mode (device mapping)
-  std::string key_path;         // --key; "" = $SNAPTHREAD_KEY_FILE or the XDG default
 };
 
 }  // namespace snapthread::viewer

@@ -35,81 +35,71 @@ void ScheduleStats(asio::steady_timer* timer, Hub* hub) {
   });
 }
 
-}  // namespace
-
-int RunWeb(WebOptions o) {
-  asio::io_context io;
-  boost::system::error_code ec;
-  const asio::ip::address address = asio::ip::make_address(o.bind, ec);
-  if (ec) {
-    std::fprintf(stderr, "snapthread-web: --bind '%s' is not an IP address\n", o.bind.c_str());
-    return 1;
-  }
+// The observer token: --token-file's, checked, or a new one beyond loopback. False after
+// saying why it cannot be used.
+bool ResolveToken(const asio::ip::address& address, WebOptions* o) {
   // Beyond loopback the page is for the observers holding the token only (observer_token.h).
   try {
-    if (!o.token_file.empty()) o.token = LoadTokenFile(o.token_file);
+    if (!o->token_file.empty()) o->token = LoadTokenFile(o->token_file);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "snapthread-web: %s\n", e.what());
-    return 1;
+    return false;
   }
-  if (!o.token.empty()) {
-    if (const std::string problem = TokenProblem(o.token); !problem.empty()) {
+  if (!o->token.empty()) {
+    if (const std::string problem = TokenProblem(o->token); !problem.empty()) {
       std::fprintf(stderr, "snapthread-web: bad --token: %s\n", problem.c_str());
-      return 1;
+      return false;
     }
   }
-  if (!address.is_loopback() && o.token.empty()) o.token = GenerateObserverToken();
+  if (!address.is_loopback() && o->token.empty()) o->token = GenerateObserverToken();
+  return true;
+}
 
+// The hub and the feed that publishes to it: a replay of --log, or the live session. The
+// feed's callbacks hold this object's address: it stays where it is while they run.
+struct Feeds {
   std::unique_ptr<LiveFeed> live;
   std::unique_ptr<ReplayFeed> replay;
   std::optional<auth::SessionKey> key;
   std::shared_ptr<Hub> hub;
-  std::shared_ptr<const PageFiles> files;
-  try {
-    files = std::make_shared<const PageFiles>(o.page_dir);
-    if (!o.log_path.empty()) {
-      // Set below, once the hub exists: the feed publishes to it.
-      replay = std::make_unique<ReplayFeed>(o.log_path, o.session,
-                                            [&hub](FeedKind k, Text t) { hub->Publish(k, std::move(t)); });
-      hub = std::make_shared<Hub>(io, "replay", replay->session(), [&replay] { return replay->counts(); });
-      hub->SetCommandHandler([&replay](const std::string& c) { return replay->Command(c); });
-      const ReplayPosition p = replay->position();
-      // The log's session name is the log's text: shown escaped.
-      std::printf("snapthread-web: replaying %s: session %s, %lld shapes over %.1f s (last seq %lld)\n",
-                  o.log_path.c_str(), messages::EscapeForDisplay(replay->session()).c_str(), static_cast<long long>(p.shape_count),
-                  p.duration_s, static_cast<long long>(p.last_seq));
-    } else {
-      key.emplace(auth::LoadKey(auth::ResolveKeyPath(o.key_path)));
-      hub = std::make_shared<Hub>(io, "live", o.session, [&live] { return live->counts(); });
-      live = std::make_unique<LiveFeed>(o.lcm_url, o.session, *key,
-                                        [&hub](FeedKind k, Text t) { hub->Publish(k, std::move(t)); });
-    }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "snapthread-web: %s\n", e.what());
-    return 1;
-  }
+  const std::string& session(const WebOptions& o) const { return replay ? replay->session() : o.common.session; }
+};
 
-  std::optional<HttpServer> server;
-  try {
-    server.emplace(io, asio::ip::tcp::endpoint(address, static_cast<unsigned short>(o.port)),
-                   ServeConfig{hub, files, AccessConfig{o.token, o.host_names, 0}, o.max_rate_hz,
-                               o.max_pages});
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "snapthread-web: %s\n", e.what());
-    return 1;
+// Opens the feed of `o` into `f`; throws with the reason when it cannot.
+void OpenFeeds(asio::io_context& io, const WebOptions& o, Feeds* f) {
+  auto publish = [f](FeedKind k, Text t) { f->hub->Publish(k, std::move(t)); };
+  if (!o.log_path.empty()) {
+    // The hub is set below, once it exists: the feed publishes to it.
+    f->replay = std::make_unique<ReplayFeed>(o.log_path, o.common.session, publish);
+    f->hub = std::make_shared<Hub>(io, "replay", f->replay->session(), [f] { return f->replay->counts(); });
+    f->hub->SetCommandHandler([f](const std::string& c) { return f->replay->Command(c); });
+    const ReplayPosition p = f->replay->position();
+    // The log's session name is the log's text: shown escaped.
+    std::printf("snapthread-web: replaying %s: session %s, %lld shapes over %.1f s (last seq %lld)\n",
+                o.log_path.c_str(), messages::EscapeForDisplay(f->replay->session()).c_str(),
+                static_cast<long long>(p.shape_count), p.duration_s, static_cast<long long>(p.last_seq));
+  } else {
+    f->key.emplace(auth::LoadKey(auth::ResolveKeyPath(o.common.key_path)));
+    f->hub = std::make_shared<Hub>(io, "live", o.common.session, [f] { return f->live->counts(); });
+    f->live = std::make_unique<LiveFeed>(o.lcm_url, o.common.session, *f->key, publish);
   }
-  // The one place the token is printed: in the URL for the operator to open (the page then
-  // moves it into a cookie and out of the address bar). With --host-name, the URL names
-  // the first, as browsers on other machines reach the bridge by it.
+}
+
+// The one place the token is printed: in the URL for the operator to open (the page then
+// moves it into a cookie and out of the address bar). With --host-name, the URL names
+// the first, as browsers on other machines reach the bridge by it.
+void PrintPageUrl(const WebOptions& o, const asio::ip::address& address, const Feeds& feeds, unsigned port) {
   const std::string host = !o.host_names.empty() ? o.host_names.front()
                            : address.is_v6()     ? "[" + o.bind + "]"
                                                  : o.bind;
   std::printf("snapthread-web: serving %s of session %s at http://%s:%u/%s\n",
-              replay ? "a replay" : "the live view",
-              messages::EscapeForDisplay(replay ? replay->session() : o.session).c_str(),
-              host.c_str(), server->port(), o.token.empty() ? "" : ("?token=" + o.token).c_str());
+              feeds.replay ? "a replay" : "the live view", messages::EscapeForDisplay(feeds.session(o)).c_str(),
+              host.c_str(), port, o.token.empty() ? "" : ("?token=" + o.token).c_str());
   std::fflush(stdout);
+}
 
+// Serves until SIGINT / SIGTERM or --duration-s, then stops the feeds.
+void Serve(asio::io_context& io, const WebOptions& o, HttpServer* server, Feeds* feeds) {
   asio::signal_set signals(io, SIGINT, SIGTERM);
   asio::steady_timer stats(io);
   asio::steady_timer deadline(io);
@@ -125,14 +115,47 @@ int RunWeb(WebOptions o) {
       if (!e) stop();
     });
   }
-  ScheduleStats(&stats, hub.get());
+  ScheduleStats(&stats, feeds->hub.get());
   server->Start();
-  if (live) live->Start();
-  if (replay) replay->Start();
+  if (feeds->live) feeds->live->Start();
+  if (feeds->replay) feeds->replay->Start();
   io.run();
   // The feeds stop before the hub and the io_context go (they post to both).
-  if (live) live->Stop();
-  if (replay) replay->Stop();
+  if (feeds->live) feeds->live->Stop();
+  if (feeds->replay) feeds->replay->Stop();
+}
+
+}  // namespace
+
+int RunWeb(WebOptions o) {
+  asio::io_context io;
+  boost::system::error_code ec;
+  const asio::ip::address address = asio::ip::make_address(o.bind, ec);
+  if (ec) {
+    std::fprintf(stderr, "snapthread-web: --bind '%s' is not an IP address\n", o.bind.c_str());
+    return 1;
+  }
+  if (!ResolveToken(address, &o)) return 1;
+  Feeds feeds;
+  std::shared_ptr<const PageFiles> files;
+  std::optional<HttpServer> server;
+  try {
+    files = std::make_shared<const PageFiles>(o.page_dir);
+    OpenFeeds(io, o, &feeds);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-web: %s\n", e.what());
+    return 1;
+  }
+  try {
+    server.emplace(io, asio::ip::tcp::endpoint(address, static_cast<unsigned short>(o.port)),
+                   ServeConfig{feeds.hub, files, AccessConfig{o.token, o.host_names, 0}, o.max_rate_hz,
+                               o.max_pages});
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snapthread-web: %s\n", e.what());
+    return 1;
+  }
+  PrintPageUrl(o, address, feeds, server->port());
+  Serve(io, o, &*server, &feeds);
   std::printf("snapthread-web: stopped\n");
   return 0;
 }

@@ -4,12 +4,13 @@
 #include <string>
 #include <vector>
 
+#include "app/common_flags.h"
+
 namespace snapthread::web {
 
 struct WebOptions {
-  std::string session = "SNAPTHREAD";  // channel prefix (env SNAPTHREAD_SESSION)
-  std::string lcm_url;                 // resolved already (flag, environment, default)
-  std::string key_path;                // --key ("" = SNAPTHREAD_KEY_FILE, then the default)
+  app::CommonFlags common;             // --session (env SNAPTHREAD_SESSION; "" in replay: the log's), --lcm-url, --key
+  std::string lcm_url;                 // the URL opened: app::LcmUrl(common)
   std::string bind = "127.0.0.1";      // listen address
   int port = 7000;                     // 0: the kernel picks one (printed)
   std::string token;                   // observer token ("" = generated when not loopback)

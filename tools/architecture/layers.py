@@ -42,6 +42,8 @@ FORBIDDEN = [
     # The browser bridge only observes: it never solves.
     ("snapthread-web", {"solvers", "linalg", "tracking", "CHOLMOD"}),
     ("web_core", {"solvers", "linalg", "tracking", "CHOLMOD", "Boost.Beast (asio)"}),
+    # The programs' common flags, signals and exit codes: no physics, no window, no server.
+    ("app", {"solvers", "linalg", "tracking", "CHOLMOD", "OpenGL (glfw, epoxy)", "Boost.Beast (asio)"}),
 ]
 
 

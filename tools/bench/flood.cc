@@ -14,22 +14,15 @@
 #include <sstream>
 #include <thread>
 
-#include "auth/key_file.h"
 #include "bench_support.h"
 #include "flood_forger.h"
+#include "realtime/percentiles.h"
 
 namespace snapthread {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto k = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size()))) ;
-  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
-}
 
 // The device's --trace (device_client.cc: t_s, seq = tick, x, y, z, fx, fy, fz,
 // model_age_ms, model_status, clamped, fading, ...) over [skip_s, end - kTailSeconds]: the
@@ -71,9 +64,13 @@ bool ReadTrace(const std::string& path, double skip_s, FloodRun* run) {
   if (counted < 2 || (*last)[0] <= (*first)[0]) return false;
   // Ticks (the trace's seq column) over time: the servo's steady rate in the window.
   run->window_tick_rate_hz = ((*last)[1] - (*first)[1]) / ((*last)[0] - (*first)[0]);
-  run->model_age_ms_p50 = Percentile(ages, 0.50);
-  run->model_age_ms_p99 = Percentile(ages, 0.99);
-  run->model_age_ms_max = ages.empty() ? 0.0 : *std::max_element(ages.begin(), ages.end());
+  // Nearest-rank percentiles, as the device's own lateness figures.
+  realtime::SampleWindow window(std::max<size_t>(1, ages.size()));
+  for (const double age : ages) window.Push(age);
+  const realtime::PercentileSummary age = window.Compute();
+  run->model_age_ms_p50 = age.p50;
+  run->model_age_ms_p99 = age.p99;
+  run->model_age_ms_max = age.max;
   // A tick without any model yet counts as fading: it renders nothing.
   run->fading_fraction = static_cast<double>(fading + (counted - static_cast<long>(ages.size()))) / counted;
   return true;
@@ -85,50 +82,18 @@ FloodRun RunFloodOnce(const FloodBenchOptions& o, bool flood, int repetition) {
   FloodRun run;
   run.repetition = repetition;
   run.flood = flood;
-  const std::string server_bin = o.bin_dir + "/snapthread-server";
-  const std::string device_bin = o.bin_dir + "/snapthread-device";
-  for (const auto& b : {server_bin, device_bin})
-    if (access(b.c_str(), X_OK) != 0) {
-      run.error = b + " missing (build snapthread-server and snapthread-device)";
-      return run;
-    }
-  const std::string scene_file = o.scenes_dir + "/" + o.scene + ".yaml";
-  const std::string session =
-      "FLOOD_" + std::to_string(getpid()) + "_" + std::to_string(repetition) + (flood ? "F" : "Q");
-  fs::create_directories(o.work_dir);
-  const std::string base = o.work_dir + "/" + session;
-  const std::string key_path = base + ".key";
-  try {
-    auth::WriteNewKey(auth::KeyLocation{key_path, "bench"}, /*overwrite=*/true);
-  } catch (const std::exception& e) {
-    run.error = std::string("cannot make a session key: ") + e.what();
-    return run;
-  }
-  char duration[32], safety[32];
-  std::snprintf(duration, sizeof duration, "%g", o.duration_s);
-  std::snprintf(safety, sizeof safety, "%g", o.duration_s + 60.0);  // a safety net only
-  const pid_t server = Spawn({server_bin, "--key", key_path, "--scene", scene_file, "--session", session, "--lcm-url",
-                              o.lcm_url, "--duration", safety, "--log-level", "info", "--summary",
-                              base + "_server.json"},
-                             base + "_server.log");
-  if (server < 0) {
-    run.error = "cannot start the server";
-    return run;
-  }
-  bool up = false;
-  for (int k = 0; k < 300 && !up; ++k) {
-    up = ReadFile(base + "_server.log").find("server: session") != std::string::npos;
-    if (!up) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  if (!up) {
-    kill(server, SIGTERM);
-    WaitFor(server, 10);
-    run.error = "the server did not start within 15 s (see " + base + "_server.log)";
-    return run;
-  }
+  ServiceSession s;
+  s.session = "FLOOD_" + std::to_string(getpid()) + "_" + std::to_string(repetition) + (flood ? "F" : "Q");
+  s.lcm_url = o.lcm_url;
+  s.duration_s = o.duration_s;
+  if (!PrepareServiceSession(o.bin_dir, o.scenes_dir, o.scene, o.work_dir, &s, &run.error)) return run;
+  s.key_path = s.base + ".key";
+  if (!WriteSessionKey(s.key_path, &run.error)) return run;
+  const pid_t server = StartServer(s, &run.error);
+  if (server < 0) return run;
   flood::ForgerOptions forger_options;
   forger_options.lcm_url = o.lcm_url;
-  forger_options.session = session;
+  forger_options.session = s.session;
   forger_options.rate_per_channel_hz = o.rate_per_channel_hz;
   flood::ForgedFlood forger(forger_options);
   std::string flood_error;
@@ -138,22 +103,16 @@ FloodRun RunFloodOnce(const FloodBenchOptions& o, bool flood, int repetition) {
     run.error = "flood: " + flood_error;
     return run;
   }
-  std::vector<std::string> device_args = {device_bin, "--key", key_path, "--backend", "virtual-hand", "--scene",
-                                          scene_file, "--session", session, "--lcm-url", o.lcm_url, "--duration",
-                                          duration, "--rate-hz", "1000", "--publish-divisor", "1", "--summary",
-                                          base + "_device.json", "--trace", base + "_trace.csv"};
+  std::vector<std::string> device_args = DeviceArgs(s);
+  device_args.insert(device_args.end(), {"--trace", s.base + "_trace.csv"});
   if (!o.realtime) device_args.push_back("--no-rt");
-  const pid_t device = Spawn(device_args, base + "_device.log");
+  const pid_t device = Spawn(device_args, s.base + "_device.log");
   const int device_rc = device < 0 ? -1 : WaitFor(device, o.duration_s + 30.0);
   forger.Stop();
   run.flood_rate_per_channel_hz = forger.AchievedRatePerChannel();
-  kill(server, SIGTERM);
-  const int server_rc = WaitFor(server, 20.0);
-  if (device_rc != 0 || server_rc != 0) {
-    run.error = "device exit " + std::to_string(device_rc) + ", server exit " + std::to_string(server_rc) +
-                " (logs " + base + "_*.log)";
-    return run;
-  }
+  run.error = StopServer(server, device_rc, s);
+  if (!run.error.empty()) return run;
+  const std::string& base = s.base;
   const std::string dev = ReadFile(base + "_device.json");
   const std::string srv = ReadFile(base + "_server.json");
   const bool ok = JsonNumber(dev, "tick_rate_hz", &run.tick_rate_hz) &&

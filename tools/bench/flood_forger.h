@@ -21,8 +21,10 @@ namespace snapthread::flood {
 
 struct ForgerOptions {
   std::string lcm_url;
-  std::string session;
+  std::string session;  // the genuine session whose channels are flooded
   double rate_per_channel_hz = 10000.0;
+  // What the forged messages carry: a force model asking for this many newtons along +z,
+  // and shapes of this many nodes.
   double forged_force_n = 1000.0;
   int forged_shape_nodes = 20;
   // Forged epoch and auth_seq: anything; the MAC check comes first and refuses them.

@@ -83,75 +83,103 @@ int WaitFor(pid_t pid, double timeout_s) {
   }
 }
 
+bool PrepareServiceSession(const std::string& bin_dir, const std::string& scenes_dir, const std::string& scene,
+                           const std::string& work_dir, ServiceSession* s, std::string* error) {
+  s->server_bin = bin_dir + "/snapthread-server";
+  s->device_bin = bin_dir + "/snapthread-device";
+  for (const auto& b : {s->server_bin, s->device_bin})
+    if (access(b.c_str(), X_OK) != 0) {
+      *error = b + " missing (build snapthread-server and snapthread-device)";
+      return false;
+    }
+  s->scene_file = scenes_dir + "/" + scene + ".yaml";
+  fs::create_directories(work_dir);
+  s->base = work_dir + "/" + s->session;
+  return true;
+}
+
+bool WriteSessionKey(const std::string& path, std::string* error) {
+  try {
+    auth::WriteNewKey(auth::KeyLocation{path, "bench"}, /*overwrite=*/true);
+  } catch (const std::exception& e) {
+    *error = std::string("cannot make a session key: ") + e.what();
+    return false;
+  }
+  return true;
+}
+
+namespace {
+std::string NumberArg(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+}  // namespace
+
+pid_t StartServer(const ServiceSession& s, std::string* error) {
+  const pid_t server = Spawn({s.server_bin, "--key", s.key_path, "--scene", s.scene_file, "--session", s.session,
+                              "--lcm-url", s.lcm_url, "--duration", NumberArg(s.duration_s + 60.0), "--log-level",
+                              "info", "--summary", s.base + "_server.json"},
+                             s.base + "_server.log");
+  if (server < 0) {
+    *error = "cannot start the server";
+    return -1;
+  }
+  // The server logs its session line once it has loaded the scene and subscribed.
+  for (int k = 0; k < 300; ++k) {
+    if (ReadFile(s.base + "_server.log").find("server: session") != std::string::npos) return server;
+    int status = 0;
+    if (waitpid(server, &status, WNOHANG) == server) {
+      *error = "the server exited at start (see " + s.base + "_server.log)";
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  kill(server, SIGTERM);
+  WaitFor(server, 10);
+  *error = "the server did not start within 15 s (see " + s.base + "_server.log)";
+  return -1;
+}
+
+std::vector<std::string> DeviceArgs(const ServiceSession& s) {
+  return {s.device_bin, "--key",  s.key_path, "--backend", "virtual-hand", "--scene", s.scene_file, "--session",
+          s.session,    "--lcm-url", s.lcm_url, "--duration", NumberArg(s.duration_s), "--rate-hz", "1000",
+          "--publish-divisor", "1", "--summary", s.base + "_device.json"};
+}
+
+std::string StopServer(pid_t server, int device_rc, const ServiceSession& s) {
+  kill(server, SIGTERM);
+  const int server_rc = WaitFor(server, 20.0);
+  if (device_rc == 0 && server_rc == 0) return "";
+  return "device exit " + std::to_string(device_rc) + ", server exit " + std::to_string(server_rc) + " (logs " +
+         s.base + "_*.log)";
+}
+
 ServiceRun RunServiceOnce(const ServiceOptions& o, const std::string& scene, int index) {
   ServiceRun run;
   run.scene = scene;
-  const std::string server_bin = o.bin_dir + "/snapthread-server";
-  const std::string device_bin = o.bin_dir + "/snapthread-device";
-  for (const auto& b : {server_bin, device_bin})
-    if (access(b.c_str(), X_OK) != 0) {
-      run.error = b + " missing (build snapthread-server and snapthread-device)";
-      return run;
-    }
-  const std::string scene_file = o.scenes_dir + "/" + scene + ".yaml";
-  const std::string session = "BENCH_" + std::to_string(getpid()) + "_" + std::to_string(index);
-  fs::create_directories(o.work_dir);
-  const std::string base = o.work_dir + "/" + session;
+  ServiceSession s;
+  s.session = "BENCH_" + std::to_string(getpid()) + "_" + std::to_string(index);
+  s.lcm_url = o.lcm_url;
+  s.duration_s = o.duration_s;
+  if (!PrepareServiceSession(o.bin_dir, o.scenes_dir, scene, o.work_dir, &s, &run.error)) return run;
   // The session key both binaries sign with: $SNAPTHREAD_KEY_FILE when set, else a new
   // one for this run (mode 0600) next to its logs.
-  std::string key_path;
   if (const char* env = std::getenv(auth::kKeyFileEnv); env != nullptr && *env != '\0') {
-    key_path = env;
+    s.key_path = env;
   } else {
-    key_path = base + ".key";
-    try {
-      auth::WriteNewKey(auth::KeyLocation{key_path, "bench"}, /*overwrite=*/true);
-    } catch (const std::exception& e) {
-      run.error = std::string("cannot make a session key: ") + e.what();
-      return run;
-    }
+    s.key_path = s.base + ".key";
+    if (!WriteSessionKey(s.key_path, &run.error)) return run;
   }
-  char duration[32], safety[32];
-  std::snprintf(duration, sizeof duration, "%g", o.duration_s);
-  std::snprintf(safety, sizeof safety, "%g", o.duration_s + 60.0);  // a safety net only
-  const pid_t server =
-      Spawn({server_bin, "--key", key_path, "--scene", scene_file, "--session", session, "--lcm-url", o.lcm_url, "--duration", safety,
-             "--log-level", "info", "--summary", base + "_server.json"},
-            base + "_server.log");
-  if (server < 0) {
-    run.error = "cannot start the server";
-    return run;
-  }
-  // The server logs its session line once it has loaded the scene and subscribed.
-  bool up = false;
-  for (int k = 0; k < 300 && !up; ++k) {
-    up = ReadFile(base + "_server.log").find("server: session") != std::string::npos;
-    int status = 0;
-    if (!up && waitpid(server, &status, WNOHANG) == server) {
-      run.error = "the server exited at start (see " + base + "_server.log)";
-      return run;
-    }
-    if (!up) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  if (!up) {
-    kill(server, SIGTERM);
-    WaitFor(server, 10);
-    run.error = "the server did not start within 15 s (see " + base + "_server.log)";
-    return run;
-  }
-  const pid_t device =
-      Spawn({device_bin, "--key", key_path, "--backend", "virtual-hand", "--scene", scene_file, "--session", session, "--lcm-url",
-             o.lcm_url, "--duration", duration, "--rate-hz", "1000", "--publish-divisor", "1", "--no-rt",
-             "--summary", base + "_device.json"},
-            base + "_device.log");
-  int device_rc = device < 0 ? -1 : WaitFor(device, o.duration_s + 30.0);
-  kill(server, SIGTERM);
-  const int server_rc = WaitFor(server, 20.0);
-  if (device_rc != 0 || server_rc != 0) {
-    run.error = "device exit " + std::to_string(device_rc) + ", server exit " + std::to_string(server_rc) + " (logs " +
-                base + "_*.log)";
-    return run;
-  }
+  const pid_t server = StartServer(s, &run.error);
+  if (server < 0) return run;
+  std::vector<std::string> device_args = DeviceArgs(s);
+  device_args.push_back("--no-rt");
+  const pid_t device = Spawn(device_args, s.base + "_device.log");
+  const int device_rc = device < 0 ? -1 : WaitFor(device, o.duration_s + 30.0);
+  run.error = StopServer(server, device_rc, s);
+  if (!run.error.empty()) return run;
+  const std::string& base = s.base;
   const std::string dev = ReadFile(base + "_device.json");
   const std::string srv = ReadFile(base + "_server.json");
   const bool ok = JsonNumber(dev, "round_trip_us_p50", &run.round_trip_us_p50) &&

@@ -29,12 +29,9 @@ class SequenceTracker {
   const std::vector<SequenceGap>& gaps() const { return gaps_; }  // first kMaxListedGaps
 
  private:
-  int64_t received_ = 0;
-  int64_t first_ = 0;
-  int64_t highest_ = 0;
-  int64_t missing_ = 0;
-  int64_t gap_count_ = 0;
-  int64_t out_of_order_ = 0;
+  int64_t received_ = 0, out_of_order_ = 0;
+  int64_t first_ = 0, highest_ = 0;  // sequence numbers
+  int64_t missing_ = 0, gap_count_ = 0;
   std::vector<SequenceGap> gaps_;
 };
 

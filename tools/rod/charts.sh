@@ -7,13 +7,8 @@
 # usage: tools/rod/charts.sh [BUILD_BIN_DIR] [OUT_DIR]   (gnuplot from Debian's gnuplot-nox)
 set -eu
 here=$(cd "$(dirname "$0")/../.." && pwd)
-bin=${1:-$here/build/bin}
-out=${2:-$here/docs/images}
-mkdir -p "$out"
-out=$(cd "$out" && pwd)
-bin=$(cd "$bin" && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. "$here/tools/chart_support.sh"
+chart_setup "$@"
 sweep="$bin/snapthread-sweep"
 
 # The first unstable row (a negative pivot, lambda_min < 0, or probe > 1e-4): Φ_c in rad.

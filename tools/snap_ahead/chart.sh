@@ -8,12 +8,8 @@
 # usage: tools/snap_ahead/chart.sh [BUILD_BIN_DIR] [OUT_DIR]   (gnuplot from gnuplot-nox)
 set -eu
 here=$(cd "$(dirname "$0")/../.." && pwd)
-bin=${1:-$here/build/bin}
-out=${2:-$here/docs/images}
-mkdir -p "$out"
-out=$(cd "$out" && pwd)
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. "$here/tools/chart_support.sh"
+chart_setup "$@"
 "$bin/snapthread-snap-ahead-chart" --scene "$here/scenes/curve2d_snap.yaml" \
   --scene "$here/scenes/thread3d_loop.yaml" --rates-hz 1000,300,100,30 --out "$work/chart.csv"
 cp "$work/chart.csv" "$here/docs/snap_ahead.csv"
