@@ -75,7 +75,7 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
 }
 
 void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out,
-                   const GraspLayout& layout, int num_grasps) {
+                   const GraspLayout& layout, int num_grasps, int digits) {
   const bool rotation = layout.grip_rotation;
   out << "step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,"
          "solve_us,status,termination,gradient_evals,hessian_evals"
@@ -87,7 +87,7 @@ void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method,
   }
   out << '\n';
   const int m = layout.NumControls();
-  out << std::setprecision(12);
+  out << std::setprecision(digits);
   for (const SweepRow& r : rows) {
     auto comp = [](const Vec& v, int i) { return i < v.size() ? v[i] : 0.0; };
     const bool planar = r.u.size() == 2;
@@ -95,7 +95,7 @@ void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method,
         << comp(r.force, 0) << ',' << comp(r.force, 1) << ',' << (planar ? 0.0 : comp(r.force, 2)) << ','
         << r.probe << ',' << r.energy << ',' << r.residual << ',' << r.iterations << ',' << method
         << ',' << r.lambda_min << ',' << (r.snapped ? 1 : 0) << ',' << std::setprecision(4) << r.solve_us
-        << std::setprecision(12) << ',' << ToString(r.status) << ',' << ToString(r.termination) << ','
+        << std::setprecision(digits) << ',' << ToString(r.status) << ',' << ToString(r.termination) << ','
         << r.gradient_evaluations << ',' << r.hessian_evaluations;
     if (rotation) {
       out << ',' << comp(r.u, 3) * 180.0 / std::numbers::pi << ',' << r.torque.x() << ',' << r.torque.y()
@@ -109,8 +109,8 @@ void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method,
   }
 }
 
-void WriteShapeCsv(const std::vector<SweepRow>& rows, const Model& model, std::ostream& out) {
-  out << "step,node,x,y,z\n" << std::setprecision(9);
+void WriteShapeCsv(const std::vector<SweepRow>& rows, const Model& model, std::ostream& out, int digits) {
+  out << "step,node,x,y,z\n" << std::setprecision(digits);
   Eigen::Matrix3Xd nodes;
   for (const SweepRow& r : rows) {
     model.NodePositions(r.state, r.u, &nodes);

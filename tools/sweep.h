@@ -54,11 +54,13 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
 // about the grasp point, world frame) and negative_pivots (the inertia of E_xx: an unstable equilibrium has > 0).
 // A scene with several grasps keeps those columns for its first grasp and adds, at the
 // end, u2_x,u2_y,u2_z,f2_x,f2_y,f2_z for the second (u3_*, f3_* for a third, ...).
+// `digits`: significant digits of every number but solve_us (17 writes each double exactly).
 void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out,
-                   const GraspLayout& layout = {}, int num_grasps = 1);
+                   const GraspLayout& layout = {}, int num_grasps = 1, int digits = 12);
 
 // Node positions of every row (Model::NodePositions): step,node,x,y,z, for drawing.
-void WriteShapeCsv(const std::vector<SweepRow>& rows, const Model& model, std::ostream& out);
+void WriteShapeCsv(const std::vector<SweepRow>& rows, const Model& model, std::ostream& out,
+                   int digits = 9);
 
 // Line colour of a registered method in the gnuplot charts (by registration order).
 const char* MethodColor(std::string_view method);

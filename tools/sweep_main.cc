@@ -41,6 +41,10 @@ int main(int argc, char** argv) {
   std::string shape_file;
   app.add_option("--shape-out,--shapes-out", shape_file,
                  "also write every row's node positions (step,node,x,y,z) to this CSV");
+  bool exact = false;
+  app.add_flag("--exact", exact,
+               "write every number but solve_us with 17 significant digits (each double exactly: "
+               "tools/same_bits/check.sh compares runs bit for bit)");
   // The models a scene may name, with their parameters (--set params.<name>=...).
   app.footer("Models (scene key `model:`):\n" + ModelHelp());
   const auto run = [&]() -> int {
@@ -86,14 +90,16 @@ int main(int argc, char** argv) {
     if (!shape_file.empty()) {
       std::ofstream shapes(shape_file);
       if (!shapes) throw std::runtime_error("--shape-out: cannot write '" + shape_file + "'");
-      WriteShapeCsv(rows, tracker->model(), shapes);
+      WriteShapeCsv(rows, tracker->model(), shapes, exact ? 17 : 9);
     }
+    const int grasps = std::max<int>(1, static_cast<int>(scene.grasps.size()));
+    const int digits = exact ? 17 : 12;
     if (out_file.empty()) {
-      WriteSweepCsv(rows, scene.solver.method, std::cout, scene.grasp_layout, std::max<int>(1, static_cast<int>(scene.grasps.size())));
+      WriteSweepCsv(rows, scene.solver.method, std::cout, scene.grasp_layout, grasps, digits);
     } else {
       std::ofstream out(out_file);
       if (!out) throw std::runtime_error("--out: cannot write '" + out_file + "'");
-      WriteSweepCsv(rows, scene.solver.method, out, scene.grasp_layout, std::max<int>(1, static_cast<int>(scene.grasps.size())));
+      WriteSweepCsv(rows, scene.solver.method, out, scene.grasp_layout, grasps, digits);
     }
     return 0;
   };
