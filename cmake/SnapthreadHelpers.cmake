@@ -29,6 +29,31 @@ function(snapthread_add_test name)
     DISCOVERY_TIMEOUT 60)
 endfunction()
 
+# snapthread_add_process_test(NAME SOURCES a.cc ... [LIBS x y] [LABELS l] [TIMEOUT s] [SERIAL]
+#                             PROGRAMS snapthread-server ...)
+# A test that runs the project's programs as child processes (tests/support: ChildProcess,
+# SessionKeyFile, the binaries' folder): snapthread_add_test with snapthread::test_support
+# linked, label `process` and a 120 s timeout unless given, and each of PROGRAMS built
+# before the test.
+function(snapthread_add_process_test name)
+  cmake_parse_arguments(ARG "SERIAL" "TIMEOUT" "SOURCES;LIBS;LABELS;PROGRAMS" ${ARGN})
+  if(NOT ARG_LABELS)
+    set(ARG_LABELS process)
+  endif()
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 120)
+  endif()
+  set(_serial "")
+  if(ARG_SERIAL)
+    set(_serial SERIAL)
+  endif()
+  snapthread_add_test(${name} SOURCES ${ARG_SOURCES} LIBS ${ARG_LIBS} snapthread::test_support
+                      LABELS ${ARG_LABELS} TIMEOUT ${ARG_TIMEOUT} ${_serial})
+  if(ARG_PROGRAMS)
+    add_dependencies(${name} ${ARG_PROGRAMS})
+  endif()
+endfunction()
+
 # The one warnings target: strict warnings as errors on the project's own code only
 # (third-party headers come in as SYSTEM includes and are not affected).
 if(NOT TARGET snapthread_warnings)

@@ -15,6 +15,7 @@
 #include <Eigen/SparseCore>
 
 #include "allocation_counter.h"
+#include "band_check.h"
 #include "linalg/banded_ldlt.h"
 #include "linalg/linear_solver.h"
 #include "models/models.h"
@@ -167,42 +168,18 @@ TEST(ModelBandAssembly, ChainsWriteHessiansValuesIntoTheBand) {
     }
     Vec x = m.InitialState(u);
     for (int i = 0; i < x.size(); ++i) x[i] += noise(rng);
-    SparseMatrix h = m.HessianPattern();
-    Vec g;
-    m.Hessian(x, u, &h);
-    m.Gradient(x, u, &g);
-    const double e = m.Energy(x, u);
+    const test_support::SeparateValues separate = test_support::EvaluateSeparately(m, x, u);
     const int b = m.HessianBandwidth();
-    const int n = m.NumStates();
-    std::vector<double> band(static_cast<size_t>(n) * (b + 1), std::numeric_limits<double>::quiet_NaN());
-    Vec g4;
-    double e4 = 0.0;
-    const BandAssemblyCapability* assembly = m.band_assembly();
-    const bool banded = assembly != nullptr && assembly->EnergyGradientAndBandHessian(x, u, &g4, band.data(), b, &e4);
-    ASSERT_EQ(banded, c.banded) << c.model << (c.contact ? " with contact" : "");
-    if (!banded) {
-      for (double v : band) EXPECT_TRUE(std::isnan(v)) << c.model << ": a declining model wrote the band";
+    const test_support::BandAssembly fused = test_support::AssembleBand(m, x, u, b);
+    ASSERT_EQ(fused.written, c.banded) << c.model << (c.contact ? " with contact" : "");
+    if (!fused.written) {
+      EXPECT_TRUE(fused.Untouched()) << c.model << ": a declining model wrote the band";
       continue;
     }
-    EXPECT_EQ(std::memcmp(&e, &e4, sizeof e), 0) << c.model << ": E " << e << " vs " << e4;
-    ASSERT_EQ(g4.size(), g.size());
-    EXPECT_EQ(std::memcmp(g.data(), g4.data(), sizeof(double) * g.size()), 0) << c.model << ": E_x";
-    std::vector<char> in_pattern(band.size(), 0);
-    for (int j = 0; j < n; ++j) {
-      for (SparseMatrix::InnerIterator it(h, j); it; ++it) {
-        if (it.row() < j) continue;
-        const size_t slot = static_cast<size_t>(it.row()) * (b + 1) + j - it.row() + b;
-        in_pattern[slot] = 1;
-        const double v = it.value();
-        EXPECT_EQ(band[slot], v) << c.model << ": E_xx(" << it.row() << ", " << j << ")";
-      }
-    }
-    for (size_t k = 0; k < band.size(); ++k) {
-      if (!in_pattern[k]) {
-        EXPECT_EQ(band[k], 0.0) << c.model << ": slot " << k << " outside the pattern";
-      }
-    }
-    EXPECT_FALSE(assembly->EnergyGradientAndBandHessian(x, u, &g4, band.data(), b + 1, &e4)) << c.model;
+    test_support::ExpectBandHoldsSeparateValues(fused, b, separate, c.model);
+    const test_support::BandAssembly wider = test_support::AssembleBand(m, x, u, b + 1);
+    EXPECT_FALSE(wider.written) << c.model;
+    EXPECT_TRUE(wider.Untouched()) << c.model << ": a declining model wrote the band";
   }
 }
 

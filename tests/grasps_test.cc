@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include "finite_difference.h"
 #include "models/rod_model.h"
+#include "rod_fixtures.h"
 #include "scene/scene.h"
 #include "sweep.h"
 #include "test_util.h"
@@ -16,25 +18,8 @@ namespace {
 
 using V3 = Eigen::Vector3d;
 
-RodParams FreeParams(int n) {
-  RodParams p;
-  p.n = n;
-  p.length = 1.1;
-  p.stretch_stiffness = 60.0;
-  p.bend_stiffness = 1.0;
-  p.bend_stiffness_2 = 1.9;
-  p.twist_stiffness = 0.7;
-  p.natural_curvature = 0.6;
-  p.natural_curvature_2 = -0.2;
-  p.clamp_rotation = Eigen::AngleAxisd(0.5, V3(1, -1, 2).normalized()).toRotationMatrix();
-  p.grasp_rotation = Eigen::AngleAxisd(-0.4, V3(0, 1, 1).normalized()).toRotationMatrix();
-  p.free_start = true;
-  return p;
-}
-
-double RelErr(const Mat& a, const Mat& b) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
-}
+using test_support::FreeRodParams;
+using test_support::MaxRelativeError;
 
 // Both grasps moved and turned, nodes and angles perturbed, lagged frames accepted at
 // another perturbed state first: every derivative against central differences.
@@ -42,7 +27,7 @@ class FreeRodDerivatives : public ::testing::TestWithParam<int> {};
 
 TEST_P(FreeRodDerivatives, MatchCentralDifferences) {
   const int n = GetParam();
-  RodModel model(FreeParams(n));
+  RodModel model(FreeRodParams(n));
   ASSERT_EQ(model.NumControls(), 12);
   std::mt19937 rng(77 + n);
   std::uniform_real_distribution<double> d(-1.0, 1.0);
@@ -57,54 +42,22 @@ TEST_P(FreeRodDerivatives, MatchCentralDifferences) {
   perturb(&x, &u);
   model.AcceptState(x, u);
   perturb(&x, &u);
-  const int nx = model.NumStates();
-  const double h = 1e-6;
-  Vec g, eu;
-  model.Gradient(x, u, &g);
-  model.ControlGradient(x, u, &eu);
-  SparseMatrix hs = model.HessianPattern();
-  model.Hessian(x, u, &hs);
-  const Mat hxx(hs);
-  Mat exu, euu;
-  model.MixedHessian(x, u, &exu);
-  model.ControlHessian(x, u, &euu);
-  Vec fd_g(nx), fd_eu(12);
-  Mat fd_h(nx, nx), fd_exu(nx, 12), fd_euu(12, 12);
-  for (int i = 0; i < nx; ++i) {
-    Vec xp = x, xm = x, gp, gm;
-    xp[i] += h;
-    xm[i] -= h;
-    fd_g[i] = (model.Energy(xp, u) - model.Energy(xm, u)) / (2 * h);
-    model.Gradient(xp, u, &gp);
-    model.Gradient(xm, u, &gm);
-    fd_h.col(i) = (gp - gm) / (2 * h);
-  }
-  for (int c = 0; c < 12; ++c) {
-    Vec up = u, um = u, gp, gm, ep, em;
-    up[c] += h;
-    um[c] -= h;
-    fd_eu[c] = (model.Energy(x, up) - model.Energy(x, um)) / (2 * h);
-    model.Gradient(x, up, &gp);
-    model.Gradient(x, um, &gm);
-    fd_exu.col(c) = (gp - gm) / (2 * h);
-    model.ControlGradient(x, up, &ep);
-    model.ControlGradient(x, um, &em);
-    fd_euu.col(c) = (ep - em) / (2 * h);
-  }
-  EXPECT_LT(RelErr(g, fd_g), 1e-6);
-  EXPECT_LT(RelErr(hxx, fd_h), 1e-6);
-  EXPECT_LT(RelErr(eu, fd_eu), 1e-6);
-  EXPECT_LT(RelErr(exu, fd_exu), 1e-6);
-  EXPECT_LT(RelErr(euu, fd_euu), 1e-6);
+  const test_support::ModelDerivatives exact = test_support::ReportedDerivatives(model, x, u);
+  const test_support::ModelDerivatives fd = test_support::CentralDifferences(model, x, u, 1e-6);
+  EXPECT_LT(MaxRelativeError(exact.e_x, fd.e_x), 1e-6);
+  EXPECT_LT(MaxRelativeError(exact.e_xx, fd.e_xx), 1e-6);
+  EXPECT_LT(MaxRelativeError(exact.e_u, fd.e_u), 1e-6);
+  EXPECT_LT(MaxRelativeError(exact.e_xu, fd.e_xu), 1e-6);
+  EXPECT_LT(MaxRelativeError(exact.e_uu, fd.e_uu), 1e-6);
   // Both grasps take part: each half of E_u is non-zero.
-  EXPECT_GT(eu.head(6).norm(), 1e-3);
-  EXPECT_GT(eu.tail(6).norm(), 1e-3);
+  EXPECT_GT(exact.e_u.head(6).norm(), 1e-3);
+  EXPECT_GT(exact.e_u.tail(6).norm(), 1e-3);
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, FreeRodDerivatives, ::testing::Values(5, 9));
 
 TEST(FreeRod, HeldEndsFollowTheirGrasps) {
-  RodModel model(FreeParams(8));
+  RodModel model(FreeRodParams(8));
   Vec u = Vec::Zero(12);
   u.head(3) = V3(0.1, 0.2, 0.3);
   u.segment(6, 3) = V3(1.0, 0.0, 0.0);
@@ -114,7 +67,7 @@ TEST(FreeRod, HeldEndsFollowTheirGrasps) {
   EXPECT_LT((nodes.col(8) - V3(1.0, 0.0, 0.0)).norm(), 1e-15);
   // Edge 0 leaves along the first grasp's x axis (R_start = clamp_rotation at φ = 0).
   const V3 t0 = (nodes.col(1) - nodes.col(0)) / (1.1 / 8);
-  EXPECT_LT((t0 - FreeParams(8).clamp_rotation.col(0)).norm(), 1e-12);
+  EXPECT_LT((t0 - FreeRodParams(8).clamp_rotation.col(0)).norm(), 1e-12);
 }
 
 const char* kTwoHands = R"(

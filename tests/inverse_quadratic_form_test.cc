@@ -23,7 +23,7 @@
 namespace snapthread {
 namespace {
 
-using test_support::AllocationCounter;
+using test_support::MallocsDuring;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
@@ -103,11 +103,8 @@ TEST_P(InverseQuadraticFormTest, EqualsTheDenseFormulaForRightHandSidesStartingA
     // Repeated calls (the scratch already sized) give the same bits and do not allocate.
     const Mat first = q;
     LinearSolverStatus again = LinearSolverStatus::kInvalidInput;
-    AllocationCounter counter;
-    again = solver->InverseQuadraticForm(rhs, &q);
-    counter.Stop();
+    EXPECT_EQ(MallocsDuring([&] { again = solver->InverseQuadraticForm(rhs, &q); }), 0) << "n = " << n;
     EXPECT_EQ(again, LinearSolverStatus::kSuccess);
-    EXPECT_EQ(counter.mallocs(), 0) << "n = " << n;
     EXPECT_TRUE(q == first) << "n = " << n;
   }
 }

@@ -27,6 +27,7 @@ namespace {
 
 // Allocation counting: tests/support/allocation_counter.h.
 using test_support::AllocationCounter;
+using test_support::MallocsDuring;
 using namespace test_matrices;
 
 // ---------------------------------------------------------------------------------
@@ -430,11 +431,8 @@ TEST_P(LinearSolverTest, SolveManyEqualsSolvePerColumnWithoutAllocating) {
     }
     EXPECT_EQ(solver->SolveMany(rhs, &rhs), LinearSolverStatus::kInvalidInput);
     LinearSolverStatus again = LinearSolverStatus::kInvalidInput;
-    AllocationCounter counter;
-    again = solver->SolveMany(rhs, &x);
-    counter.Stop();
+    EXPECT_EQ(MallocsDuring([&] { again = solver->SolveMany(rhs, &x); }), 0) << "n = " << n;
     EXPECT_EQ(again, LinearSolverStatus::kSuccess);
-    EXPECT_EQ(counter.mallocs(), 0) << "n = " << n;
   }
 }
 

@@ -24,6 +24,7 @@
 #include <Eigen/SparseCore>
 
 #include "allocation_counter.h"
+#include "finite_difference.h"
 #include "models/models.h"
 #include "models/rod_model.h"
 
@@ -44,41 +45,26 @@ std::vector<Case> AllCases() {
   cases.push_back({"cusp", {.model = "cusp"}});
   // Non-default lengths and stiffnesses so that a coefficient mix-up cannot cancel.
   for (int n : {2, 3, 5, 10, 23}) {
-    ModelParams p;
-    p.model = "curve2d";
-    p.Set("n", n);
-    p.Set("segment_length", 0.7);
-    p.Set("bending", 1.3);
-    p.Set("stretching", 40.0);
-    cases.push_back({"curve2d_n" + std::to_string(n), p});
+    cases.push_back({"curve2d_n" + std::to_string(n),
+                     {.model = "curve2d",
+                      .values = {{"n", n}, {"segment_length", 0.7}, {"bending", 1.3}, {"stretching", 40.0}}}});
   }
   for (bool grip : {false, true}) {
     for (int n : {2, 3, 5, 10, 17}) {
       if (grip && n < 3) continue;
-      ModelParams p;
-      p.model = "thread3d";
-      p.Set("n", n);
-      p.Set("segment_length", 0.8);
-      p.Set("bending", 2.1);
-      p.Set("stretching", 60.0);
-      p.Set("reference_bend", 0.3);
-      p.Set("grip_direction", grip);
-      cases.push_back({"thread3d_n" + std::to_string(n) + (grip ? "_grip" : ""), p});
+      cases.push_back({"thread3d_n" + std::to_string(n) + (grip ? "_grip" : ""),
+                       {.model = "thread3d",
+                        .values = {{"n", n}, {"segment_length", 0.8}, {"bending", 2.1}, {"stretching", 60.0},
+                                   {"reference_bend", 0.3}, {"grip_direction", grip}}}});
     }
   }
   // The rod: a ribbon (B2 != B1) with natural curvature in both directions.
   for (int n : {3, 5, 12}) {
-    ModelParams p;
-    p.model = "rod";
-    p.Set("n", n);
-    p.Set("length", 1.3);
-    p.Set("stretch_stiffness", 80.0);
-    p.Set("bend_stiffness", 1.1);
-    p.Set("bend_stiffness_2", 2.3);
-    p.Set("twist_stiffness", 0.7);
-    p.Set("natural_curvature", 0.4);
-    p.Set("natural_curvature_2", -0.3);
-    cases.push_back({"rod_n" + std::to_string(n), p});
+    cases.push_back({"rod_n" + std::to_string(n),
+                     {.model = "rod",
+                      .values = {{"n", n}, {"length", 1.3}, {"stretch_stiffness", 80.0}, {"bend_stiffness", 1.1},
+                                 {"bend_stiffness_2", 2.3}, {"twist_stiffness", 0.7}, {"natural_curvature", 0.4},
+                                 {"natural_curvature_2", -0.3}}}});
   }
   // Self-contact (issue 15): capsules of radius 0.02 on edges of 0.1 with an activation
   // gap of 0.04, at curled states where several pairs are active (ContactPoints).
@@ -235,55 +221,6 @@ constexpr double kRelTol = 1e-6;
                                        << fd;
 }
 
-Vec FdEnergyX(const Model& m, const Vec& x, const Vec& u) {
-  Vec out(x.size());
-  for (int i = 0; i < x.size(); ++i) {
-    Vec xp = x, xm = x;
-    xp[i] += kStep;
-    xm[i] -= kStep;
-    out[i] = (m.Energy(xp, u) - m.Energy(xm, u)) / (2.0 * kStep);
-  }
-  return out;
-}
-Vec FdEnergyU(const Model& m, const Vec& x, const Vec& u) {
-  Vec out(u.size());
-  for (int i = 0; i < u.size(); ++i) {
-    Vec up = u, um = u;
-    up[i] += kStep;
-    um[i] -= kStep;
-    out[i] = (m.Energy(x, up) - m.Energy(x, um)) / (2.0 * kStep);
-  }
-  return out;
-}
-// Column j: central difference of the gradient along x_j (E_xx) or u_j (E_xu).
-Mat FdGradient(const Model& m, const Vec& x, const Vec& u, bool along_u) {
-  const int cols = along_u ? static_cast<int>(u.size()) : static_cast<int>(x.size());
-  Mat out(x.size(), cols);
-  Vec gp, gm;
-  for (int j = 0; j < cols; ++j) {
-    Vec xp = x, xm = x, up = u, um = u;
-    (along_u ? up : xp)[j] += kStep;
-    (along_u ? um : xm)[j] -= kStep;
-    m.Gradient(xp, up, &gp);
-    m.Gradient(xm, um, &gm);
-    out.col(j) = (gp - gm) / (2.0 * kStep);
-  }
-  return out;
-}
-Mat FdControlGradientU(const Model& m, const Vec& x, const Vec& u) {
-  Mat out(u.size(), u.size());
-  Vec gp, gm;
-  for (int j = 0; j < u.size(); ++j) {
-    Vec up = u, um = u;
-    up[j] += kStep;
-    um[j] -= kStep;
-    m.ControlGradient(x, up, &gp);
-    m.ControlGradient(x, um, &gm);
-    out.col(j) = (gp - gm) / (2.0 * kStep);
-  }
-  return out;
-}
-
 class ModelDerivativeTest : public ::testing::TestWithParam<Case> {
  protected:
   void SetUp() override { model_ = MakeModel(GetParam().params); }
@@ -339,44 +276,35 @@ TEST_P(ModelDerivativeTest, DerivativesMatchFiniteDifferences) {
     const Vec& u = pt.u;
     ASSERT_TRUE(std::isfinite(m.Energy(x, u)));
 
-    Vec g;
-    m.Gradient(x, u, &g);
-    ASSERT_EQ(g.size(), m.NumStates());
-    EXPECT_TRUE(RelClose(g, FdEnergyX(m, x, u), 1e-6)) << "E_x";
-
+    const test_support::ModelDerivatives exact = test_support::ReportedDerivatives(m, x, u);
+    const test_support::ModelDerivatives fd = test_support::CentralDifferences(m, x, u, kStep);
+    ASSERT_EQ(exact.e_x.size(), m.NumStates());
+    ASSERT_EQ(exact.e_u.size(), m.NumControls());
+    ASSERT_EQ(exact.e_xu.rows(), m.NumStates());
+    ASSERT_EQ(exact.e_xu.cols(), m.NumControls());
+    ASSERT_EQ(exact.e_uu.rows(), m.NumControls());
+    ASSERT_EQ(exact.e_uu.cols(), m.NumControls());
+    // Hessian() into an empty matrix: exactly HessianPattern()'s structure.
     SparseMatrix h;
     m.Hessian(x, u, &h);
     ASSERT_EQ(h.rows(), m.NumStates());
-    // Exactly HessianPattern()'s structure.
     const SparseMatrix& pattern = m.HessianPattern();
     ASSERT_EQ(h.nonZeros(), pattern.nonZeros());
     for (int j = 0; j <= h.cols(); ++j) ASSERT_EQ(h.outerIndexPtr()[j], pattern.outerIndexPtr()[j]);
     for (int k = 0; k < h.nonZeros(); ++k) ASSERT_EQ(h.innerIndexPtr()[k], pattern.innerIndexPtr()[k]);
     const Mat hd = Mat(h);
     EXPECT_LE((hd - hd.transpose()).norm(), 1e-12 * hd.norm()) << "E_xx not symmetric";
-    EXPECT_TRUE(RelClose(hd, FdGradient(m, x, u, false), 1e-6)) << "E_xx";
 
-    Vec eu;
-    m.ControlGradient(x, u, &eu);
-    ASSERT_EQ(eu.size(), m.NumControls());
-    EXPECT_TRUE(RelClose(eu, FdEnergyU(m, x, u), 1e-6)) << "E_u";
-
-    Mat exu;
-    m.MixedHessian(x, u, &exu);
-    ASSERT_EQ(exu.rows(), m.NumStates());
-    ASSERT_EQ(exu.cols(), m.NumControls());
-    EXPECT_TRUE(RelClose(exu, FdGradient(m, x, u, true), 1e-6)) << "E_xu";
-
-    Mat euu;
-    m.ControlHessian(x, u, &euu);
-    ASSERT_EQ(euu.rows(), m.NumControls());
-    ASSERT_EQ(euu.cols(), m.NumControls());
-    EXPECT_TRUE(RelClose(euu, FdControlGradientU(m, x, u), 1e-6)) << "E_uu";
+    EXPECT_TRUE(RelClose(exact.e_x, fd.e_x, 1e-6)) << "E_x";
+    EXPECT_TRUE(RelClose(hd, fd.e_xx, 1e-6)) << "E_xx";
+    EXPECT_TRUE(RelClose(exact.e_u, fd.e_u, 1e-6)) << "E_u";
+    EXPECT_TRUE(RelClose(exact.e_xu, fd.e_xu, 1e-6)) << "E_xu";
+    EXPECT_TRUE(RelClose(exact.e_uu, fd.e_uu, 1e-6)) << "E_uu";
 
     if (GraspLayoutOf(p).grip_direction) {
       // Only d/|d| enters: scaling d changes nothing, so E_d is orthogonal to d.
       const Eigen::Vector3d d = u.tail<3>();
-      EXPECT_LE(std::abs(eu.tail<3>().dot(d)), 1e-9 * (eu.norm() + 1.0) * d.norm());
+      EXPECT_LE(std::abs(exact.e_u.tail<3>().dot(d)), 1e-9 * (exact.e_u.norm() + 1.0) * d.norm());
     }
   }
 }

@@ -13,67 +13,19 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "band_check.h"
 #include "models/rod_model.h"
+#include "rod_fixtures.h"
 
 namespace snapthread {
 namespace {
 
 using V3 = Eigen::Vector3d;
 
-// A ribbon-like rod with natural curvature, clamp and grasp turned (as rod_test.cc's).
-RodParams BentParams(int n) {
-  RodParams p;
-  p.n = n;
-  p.length = 1.3;
-  p.stretch_stiffness = 50.0;
-  p.bend_stiffness = 1.0;
-  p.bend_stiffness_2 = 2.7;
-  p.twist_stiffness = 0.8;
-  p.natural_curvature = 0.9;
-  p.natural_curvature_2 = -0.4;
-  p.clamp_position = V3(0.1, -0.2, 0.3);
-  p.clamp_rotation = Eigen::AngleAxisd(0.4, V3(1, 2, 3).normalized()).toRotationMatrix();
-  p.grasp_rotation = Eigen::AngleAxisd(-0.3, V3(0, 1, 1).normalized()).toRotationMatrix() * p.clamp_rotation;
-  return p;
-}
-
-struct RandomState {
-  Vec x, u;
-};
-
-// The grasp moved and rolled, nodes and angles perturbed from the initial state.
-RandomState Perturbed(const RodModel& model, const Vec& x0, const Vec& u0, std::mt19937* rng) {
-  std::uniform_real_distribution<double> d(-1.0, 1.0);
-  RandomState s{x0, u0};
-  const double l = model.params().length / model.params().n;
-  for (int i = 0; i < s.x.size(); ++i) s.x[i] += 0.2 * l * d(*rng);
-  for (int j = 1; j <= model.params().n - 2; ++j) s.x[model.ThetaIndex(j)] += 0.6 * d(*rng);
-  for (int c = 0; c < 3; ++c) s.u[c] += 0.2 * l * d(*rng);
-  for (int c = 3; c < 6; ++c) s.u[c] += 0.2 * d(*rng);
-  return s;
-}
-
-struct RandomPair {
-  RandomState older, newer;
-};
-
-RandomPair RandomBentPair(const RodModel& model, std::mt19937* rng) {
-  const RodParams& p = model.params();
-  Vec u(6);
-  u << p.clamp_position + 0.8 * p.length * p.clamp_rotation.col(0) + V3(0.05, 0.2, -0.1) * p.length, 0.3, -0.5,
-      1.2;
-  RandomPair pair;
-  pair.older = Perturbed(model, model.InitialState(u), u, rng);
-  pair.newer = Perturbed(model, pair.older.x, pair.older.u, rng);
-  return pair;
-}
-
-// The frames accepted at one random state, evaluated at another (twist rates non-zero).
-RandomState RandomBentState(RodModel* model, std::mt19937* rng) {
-  const RandomPair pair = RandomBentPair(*model, rng);
-  model->AcceptState(pair.older.x, pair.older.u);
-  return pair.newer;
-}
+using test_support::RandomBentPair;
+using test_support::RandomBentState;
+using RandomState = test_support::RodState;
+using RandomPair = test_support::RodStatePair;
 
 // E_xx straight into the banded factorisation's storage (model.h): every lower-triangle
 // entry of the pattern at its band slot (over NaN-filled storage, so each is written) with
@@ -83,7 +35,7 @@ RandomState RandomBentState(RodModel* model, std::mt19937* rng) {
 TEST(RodModel, BandAssemblyHoldsHessiansValues) {
   std::mt19937 rng(17);
   for (bool free_start : {false, true}) {
-    RodParams p = BentParams(9);
+    RodParams p = test_support::BentRodParams(9);
     p.free_start = free_start;
     RodModel model(p);
     Vec x, u;
@@ -99,34 +51,13 @@ TEST(RodModel, BandAssemblyHoldsHessiansValues) {
       x = model.InitialState(u);
       for (int i = 0; i < x.size(); ++i) x[i] += 0.03 * d(rng);
     }
-    SparseMatrix h = model.HessianPattern();
-    Vec g;
-    model.Hessian(x, u, &h);
-    model.Gradient(x, u, &g);
-    const double e = model.Energy(x, u);
+    const test_support::SeparateValues separate = test_support::EvaluateSeparately(model, x, u);
+    const SparseMatrix& h = separate.h;
     const int b = model.HessianBandwidth();
     const int n = model.NumStates();
-    std::vector<double> band(static_cast<size_t>(n) * (b + 1), std::numeric_limits<double>::quiet_NaN());
-    Vec g4;
-    double e4 = 0.0;
-    ASSERT_TRUE(model.EnergyGradientAndBandHessian(x, u, &g4, band.data(), b, &e4));
-    EXPECT_EQ(std::memcmp(&e, &e4, sizeof e), 0) << e << " vs " << e4;
-    ASSERT_EQ(g4.size(), g.size());
-    EXPECT_EQ(std::memcmp(g.data(), g4.data(), sizeof(double) * g.size()), 0);
-    std::vector<char> in_pattern(band.size(), 0);
-    for (int j = 0; j < n; ++j) {
-      for (SparseMatrix::InnerIterator it(h, j); it; ++it) {
-        if (it.row() < j) continue;
-        const size_t slot = static_cast<size_t>(it.row()) * (b + 1) + j - it.row() + b;
-        in_pattern[slot] = 1;
-        EXPECT_EQ(band[slot], it.value()) << "E_xx(" << it.row() << ", " << j << ")";
-      }
-    }
-    for (size_t k = 0; k < band.size(); ++k) {
-      if (!in_pattern[k]) {
-        EXPECT_EQ(band[k], 0.0) << "slot " << k << " outside the pattern";
-      }
-    }
+    const test_support::BandAssembly fused = test_support::AssembleBand(model, x, u, b);
+    ASSERT_TRUE(fused.written);
+    test_support::ExpectBandHoldsSeparateValues(fused, b, separate, free_start ? "without a clamp" : "clamped");
     // The compressed matrix asked for at the band's state (a solver that factorised the
     // band in place does): the same values.
     SparseMatrix h2 = model.HessianPattern();
@@ -137,21 +68,17 @@ TEST(RodModel, BandAssemblyHoldsHessiansValues) {
                                                      << (free_start ? " without a clamp" : "");
       }
     }
-    std::fill(band.begin(), band.end(), std::numeric_limits<double>::quiet_NaN());
-    band.resize(static_cast<size_t>(n) * (b + 2), std::numeric_limits<double>::quiet_NaN());
-    EXPECT_FALSE(model.EnergyGradientAndBandHessian(x, u, &g4, band.data(), b + 1, &e4));
-    for (double v : band) EXPECT_TRUE(std::isnan(v)) << "a declining model wrote the band";
+    const test_support::BandAssembly wider = test_support::AssembleBand(model, x, u, b + 1);
+    EXPECT_FALSE(wider.written);
+    EXPECT_TRUE(wider.Untouched()) << "a declining model wrote the band";
   }
-  RodParams pc = BentParams(9);
+  RodParams pc = test_support::BentRodParams(9);
   pc.contact.enabled = true;
   RodModel contact(pc);
   const RandomState s = RandomBentState(&contact, &rng);
-  const int b = contact.HessianBandwidth();
-  std::vector<double> band(static_cast<size_t>(contact.NumStates()) * (b + 1), std::numeric_limits<double>::quiet_NaN());
-  Vec g;
-  double e = 0.0;
-  EXPECT_FALSE(contact.EnergyGradientAndBandHessian(s.x, s.u, &g, band.data(), b, &e));
-  for (double v : band) EXPECT_TRUE(std::isnan(v)) << "the model with contact wrote the band";
+  const test_support::BandAssembly declined = test_support::AssembleBand(contact, s.x, s.u, contact.HessianBandwidth());
+  EXPECT_FALSE(declined.written);
+  EXPECT_TRUE(declined.Untouched()) << "the model with contact wrote the band";
 }
 
 // The grasp maps are kept for the last u (every evaluation of an update asks for the same
@@ -160,7 +87,7 @@ TEST(RodModel, BandAssemblyHoldsHessiansValues) {
 // and nothing kept gives, to the last bit.
 TEST(RodModel, GraspMapsFollowTheAcceptedFrames) {
   std::mt19937 rng(41);
-  const RodParams p = BentParams(8);
+  const RodParams p = test_support::BentRodParams(8);
   RodModel kept(p), fresh(p);
   const RandomPair pair = RandomBentPair(kept, &rng);
   const RandomState& s = pair.newer;
@@ -195,7 +122,7 @@ TEST(RodModel, GraspMapsFollowTheAcceptedFrames) {
 TEST(RodModel, KeptPassValuesAreTheComputedOnes) {
   std::mt19937 rng(23);
   for (const char* what : {"gradient", "band", "energy"}) {
-    const RodParams p = BentParams(10);
+    const RodParams p = test_support::BentRodParams(10);
     RodModel kept(p), fresh(p);
     const RandomPair pair = RandomBentPair(kept, &rng);
     Vec g;

@@ -40,15 +40,10 @@ work=$(mktemp -d /tmp/snapthread-netns-XXXXXX)
 cleanup() { netns_kill "${all_ns[@]}"; }
 trap cleanup EXIT
 
-# fail, json, make_key, run_session, end_session, netns_kill, netns_remove_stale
+# fail, json, make_key, run_session, end_session, netns_kill, netns_start
 source "$(dirname "$0")/../../tests/support/script_support.sh"
 make_key
-netns_remove_stale '^st_(br|srv|dev|obs)_[0-9]+$'
-
-if ! ip netns add "$ns_br" 2>"$work/netns_err.txt"; then
-  echo "SKIPPED: ip netns add not permitted here: $(cat "$work/netns_err.txt")"
-  exit $skip
-fi
+netns_start '^st_(br|srv|dev|obs)_[0-9]+$' "$ns_br"
 set -e
 ip -n "$ns_br" link set lo up
 ip -n "$ns_br" link add br0 type bridge

@@ -28,6 +28,7 @@
 
 #include "messages/channels.h"
 #include "png_image.h"
+#include "report_session.h"
 #include "snapthread/device_state_t.hpp"
 #include "snapthread/device_status_t.hpp"
 #include "snapthread/force_model_t.hpp"
@@ -58,22 +59,8 @@ std::vector<uint8_t> Encode(const T& msg) {
   return buf;
 }
 
-force_model_t Model(int seq) {
-  force_model_t m{};
-  m.utime = seq * 1000 + 500;
-  m.seq = seq;
-  m.device_seq = seq;
-  m.device_utime = seq * 1000;
-  m.server_receive_utime = seq * 1000 + 100;
-  m.solve_us = 200 + seq % 7;
-  m.status = seq == 100 ? force_model_t::STATUS_SNAPPED : force_model_t::STATUS_REGULAR;
-  m.f0[0] = 0.01 * seq;
-  m.f0[1] = 0.005 * seq;
-  for (int i = 0; i < 3; ++i) m.K[i][i] = -50.0;
-  m.iterations = 2 + (seq == 100 ? 17 : 0);
-  m.residual = 1e-11;
-  return m;
-}
+// A genuine force model: its server times from 0 (the logger stamps the log itself).
+force_model_t Model(int seq) { return ReportModel(seq, 0); }
 
 using Message = std::pair<std::string, std::vector<uint8_t>>;
 
@@ -81,53 +68,13 @@ using Message = std::pair<std::string, std::vector<uint8_t>>;
 std::vector<Message> GenuineSession() {
   std::vector<Message> out;
   for (int k = 1; k <= kModels; ++k) {
-    device_state_t pose{};
-    pose.utime = k * 1000;
-    pose.seq = k;
-    pose.device_id = "lab";
-    pose.orientation[0] = 1.0;
-    out.emplace_back("LAB1_DEVICE_STATE", Encode(pose));
+    out.emplace_back("LAB1_DEVICE_STATE", Encode(ReportPose(k, "lab")));
     out.emplace_back("LAB1_FORCE_MODEL", Encode(Model(k)));
     if (k % 10 == 0) {
-      thread_shape_t s{};
-      s.utime = k * 1000;
-      s.seq = k / 10;
-      s.scene = "curve2d_snap";
-      s.model = "curve2d";
-      s.num_nodes = 2;
-      s.positions = {{0, 0, 0}, {1, 0, 0}};
-      out.emplace_back("LAB1_SHAPE", Encode(s));
-      solver_status_t st{};
-      st.utime = k * 1000;
-      st.seq = k / 10;
-      st.scene = "curve2d_snap";
-      st.method = k <= 100 ? "newton" : "higher-order";
-      st.iterations = 2;
-      st.residual = 1e-11;
-      st.lambda_min = 0.5;
-      st.update_rate_hz = 1000;
-      st.solve_us_p50 = 200;
-      st.solve_us_p99 = 300;
-      st.knot = k < 150 ? "unknot" : "trefoil";
-      st.knot_determinant = k < 150 ? 1 : 3;
-      st.contacts = k < 100 ? 0 : 2;
-      out.emplace_back("LAB1_SOLVER_STATUS", Encode(st));
+      out.emplace_back("LAB1_SHAPE", Encode(ReportShape(k, k * 1000, "curve2d_snap")));
+      out.emplace_back("LAB1_SOLVER_STATUS", Encode(ReportSolverStatus(k, k * 1000, "curve2d_snap")));
     }
-    if (k % 40 == 0) {
-      device_status_t d{};
-      d.utime = k * 1000;
-      d.seq = k / 40;
-      d.device_id = "lab";
-      d.tick_rate_hz = 1000;
-      d.lateness_us_p50 = 5 + k / 40;
-      d.lateness_us_p99 = 40 + k / 10;
-      d.lateness_us_max = 90 + k / 10;
-      d.model_age_ms = 0.7;
-      d.round_trip_us_p50 = 700;
-      d.round_trip_us_p99 = 900;
-      d.force_norm_n = 0.01 * k;
-      out.emplace_back("LAB1_DEVICE_STATUS", Encode(d));
-    }
+    if (k % 40 == 0) out.emplace_back("LAB1_DEVICE_STATUS", Encode(ReportDeviceStatus(k, "lab")));
   }
   return out;
 }
@@ -291,23 +238,6 @@ bool PrintableLines(const std::string& text) {
   return std::all_of(text.begin(), text.end(), [](char c) {
     return c == '\n' || (static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f);
   });
-}
-
-// A PNG with real content: valid, plot-sized, many colours and a good share of ink.
-void ExpectRealPlot(const viewer_test::Image& img, const std::string& what) {
-  EXPECT_GE(img.width, 400) << what;
-  EXPECT_GE(img.height, 300) << what;
-  std::set<uint32_t> colours;
-  size_t ink = 0;
-  for (int y = 0; y < img.height; ++y) {
-    for (int x = 0; x < img.width; ++x) {
-      const uint8_t* p = img.At(x, y);
-      colours.insert(uint32_t(p[0]) << 16 | uint32_t(p[1]) << 8 | p[2]);
-      ink += (p[0] < 200 || p[1] < 200 || p[2] < 200);
-    }
-  }
-  EXPECT_GE(colours.size(), 8u) << what;
-  EXPECT_GT(ink, size_t(img.width) * img.height / 100) << what << " is nearly blank";
 }
 
 class ReportInjectionTest : public ::testing::TestWithParam<Hostile> {

@@ -11,8 +11,6 @@
 //   * every response carries the Content-Security-Policy and its companions;
 //   * --max-pages: the page past the limit gets 503 and is counted;
 //   * the token is printed once, and a token file others may read is refused.
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -26,6 +24,7 @@
 
 #include <gtest/gtest.h>
 
+#include "loopback_socket.h"
 #include "test_support.h"
 
 namespace snapthread::attack_test {
@@ -42,21 +41,7 @@ struct Response {
 };
 
 // A connected socket to 127.0.0.1:port (-1 on failure), with a 10 s receive timeout.
-int Connect(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  if (fd < 0) return -1;
-  timeval tv{10, 0};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<uint16_t>(port));
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
-}
+int Connect(int port) { return test_support::ConnectLoopback(port, 10); }
 
 Response Parse(const std::string& raw) {
   Response r;

@@ -7,8 +7,6 @@
 // the real binaries (server, sim-path device, snapthread-web) over udpm on loopback: the
 // page's WebSocket carries the genuine device's statuses and the genuine shapes only,
 // the forged ones are refused (counted), and shapes keep flowing during the flood.
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -26,6 +24,7 @@
 
 #include "messages/channels.h"
 #include "sample_messages.h"
+#include "loopback_socket.h"
 #include "test_support.h"
 
 namespace snapthread::attack_test {
@@ -95,14 +94,8 @@ class Flooder {
 class WsReader {
  public:
   bool Open(int port) {
-    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
-    timeval tv{5, 0};
-    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(static_cast<uint16_t>(port));
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) return false;
+    fd_ = test_support::ConnectLoopback(port, 5);
+    if (fd_ < 0) return false;
     const std::string host = "127.0.0.1:" + std::to_string(port);
     const std::string request = "GET /ws HTTP/1.1\r\nHost: " + host + "\r\nOrigin: http://" + host +
                                 "\r\nConnection: Upgrade\r\nUpgrade: websocket\r\nSec-WebSocket-Version: 13\r\n"
@@ -222,10 +215,7 @@ TEST(WebFlood, AHundredForgedDeviceIdsDoNotPushOutTheGenuineDevice) {
   ASSERT_TRUE(std::regex_search(bridge, rejected, std::regex(R"("auth_rejected":(\d+))"))) << bridge;
   EXPECT_GT(std::stoll(rejected[1]), 1000) << "the forged messages are refused and counted";
 
-  device.Signal(SIGTERM);
-  server.Signal(SIGTERM);
-  EXPECT_TRUE(device.WaitOrKill(10));
-  EXPECT_TRUE(server.WaitOrKill(10));
+  EXPECT_TRUE(test_support::TerminateTogether({&device, &server}, 10)) << "device or server killed";
   web.Signal(SIGTERM);
   EXPECT_TRUE(web.WaitOrKill(10));
 }

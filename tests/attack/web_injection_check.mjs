@@ -9,26 +9,21 @@
 //   literal_<field>:    the field's payload appears, as text, in the status panel
 //   shapes, frames:     the page's counters; last_seq: the last shape's seq, once the replay
 //                       ended; csp: the page's Content-Security-Policy header
-import { createRequire } from 'node:module';
 import path from 'node:path';
 
+import { launchChromium, printCheck, requireFrom, sleep } from '../support/browser_check_support.mjs';
+
 const [modules, url, out] = process.argv.slice(2);
-const require = createRequire(path.join(path.resolve(modules), 'index.js'));
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const require = requireFrom(modules);
 
 // The payload web_injection_test.cc puts in each field.
 const payload = (field) => `<img src=/pwned-img-${field} onerror="window.__pwned='${field}'">` +
   `<script>window.__pwned='${field}-script'</script>` +
   `<svg onload="window.__pwned='${field}-svg'"></svg>`;
 
-let browser;
-try {
-  const { chromium } = require('playwright-core');
-  browser = await chromium.launch({
-    executablePath: '/usr/bin/chromium', timeout: 60000,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--no-first-run', '--use-angle=swiftshader',
-           '--enable-unsafe-swiftshader', '--disable-background-networking'],
-  });
+await printCheck(async (browsers) => {
+  const browser = await launchChromium(require);
+  browsers.push(browser);
   const context = await browser.newContext({ viewport: { width: 1000, height: 700 } });
   const page = await context.newPage();
   const markerRequests = [];
@@ -74,10 +69,5 @@ try {
     result[`literal_${field}`] = seen.text.includes(payload(field));
   }
   await page.screenshot({ path: path.join(out, 'injection.png') });
-  console.log(JSON.stringify(result));
-} catch (e) {
-  console.log(JSON.stringify({ error: String(e && e.stack ? e.stack : e) }));
-  process.exitCode = 1;
-} finally {
-  if (browser) await browser.close();
-}
+  return result;
+});

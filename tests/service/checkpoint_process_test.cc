@@ -35,6 +35,8 @@
 #include "snapthread/force_model_t.hpp"
 #include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
+#include "lcm_thread.h"
+#include "process_session_test.h"
 #include "test_support.h"
 #include "tracking/make_tracker.h"
 
@@ -61,17 +63,12 @@ std::string Hex(int64_t v) {
 class SessionListener {
  public:
   explicit SessionListener(const std::string& session) : lcm_(kUrl), channels_(session) {
-    messages::Subscribe<&SessionListener::OnStatus>(lcm_, channels_.solver_status, this);
-    messages::Subscribe<&SessionListener::OnShape>(lcm_, channels_.shape, this);
-    messages::Subscribe<&SessionListener::OnModel>(lcm_, channels_.force_model, this);
-    thread_ = std::thread([this] {
-      while (!stop_) lcm_.handleTimeout(20);
-    });
+    messages::Subscribe<&SessionListener::OnStatus>(lcm_.lcm(), channels_.solver_status, this);
+    messages::Subscribe<&SessionListener::OnShape>(lcm_.lcm(), channels_.shape, this);
+    messages::Subscribe<&SessionListener::OnModel>(lcm_.lcm(), channels_.force_model, this);
+    lcm_.Start();
   }
-  ~SessionListener() {
-    stop_ = true;
-    thread_.join();
-  }
+  ~SessionListener() { lcm_.Stop(); }
 
   void OnStatus(const lcm::ReceiveBuffer*, const std::string&, const solver_status_t* m) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -122,7 +119,7 @@ class SessionListener {
     s.orientation[0] = 1.0;
     s.buttons = 1;
     if (!auth::Sign(&s, channels_.device_state, Get(&epoch_), auth_seq_.Next(), key_->key())) return false;
-    if (lcm_.publish(channels_.device_state, &s) != 0) return false;
+    if (lcm_.lcm().publish(channels_.device_state, &s) != 0) return false;
     return test_support::WaitUntil([&] { return Get(&answered_) >= s.seq; }, kWaitS, 0.0005);
   }
   void set_key(const test_support::SessionKeyFile* key) { key_ = key; }
@@ -132,7 +129,7 @@ class SessionListener {
     std::lock_guard<std::mutex> lock(mutex_);
     return *v;
   }
-  lcm::LCM lcm_;
+  test_support::LcmThread lcm_;
   messages::Channels channels_;
   const test_support::SessionKeyFile* key_ = nullptr;
   auth::AuthSequence auth_seq_;
@@ -141,8 +138,6 @@ class SessionListener {
   int64_t epoch_ = 0, answered_ = 0, shapes_ = 0;
   std::map<int64_t, thread_shape_t> first_shape_;
   thread_shape_t last_shape_{};
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
 };
 
 double ShapeDistance(const thread_shape_t& a, const Eigen::Matrix3Xd& nodes) {
@@ -191,17 +186,10 @@ std::vector<Tick> ReadTicks(const std::string& path) {
   return ticks;
 }
 
-class CheckpointProcessTest : public ::testing::Test {
+class CheckpointProcessTest : public test_support::ProcessSessionTest {
  protected:
-  const test_support::SessionKeyFile key_file_;
-
   void SetUp() override {
-    bin_ = test_support::BinDir();
-    ASSERT_FALSE(bin_.empty() || test_support::SourceDir().empty()) << "run through ctest";
-    lcm::LCM probe(kUrl);
-    ASSERT_TRUE(probe.good()) << "LCM udpm does not start (deploy/multicast-route.sh)";
-    session_ = test_support::UniqueSession("CK");
-    tmp_ = std::make_unique<test_support::ScopedTempDir>("ckpt_" + session_);
+    ASSERT_NO_FATAL_FAILURE(StartSession("CK", "ckpt"));
     state_dir_ = tmp_->path() + "/state";
     scene_path_ = test_support::ScenePath("curve2d_snap.yaml");
     scene_ = LoadScene(scene_path_);
@@ -259,9 +247,8 @@ class CheckpointProcessTest : public ::testing::Test {
     return r;
   }
 
-  std::string bin_, session_, state_dir_, scene_path_;
+  std::string state_dir_, scene_path_;
   Scene scene_;
-  std::unique_ptr<test_support::ScopedTempDir> tmp_;
   std::unique_ptr<SessionListener> listener_;
 };
 

@@ -21,19 +21,13 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int64_t kTickUs = 1000;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
+// The limits the tests below are written for, spelled out so that a change of the
+// defaults does not change the tests.
 SafetyLimits Limits() {
-  SafetyLimits l;
-  l.max_force_n = 3.0;
-  l.max_stiffness_n_per_m = 800.0;
-  l.max_force_rate_n_per_s = 1000.0;
-  l.model_timeout_s = 0.050;
-  l.fade_time_s = 0.100;
-  l.workspace_radius_m = 0.08;
-  l.max_torque_nm = 0.05;
-  l.max_torque_rate_nm_per_s = 20.0;
-  l.max_torque_stiffness_nm_per_rad = 0.1;
-  l.tick_period_s = 0.001;
-  return l;
+  return {.max_force_n = 3.0, .max_stiffness_n_per_m = 800.0, .max_force_rate_n_per_s = 1000.0,
+          .model_timeout_s = 0.050, .fade_time_s = 0.100, .workspace_radius_m = 0.08,
+          .max_torque_nm = 0.05, .max_torque_rate_nm_per_s = 20.0,
+          .max_torque_stiffness_nm_per_rad = 0.1, .tick_period_s = 0.001};
 }
 
 // A rod-like wrench model: a spring in position, a torsion spring in rotation with the

@@ -8,8 +8,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -17,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "process_session_test.h"
 #include "scene/scene.h"
 #include "test_support.h"
 
@@ -26,40 +25,16 @@ namespace {
 using test_support::ChildProcess;
 constexpr const char* kUrl = test_support::kLoopbackLcmUrl;
 
-struct Row {
-  double t_s, model_age_ms, qw, qx, tx, ty, tz;
-  int status, fading;
+class RodWrenchProcess : public test_support::ProcessSessionTest {
+ protected:
+  void SetUp() override { ASSERT_NO_FATAL_FAILURE(StartSession("RW", "rod_wrench")); }
 };
 
-std::vector<Row> ReadTrace(const std::string& path) {
-  std::vector<Row> rows;
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);  // header
-  while (std::getline(in, line)) {
-    Row r{};
-    long long seq = 0;
-    double x, y, z, fx, fy, fz, qy, qz;
-    int clamped = 0;
-    if (std::sscanf(line.c_str(), "%lf,%lld,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf",
-                    &r.t_s, &seq, &x, &y, &z, &fx, &fy, &fz, &r.model_age_ms, &r.status, &clamped, &r.fading,
-                    &r.qw, &r.qx, &qy, &qz, &r.tx, &r.ty, &r.tz) == 19) {
-      rows.push_back(r);
-    }
-  }
-  return rows;
-}
-
-TEST(RodWrenchProcess, DeviceRendersTheTwistTorqueBeforeTheBuckle) {
-  const test_support::SessionKeyFile key_file;
-  const std::string bin = test_support::BinDir();
+TEST_F(RodWrenchProcess, DeviceRendersTheTwistTorqueBeforeTheBuckle) {
+  const std::string& bin = bin_;
+  const std::string& session = session_;
+  const std::string dir = tmp_->path();
   const std::string scene_path = test_support::ScenePath("rod_greenhill.yaml");
-  ASSERT_TRUE(std::filesystem::exists(bin + "/snapthread-server"));
-  ASSERT_TRUE(std::filesystem::exists(bin + "/snapthread-device"));
-  {
-    lcm::LCM probe(kUrl);
-    ASSERT_TRUE(probe.good()) << "LCM udpm does not start here (deploy/multicast-route.sh)";
-  }
   const Scene scene = LoadScene(scene_path);
   const int n = scene.params.Integer("n");
   const double gj = scene.params.Number("twist_stiffness");
@@ -71,9 +46,6 @@ TEST(RodWrenchProcess, DeviceRendersTheTwistTorqueBeforeTheBuckle) {
   // clamp acts past about 270 degrees.
   const double angular_speed_deg = 90.0, duration_s = 4.5;
 
-  const std::string session = test_support::UniqueSession("RW");
-  const test_support::ScopedTempDir tmp("rod_wrench_" + session);
-  const std::string dir = tmp.path();
   ChildProcess server({bin + "/snapthread-server", "--scene", scene_path, "--session", session, "--lcm-url", kUrl,
                        "--summary", dir + "/server.json", "--duration", "300"},
                       test_support::OneLog(dir + "/server.log", true));
@@ -103,16 +75,16 @@ TEST(RodWrenchProcess, DeviceRendersTheTwistTorqueBeforeTheBuckle) {
 
   // Settled rows: a fresh regular model and no stale tick within the fade time (the fade
   // gain is 1). The roll is unwrapped along the trace (the path only rolls forward).
-  const std::vector<Row> rows = ReadTrace(dir + "/trace.csv");
+  const std::vector<test_support::DeviceTraceRow> rows = test_support::ReadDeviceTrace(dir + "/trace.csv");
   ASSERT_GT(rows.size(), 1000u);
   const double fade_s = 0.100;
   double last_unsettled = 0.0, roll = 0.0, previous = 0.0;
   int settled = 0, lawful = 0, clamped = 0;
-  for (const Row& r : rows) {
-    const double angle = 2.0 * std::atan2(r.qx, r.qw);  // the sim hand rolls about x
+  for (const test_support::DeviceTraceRow& r : rows) {
+    const double angle = 2.0 * std::atan2(r.orientation[1], r.orientation[0]);  // the sim hand rolls about x
     roll += std::remainder(angle - previous, 2.0 * std::numbers::pi);
     previous = angle;
-    if (r.model_age_ms < 0.0 || r.fading || r.status != 0) {
+    if (r.model_age_ms < 0.0 || r.fading || r.model_status != 0) {
       last_unsettled = r.t_s;
       continue;
     }
@@ -124,12 +96,12 @@ TEST(RodWrenchProcess, DeviceRendersTheTwistTorqueBeforeTheBuckle) {
     if (free_torque > max_torque) ++clamped;
     // Linear in the roll for the straight rod, so the 6-DoF local model is exact to the
     // trace's 9 digits at any model age; 1e-6 N m covers the rod's 1e-6 imperfection.
-    const bool ok = std::abs(r.tx - expected) < 1e-6 + 1e-4 * std::abs(expected) &&
-                    std::hypot(r.ty, r.tz) < 1e-6 + 1e-4 * std::abs(expected);
+    const bool ok = std::abs(r.torque_nm[0] - expected) < 1e-6 + 1e-4 * std::abs(expected) &&
+                    std::hypot(r.torque_nm[1], r.torque_nm[2]) < 1e-6 + 1e-4 * std::abs(expected);
     lawful += ok ? 1 : 0;
     if (!ok && settled - lawful < 5) {
-      std::printf("t = %.3f s, roll %.4f rad: torque (%.6g, %.3g, %.3g) N m, expected %.6g\n", r.t_s, roll, r.tx,
-                  r.ty, r.tz, expected);
+      std::printf("t = %.3f s, roll %.4f rad: torque (%.6g, %.3g, %.3g) N m, expected %.6g\n", r.t_s, roll, r.torque_nm[0],
+                  r.torque_nm[1], r.torque_nm[2], expected);
     }
   }
   std::printf("rod_wrench: %d settled ticks, %d lawful, %d clamped; roll reached %.1f degrees\n", settled, lawful,

@@ -95,18 +95,10 @@ TEST(ServerMessagesTest, PlanarForceModelUnitsAndPlane) {
   p.model = "curve2d";
   auto model = MakeModel(p);
   const TrackResult r = FakeResult(2, 0.5);
-  ForceModelInputs in;
-  in.mapping = &map;
-  in.model = model.get();
-  in.u = Vec::Zero(2);
-  in.position_m = Eigen::Vector3d(0.01, 0.02, 0.003);
-  in.result = &r;
-  in.device_seq = 41;
-  in.device_utime = 123456;
-  in.server_receive_utime = 777;
-  in.solve_us = 12.4;
-  in.seq = 5;
-  in.utime = 999;
+  const ForceModelInputs in{.mapping = &map, .model = model.get(), .u = Vec::Zero(2),
+                            .position_m = Eigen::Vector3d(0.01, 0.02, 0.003), .result = &r,
+                            .device_seq = 41, .device_utime = 123456, .server_receive_utime = 777,
+                            .solve_us = 12.4, .seq = 5, .utime = 999};
   const force_model_t m = BuildForceModel(in);
   EXPECT_EQ(m.status, force_model_t::STATUS_REGULAR);
   EXPECT_EQ(m.device_seq, 41);
@@ -132,10 +124,7 @@ TEST(ServerMessagesTest, PlanarForceModelUnitsAndPlane) {
 
 TEST(ServerMessagesTest, GripTorque) {
   const DeviceMapping map = TestMapping();
-  ModelParams p;
-  p.model = "thread3d";
-  p.Set("grip_direction", true);
-  auto model = MakeModel(p);
+  auto model = MakeModel(ModelParams{.model = "thread3d"}.Set("grip_direction", true));
   TrackResult r = FakeResult(6, 1.0);
   r.force.segment<3>(3) = Eigen::Vector3d(0.0, 3.0, 0.0);  // F_d
   ForceModelInputs in;
@@ -267,10 +256,7 @@ TEST(ServerMessagesTest, ShapeCountsMatchAndValidate) {
 // density 2 / (7 ℓ) rad per model length (the twist acts between the held edges' midpoints).
 TEST(ServerMessagesTest, RodShapeCarriesMaterialFramesAndTwistDensity) {
   const DeviceMapping map = TestMapping();
-  ModelParams p;
-  p.model = "rod";
-  p.Set("n", 8);
-  auto model = MakeModel(p);
+  auto model = MakeModel(ModelParams{.model = "rod"}.Set("n", 8));
   const double roll = 2.0;
   const Vec u = (Vec(6) << 1.0, 0.0, 0.0, roll, 0.0, 0.0).finished();
   ShapeInputs in;

@@ -18,6 +18,8 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "arrival_log.h"
+#include "lcm_thread.h"
+#include "process_session_test.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "messages/channels.h"
@@ -49,18 +51,9 @@ double SecondsToExit(ChildProcess* child, int sig, int* code) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-class SignalTest : public ::testing::Test {
+class SignalTest : public test_support::ProcessSessionTest {
  protected:
-  // The session key of every binary here (SNAPTHREAD_KEY_FILE, inherited).
-  const test_support::SessionKeyFile key_file_;
-  void SetUp() override {
-    bin_ = test_support::BinDir();
-    ASSERT_FALSE(bin_.empty() || test_support::SourceDir().empty()) << "run through ctest";
-    lcm::LCM probe(kUrl);
-    ASSERT_TRUE(probe.good()) << "LCM udpm does not start (deploy/multicast-route.sh)";
-    session_ = test_support::UniqueSession("SIG");
-    tmp_ = std::make_unique<test_support::ScopedTempDir>("signal_" + session_);
-  }
+  void SetUp() override { ASSERT_NO_FATAL_FAILURE(StartSession("SIG", "signal")); }
 
   std::unique_ptr<ChildProcess> StartServer(const std::vector<std::string>& extra = {}) {
     std::vector<std::string> argv{bin_ + "/snapthread-server", "--scene",
@@ -72,9 +65,6 @@ class SignalTest : public ::testing::Test {
     EXPECT_TRUE(child->WaitForOutput("server: session", 30)) << child->Out();
     return child;
   }
-
-  std::string bin_, session_;
-  std::unique_ptr<test_support::ScopedTempDir> tmp_;
 };
 
 TEST_F(SignalTest, ServerStopsWithinOneSecondOnSigtermAndSigint) {
@@ -132,15 +122,10 @@ TEST_F(SignalTest, ViewerStopsWithinOneSecond) {
 class StatusListener {
  public:
   explicit StatusListener(const std::string& session) : lcm_(kUrl), channels_(session) {
-    messages::Subscribe<&StatusListener::On>(lcm_, channels_.solver_status, this);
-    thread_ = std::thread([this] {
-      while (!stop_) lcm_.handleTimeout(20);
-    });
+    messages::Subscribe<&StatusListener::On>(lcm_.lcm(), channels_.solver_status, this);
+    lcm_.Start();
   }
-  ~StatusListener() {
-    stop_ = true;
-    thread_.join();
-  }
+  ~StatusListener() { lcm_.Stop(); }
   void On(const lcm::ReceiveBuffer*, const std::string&, const solver_status_t* msg) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -154,17 +139,15 @@ class StatusListener {
     std::lock_guard<std::mutex> lock(mutex_);
     return last_;
   }
-  lcm::LCM& lcm() { return lcm_; }
+  lcm::LCM& lcm() { return lcm_.lcm(); }
   const messages::Channels& channels() const { return channels_; }
 
  private:
-  lcm::LCM lcm_;
+  test_support::LcmThread lcm_;
   messages::Channels channels_;
   std::mutex mutex_;
   test_support::ArrivalLog times_;
   solver_status_t last_{};
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
 };
 
 TEST_F(SignalTest, ServerProcessSurvivesLoadSceneDevZeroAndAFifo) {

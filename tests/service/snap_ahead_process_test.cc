@@ -27,7 +27,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -57,32 +56,7 @@ constexpr size_t kWindowRows = 100;
 // Two consecutive rows further apart than this: the device missed ticks (a stall).
 constexpr double kStalledS = 0.0025;
 
-// One row of the device's --trace (device_client.cc WriteTraceRow).
-struct Row {
-  double t_s = 0.0;
-  long long tick = 0;
-  Eigen::Vector3d p = Eigen::Vector3d::Zero(), f = Eigen::Vector3d::Zero();
-  double age_ms = -1.0;
-  bool fading = false;
-};
-
-std::vector<Row> ReadTrace(const std::string& path) {
-  std::vector<Row> rows;
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);  // header
-  while (std::getline(in, line)) {
-    Row r;
-    int status = 0, clamped = 0, fading = 0;
-    if (std::sscanf(line.c_str(), "%lf,%lld,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d", &r.t_s, &r.tick,
-                    &r.p[0], &r.p[1], &r.p[2], &r.f[0], &r.f[1], &r.f[2], &r.age_ms, &status,
-                    &clamped, &fading) == 12) {
-      r.fading = fading != 0;
-      rows.push_back(r);
-    }
-  }
-  return rows;
-}
+using Row = test_support::DeviceTraceRow;  // one traced servo tick
 
 struct FoldResult {
   bool measured = false;
@@ -121,7 +95,7 @@ RunResult Analyse(const std::vector<Row>& rows, const std::vector<Eigen::Vector3
   std::vector<Jump> jumps;
   bool in_step = false;
   for (size_t i = kSettleRows; i < rows.size(); ++i) {
-    const bool big = (rows[i].f - rows[i - 1].f).norm() > kStepN;
+    const bool big = (rows[i].force_n - rows[i - 1].force_n).norm() > kStepN;
     if (big && !in_step) {
       Jump j{i, 0.0, ""};
       if (watchdog[i] || watchdog[i - 1]) {
@@ -134,7 +108,7 @@ RunResult Analyse(const std::vector<Row>& rows, const std::vector<Eigen::Vector3
       }
       jumps.push_back(j);
     }
-    if (big) jumps.back().size_n = (rows[i].f - rows[jumps.back().row - 1].f).norm();
+    if (big) jumps.back().size_n = (rows[i].force_n - rows[jumps.back().row - 1].force_n).norm();
     in_step = big;
   }
 
@@ -146,8 +120,8 @@ RunResult Analyse(const std::vector<Row>& rows, const std::vector<Eigen::Vector3
     size_t c = from;
     Eigen::Vector3d v = Eigen::Vector3d::Zero();
     for (; c < rows.size(); ++c) {
-      v = (rows[c].p - rows[c - 1].p).normalized();
-      if ((rows[c - 1].p - folds[k]).dot(v) < 0.0 && (rows[c].p - folds[k]).dot(v) >= 0.0) break;
+      v = (rows[c].position_m - rows[c - 1].position_m).normalized();
+      if ((rows[c - 1].position_m - folds[k]).dot(v) < 0.0 && (rows[c].position_m - folds[k]).dot(v) >= 0.0) break;
     }
     if (c >= rows.size()) {
       fr.why_not = "the trace never crosses it";
@@ -178,11 +152,11 @@ RunResult Analyse(const std::vector<Row>& rows, const std::vector<Eigen::Vector3
     if (has_jump) {
       const Jump& j = jumps[next_jump++];
       const Row& r = rows[j.row];
-      fr.error_ticks = (r.p - folds[k]).dot(v) / kTickTravelM;
+      fr.error_ticks = (r.position_m - folds[k]).dot(v) / kTickTravelM;
       fr.size_n = j.size_n;
       fr.ticks_after_crossing = r.tick - rows[c].tick;
       // The tick that felt it travelled this much beyond one tick (a delayed tick).
-      const double travelled = (r.p - rows[j.row - 1].p).dot(v) / kTickTravelM;
+      const double travelled = (r.position_m - rows[j.row - 1].position_m).dot(v) / kTickTravelM;
       fr.allowance_ticks = 2.0 + std::max(0.0, travelled - 1.0);
       from = j.row + 1;
     } else {
@@ -251,7 +225,7 @@ class SnapAheadProcessTest : public ::testing::Test {
     EXPECT_EQ(code, 0) << device.Out();
     server.Signal(SIGTERM);
     EXPECT_TRUE(server.Wait(60, &code));
-    const std::vector<Row> rows = ReadTrace(dir + "/trace_" + tag + ".csv");
+    const std::vector<Row> rows = test_support::ReadDeviceTrace(dir + "/trace_" + tag + ".csv");
     // How many ticks the device ran in its 6.6 s depends on the scheduler (4877 in one
     // loaded run): the trace must reach past both folds, which Analyse checks.
     EXPECT_GT(rows.size(), static_cast<size_t>(kSettleRows)) << tag;

@@ -46,4 +46,14 @@ class AllocationCounter {
   long mallocs_ = -1, news_ = -1;  // >= 0 once stopped
 };
 
+// The heap allocations (malloc calls, operator new included) that f() makes on this
+// thread: 0 is the promise of a call that reuses presized outputs.
+template <class F>
+long MallocsDuring(F&& f) {
+  AllocationCounter counter;
+  f();
+  counter.Stop();
+  return counter.mallocs();
+}
+
 }  // namespace snapthread::test_support

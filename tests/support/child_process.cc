@@ -114,4 +114,11 @@ std::string ChildProcess::Err() const {
   return ReadFile(options_.err_path.empty() ? options_.out_path : options_.err_path);
 }
 
+bool TerminateTogether(std::initializer_list<ChildProcess*> children, double timeout_s) {
+  for (ChildProcess* child : children) child->Signal(SIGTERM);
+  bool all_exited = true;
+  for (ChildProcess* child : children) all_exited = child->WaitOrKill(timeout_s) && all_exited;
+  return all_exited;
+}
+
 }  // namespace snapthread::test_support

@@ -2,6 +2,7 @@
 // on every wait, and a clean kill, so a failing test never leaks processes.
 #pragma once
 
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -63,5 +64,10 @@ class ChildProcess {
   int code_ = -1;
   ChildOptions options_;
 };
+
+// Ends a session's processes together: SIGTERM to each at once (so the shutdown takes as
+// long as the slowest, not the sum), then each waited for up to timeout_s and killed at
+// the deadline (WaitOrKill). False when any had to be killed.
+bool TerminateTogether(std::initializer_list<ChildProcess*> children, double timeout_s);
 
 }  // namespace snapthread::test_support

@@ -82,3 +82,13 @@ netns_remove_stale() {
     fi
   done
 }
+# netns_start STALE_REGEX NS: removes the stale namespaces of earlier runs (as
+# netns_remove_stale), then adds NS, the run's first namespace; where that is not
+# permitted (not root, no CAP_SYS_ADMIN) prints SKIPPED and exits 77, ctest's skip code.
+netns_start() {
+  netns_remove_stale "$1"
+  if ! ip netns add "$2" 2>"$work/netns_err.txt"; then
+    echo "SKIPPED: ip netns add not permitted here: $(cat "$work/netns_err.txt")"
+    exit 77
+  fi
+}

@@ -12,26 +12,22 @@
 //   auth URL_WITHOUT_TOKEN OUT_DIR TOKEN: HTTP status of the page and of a WebSocket
 //        upgrade without, with a wrong and with the right token (no browser); the page with
 //        the right token redirects (303), setting the cookie the script then loads with.
-import { createRequire } from 'node:module';
 import { readdirSync, readFileSync } from 'node:fs';
 import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
 
+import { launchChromium, printCheck, requireFrom, sleep } from '../support/browser_check_support.mjs';
+
 const [modules, browserName, mode, url, out, arg] = process.argv.slice(2);
-const require = createRequire(path.join(path.resolve(modules), 'index.js'));
+const require = requireFrom(modules);
 const MEASURE_S = 5;
 // After the first shapes: the browser compiles the shaders and JIT-compiles the page in
 // the first seconds (longer on a loaded machine), and a page then works off the messages
 // queued meanwhile; the rates are of the steady state after it, as an observer sees it.
 const WARM_UP_S = 8;
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-
-const CHROMIUM_ARGS = [
-  '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-  '--disable-background-networking', '--disable-component-update', '--disable-sync',
-  '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-  // Pages in the background must keep drawing: the test opens two at once.
+// Pages in the background must keep drawing: the test opens two at once.
+const CHROMIUM_BACKGROUND_ARGS = [
   '--disable-background-timer-throttling', '--disable-renderer-backgrounding',
   '--disable-backgrounding-occluded-windows',
 ];
@@ -70,11 +66,7 @@ const cpuSince = (a, b, s) => Object.fromEntries(Object.keys(b).map((k) => [k, N
 // select}; page.evaluate(fn) is the same in both.
 const DRIVERS = {
   chromium: {
-    async launch() {
-      const { chromium } = require('playwright-core');
-      // launch() gives Chromium a new empty --user-data-dir of its own.
-      return chromium.launch({ executablePath: '/usr/bin/chromium', args: CHROMIUM_ARGS, timeout: 60000 });
-    },
+    launch: () => launchChromium(require, CHROMIUM_BACKGROUND_ARGS),
     async open(browser, viewport) {
       // A context (a window) per page: two tabs of one window would leave one in the
       // background, where Chromium throttles its animation frames.
@@ -239,22 +231,12 @@ async function auth(token) {
   };
 }
 
-let browser;
-try {
-  let result;
-  if (mode === 'auth') {
-    result = await auth(arg);
-  } else {
-    if (!driver) throw new Error(`browser ${browserName}: chromium or firefox`);
-    browser = await driver.launch();
-    if (mode === 'live') result = await live(browser, Number(arg || 2));
-    else if (mode === 'page') result = await wholePage(browser, Number(arg || 15));
-    else result = await replay(browser);
-  }
-  console.log(JSON.stringify(result));
-} catch (e) {
-  console.log(JSON.stringify({ error: String(e && e.stack ? e.stack : e) }));
-  process.exitCode = 1;
-} finally {
-  if (browser) await browser.close();
-}
+await printCheck(async (browsers) => {
+  if (mode === 'auth') return auth(arg);
+  if (!driver) throw new Error(`browser ${browserName}: chromium or firefox`);
+  const browser = await driver.launch();
+  browsers.push(browser);
+  if (mode === 'live') return live(browser, Number(arg || 2));
+  if (mode === 'page') return wholePage(browser, Number(arg || 15));
+  return replay(browser);
+});

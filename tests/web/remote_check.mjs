@@ -9,14 +9,14 @@
 //   without: a fresh browser context opening the same address without the token: the
 //     status, whether any script ran (shapes), and the page's files and WebSocket asked
 //     for directly.
-import { createRequire } from 'node:module';
 import { writeFileSync } from 'node:fs';
 import path from 'node:path';
 import zlib from 'node:zlib';
 
+import { launchChromium, printCheck, requireFrom, sleep } from '../support/browser_check_support.mjs';
+
 const [modules, url, out] = process.argv.slice(2);
-const require = createRequire(path.join(path.resolve(modules), 'index.js'));
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const require = requireFrom(modules);
 const MEASURE_S = 5;
 
 // The native viewer's tube colours by status (viewer/marker_colors.h), as the page uses.
@@ -136,20 +136,8 @@ async function without(browser) {
   return result;
 }
 
-let browser;
-try {
-  const { chromium } = require('playwright-core');
-  browser = await chromium.launch({
-    executablePath: '/usr/bin/chromium', timeout: 60000,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-           '--disable-background-networking', '--disable-component-update', '--disable-sync',
-           '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  });
-  const result = { without: await without(browser), with_token: await withToken(browser) };
-  console.log(JSON.stringify(result));
-} catch (e) {
-  console.log(JSON.stringify({ error: String(e && e.stack ? e.stack : e) }));
-  process.exitCode = 1;
-} finally {
-  if (browser) await browser.close();
-}
+await printCheck(async (browsers) => {
+  const browser = await launchChromium(require);
+  browsers.push(browser);
+  return { without: await without(browser), with_token: await withToken(browser) };
+});

@@ -23,15 +23,8 @@ AccessConfig Config(std::string token = kToken) { return {std::move(token), {"La
 
 RequestFacts Facts(std::string_view target, std::string_view host, std::string_view cookie = "",
                    std::string_view origin = "", bool upgrade = false) {
-  RequestFacts f;
-  f.target = target;
-  f.host = host;
-  f.cookie = cookie;
-  f.origin = origin;
-  f.upgrade = upgrade;
-  f.local_address = "10.213.7.1";
-  f.local_is_loopback = false;
-  return f;
+  return {.target = target, .host = host, .origin = origin, .cookie = cookie, .upgrade = upgrade,
+          .local_address = "10.213.7.1", .local_is_loopback = false};
 }
 
 bool AnyPage(std::string_view path) { return path == "/" || path == "/app.js"; }

@@ -144,10 +144,7 @@ class WebBrowserTest : public ::testing::Test {
     RecordProperty(browser + "_live", live);
     std::printf("web_browser_test %s live: %s\n", browser.c_str(), live.c_str());
 
-    device.Signal(SIGTERM);
-    server.Signal(SIGTERM);
-    EXPECT_TRUE(device.WaitOrKill(10));
-    EXPECT_TRUE(server.WaitOrKill(10));
+    EXPECT_TRUE(test_support::TerminateTogether({&device, &server}, 10)) << "device or server killed";
     logger.Signal(SIGINT);
     EXPECT_TRUE(logger.WaitOrKill(10));
     web->Signal(SIGTERM);

@@ -46,15 +46,10 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# fail, json, make_key, netns_kill, netns_remove_stale
+# fail, json, make_key, netns_kill, netns_start
 source "$(dirname "$0")/../support/script_support.sh"
 make_key
-netns_remove_stale '^st_(wsrv|wobs)_[0-9]+$'
-
-if ! ip netns add "$ns_srv" 2>"$work/netns_err.txt"; then
-  echo "SKIPPED: ip netns add not permitted here: $(cat "$work/netns_err.txt")"
-  exit $skip
-fi
+netns_start '^st_(wsrv|wobs)_[0-9]+$' "$ns_srv"
 set -e
 ip netns add "$ns_obs"
 ip link add "wa$tag" netns "$ns_srv" type veth peer name "wb$tag" netns "$ns_obs"
