@@ -7,6 +7,7 @@
 
 #include "messages/pose_mapping.h"
 #include "messages/validate.h"
+#include "models/contact_capability.h"
 #include "shape_frames.h"
 #include "server_wrench.h"
 
@@ -195,8 +196,9 @@ thread_shape_t BuildShape(const ShapeInputs& in) {
     msg.force[i] = Finite(in.force_model_units[i]) ? in.force_model_units[i] : 0.0;
   }
   // Self-contact: the closest points of each active pair (none without contact).
-  if (nodes.cols() > 0) {
-    for (const contact::ContactPoint& c : model.ActiveContacts(in.x, in.u)) {
+  const ContactCapability* const self_contact = model.contact();
+  if (nodes.cols() > 0 && self_contact != nullptr) {
+    for (const contact::ContactPoint& c : self_contact->ActiveContacts(in.x, in.u)) {
       std::vector<double> row(6, 0.0);
       for (int i = 0; i < 3; ++i) {
         row[i] = Finite(c.point_a[i]) ? c.point_a[i] : 0.0;

@@ -1,17 +1,17 @@
 #include "shape_frames.h"
 
-#include "models/rod_model.h"
+#include "models/frames_capability.h"
 
 namespace snapthread::server {
 
 void FillShapeFrames(const Model& model, const Vec& x, const Vec& u, thread_shape_t* msg) {
   msg->num_frames = 0;
   msg->frames.clear();
-  const auto* rod = dynamic_cast<const RodModel*>(&model);
-  if (rod == nullptr || x.size() != model.NumStates() || u.size() != model.NumControls()) return;
+  const FramesCapability* frames = model.frames();
+  if (frames == nullptr || x.size() != model.NumStates() || u.size() != model.NumControls()) return;
   Eigen::Matrix3Xd d1;
   Vec density;
-  rod->MaterialFrames(x, u, &d1, &density);
+  frames->MaterialFrames(x, u, &d1, &density);
   // A frame that is not finite is not drawable: send none rather than a made-up one.
   if (!d1.allFinite() || !density.allFinite()) return;
   msg->frames.reserve(static_cast<size_t>(d1.cols()));

@@ -1,5 +1,6 @@
-// thread_shape_t.frames for a viewer (issue 14 item 3): the rod's material director m1
-// and twist density per edge; every other model sends none.
+// thread_shape_t.frames for a viewer (issue 14 item 3): the material director m1 and
+// twist density per edge of a model with frames (FramesCapability, the rod); every other
+// model sends none.
 #pragma once
 
 #include "models/model.h"
@@ -8,9 +9,10 @@
 
 namespace snapthread::server {
 
-// Sets msg->frames / num_frames: for the rod (RodModel) one row per edge, (m1 x, y, z,
-// twist density in rad per model length), in the order of the edges (row j joins nodes j
-// and j + 1); otherwise, or when x / u do not fit the model or a value is not finite, none.
+// Sets msg->frames / num_frames: for a model with frames (Model::frames(), the rod) one
+// row per edge, (m1 x, y, z, twist density in rad per model length), in the order of the
+// edges (row j joins nodes j and j + 1); otherwise, or when x / u do not fit the model or
+// a value is not finite, none.
 void FillShapeFrames(const Model& model, const Vec& x, const Vec& u, thread_shape_t* msg);
 
 }  // namespace snapthread::server

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "models/registry.h"
+#include "models/symmetry_capability.h"
 #include "sweep.h"
 #include "test_util.h"
 
@@ -21,7 +22,8 @@ std::vector<SweepRow> AxisSweep(const std::string& method) {
   return RunSweep(MakeTracker(scene).get(), PathControls(scene, 200));
 }
 
-// The thread3d model with its symmetry hidden: what the solvers saw before.
+// The thread3d model with its symmetry hidden (symmetry() stays null): what the solvers
+// saw before.
 class WithoutSymmetries final : public Model {
  public:
   explicit WithoutSymmetries(std::unique_ptr<Model> m) : m_(std::move(m)) {}
@@ -49,7 +51,9 @@ class WithoutSymmetries final : public Model {
 TEST(Symmetry, TheRollLeavesTheEnergyOnTheAxisAndItsGeneratorIsAKernelVector) {
   const Scene scene = testing::SceneFile("thread3d_axis_cross.yaml");
   const auto model = MakeModel(scene.params);
-  ASSERT_EQ(model->NumSymmetries(), 1);
+  const SymmetryCapability* roll = model->symmetry();
+  ASSERT_NE(roll, nullptr);
+  ASSERT_EQ(roll->NumSymmetries(), 1);
   Vec u(3);
   u << 7.0, 0.0, 0.0;
   // An equilibrium on the axis (the buckled thread), then rolled.
@@ -59,23 +63,23 @@ TEST(Symmetry, TheRollLeavesTheEnergyOnTheAxisAndItsGeneratorIsAKernelVector) {
   const Vec x = tracker->state();
   Vec y, g, gy;
   for (double t : {0.3, 1.0, 3.0}) {
-    model->ApplySymmetry(0, t, x, u, &y);
+    roll->ApplySymmetry(0, t, x, u, &y);
     EXPECT_NEAR(model->Energy(y, u), model->Energy(x, u), 1e-12) << "t = " << t;
     EXPECT_GT((y - x).norm(), 0.1) << "the roll moves the buckled thread";
   }
   // The generator is the roll's derivative, and E_xx g = 0 at the equilibrium.
-  model->SymmetryGenerator(0, x, u, &g);
+  roll->SymmetryGenerator(0, x, u, &g);
   const double h = 1e-6;
   Vec yp, ym;
-  model->ApplySymmetry(0, h, x, u, &yp);
-  model->ApplySymmetry(0, -h, x, u, &ym);
+  roll->ApplySymmetry(0, h, x, u, &yp);
+  roll->ApplySymmetry(0, -h, x, u, &ym);
   EXPECT_LT(((yp - ym) / (2 * h) - g).norm(), 1e-8 * g.norm());
   SparseMatrix hess = model->HessianPattern();
   model->Hessian(x, u, &hess);
   EXPECT_LT((hess * g).norm(), 1e-6 * g.norm());
   // Off the axis the roll costs energy.
   u[1] = 0.3;
-  model->ApplySymmetry(0, 3.0, x, u, &y);
+  roll->ApplySymmetry(0, 3.0, x, u, &y);
   EXPECT_GT(std::abs(model->Energy(y, u) - model->Energy(x, u)), 1e-4);
 }
 

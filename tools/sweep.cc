@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "models/grasp_torque_capability.h"
 
 namespace snapthread {
 
@@ -47,6 +48,7 @@ std::vector<Vec> PathControls(const Scene& scene, int steps_per_leg) {
 std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls) {
   std::vector<SweepRow> rows;
   rows.reserve(controls.size());
+  const GraspTorqueCapability* const grasp_torque = tracker->model().grasp_torque();
   for (size_t i = 0; i < controls.size(); ++i) {
     const TrackResult& r = i == 0 ? tracker->Reset(controls[i]) : tracker->Update(controls[i]);
     SweepRow row;
@@ -63,7 +65,7 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
     row.gradient_evaluations = r.summary.gradient_evaluations;
     row.hessian_evaluations = r.summary.hessian_evaluations;
     row.negative_pivots = r.summary.negative_pivots;
-    if (!tracker->model().GraspTorque(row.state, row.u, &row.torque)) row.torque.setZero();
+    if (grasp_torque != nullptr) grasp_torque->GraspTorque(row.state, row.u, &row.torque);
     row.snapped = i > 0 && r.snapped;
     row.status = r.summary.status;
     row.termination = r.summary.termination;

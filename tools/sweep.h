@@ -28,7 +28,7 @@ struct SweepRow {
   double probe = 0.0, energy = 0.0, residual = 0.0, lambda_min = 0.0, solve_us = 0.0;
   int iterations = 0, gradient_evaluations = 0, hessian_evaluations = 0;
   int negative_pivots = 0;  // of E_xx at the equilibrium (its inertia)
-  Eigen::Vector3d torque = Eigen::Vector3d::Zero();  // Model::GraspTorque, 0 without one
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();  // GraspTorqueCapability, 0 without one
   bool snapped = false;
   EquilibriumStatus status = EquilibriumStatus::kRegular;
   Termination termination = Termination::kConverged;
@@ -50,7 +50,7 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
 // step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,solve_us
 // A grasp that holds its orientation (layout.grip_rotation, the rod) adds, at the end,
 // roll_deg (the x component of the grasp's rotation vector, degrees: the roll about the
-// start tangent), t_x,t_y,t_z (Model::GraspTorque: the torque of the model on the hand
+// start tangent), t_x,t_y,t_z (GraspTorqueCapability: the torque of the model on the hand
 // about the grasp point, world frame) and negative_pivots (the inertia of E_xx: an unstable equilibrium has > 0).
 // A scene with several grasps keeps those columns for its first grasp and adds, at the
 // end, u2_x,u2_y,u2_z,f2_x,f2_y,f2_z for the second (u3_*, f3_* for a third, ...).

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "models/band_assembly_capability.h"
 #include "models/hessian_assembly.h"
 #include "models/model.h"
 #include "models/params.h"
@@ -23,7 +24,7 @@
 namespace snapthread::internal {
 
 template <class Derived>
-class ChainModel : public Model {
+class ChainModel : public Model, public BandAssemblyCapability {
  public:
   int NumStates() const override { return assembly_.NumStates(); }
   int NumControls() const override { return assembly_.NumControls(); }
@@ -91,6 +92,7 @@ class ChainModel : public Model {
     return e + Self().ContactEnergy(x, u);
   }
 
+  const BandAssemblyCapability* band_assembly() const override { return this; }
   bool EnergyGradientAndBandHessian(const Vec& x, const Vec& u, Vec* g, double* band, int bandwidth,
                                     double* energy) const override {
     // Self-contact adds its pairs through the compressed matrix only.

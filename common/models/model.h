@@ -1,5 +1,8 @@
 // The energy model interface: every system of the seed (zeeman, cusp, curve2d,
-// thread3d) is a smooth energy E(x, u) of internal state x and controls u (the grasp).
+// thread3d) and the rod is a smooth energy E(x, u) of internal state x and controls u
+// (the grasp). Model holds what every model has; what only some can do (self-contact,
+// symmetries, lagged history, material frames, band assembly, grasp torque) is an
+// optional capability, a small interface of its own reached through an accessor below.
 //
 // Conventions
 //  * x has NumStates() entries, u has NumControls() entries.
@@ -14,17 +17,20 @@
 //    their size is wrong (so a caller that keeps them allocated pays nothing).
 #pragma once
 
-#include <memory>
-#include <string>
 #include <string_view>
-#include <vector>
 
 #include <Eigen/Core>
 
-#include "contact/self_contact.h"
 #include "numeric/types.h"
 
 namespace snapthread {
+
+class BandAssemblyCapability;    // models/band_assembly_capability.h
+class ContactCapability;         // models/contact_capability.h
+class FramesCapability;          // models/frames_capability.h
+class GraspTorqueCapability;     // models/grasp_torque_capability.h
+class HistoryCapability;         // models/history_capability.h
+class SymmetryCapability;        // models/symmetry_capability.h
 
 // What a grasp is, as a device sees it: a position with `spatial_dimension` coordinates
 // (2 for planar models, 3 in space), followed by a unit grip direction (3 numbers) when
@@ -47,7 +53,7 @@ class Model {
   virtual std::string_view Name() const = 0;
   virtual int NumStates() const = 0;
   virtual int NumControls() const = 0;
-  // 2 for planar models (u = (X, Y)), 3 for thread3d.
+  // 2 for planar models (u = (X, Y)), 3 for thread3d and the rod.
   virtual int SpatialDimension() const = 0;
 
   virtual double Energy(const Vec& x, const Vec& u) const = 0;
@@ -56,34 +62,31 @@ class Model {
   // E_xx with the pattern of HessianPattern(). A model with self-contact changes that
   // pattern (the blocks of the segment pairs near contact, models/contact_terms.h) inside
   // a Hessian evaluation, rarely; HessianPatternVersion() then moves, Hessian() gives
-  // *h the new structure, and a solver analyses its factorisation again. 0 for the rest.
+  // *h the new structure, and a solver analyses its factorisation again. The version is
+  // part of the Hessian's contract, not a capability: a fixed pattern is version 0
+  // forever, which is the default.
   virtual const SparseMatrix& HessianPattern() const = 0;
   virtual int HessianPatternVersion() const { return 0; }
   virtual void Hessian(const Vec& x, const Vec& u, SparseMatrix* h) const = 0;
-  // E_x and E_xx at one state, the same values as Gradient() and Hessian(); a model may
-  // fuse the two passes over its terms (the solvers call this where both are needed).
+
+  // Fused evaluations (GradientAndHessian, EnergyGradientAndHessian and, below,
+  // ControlDerivatives) are no capabilities: every model has them, as the separate calls
+  // (the defaults, the same values). They are the solvers' and the tracker's hot path, a
+  // model overrides one only to make one pass over its terms instead of two or three, and
+  // a default keeps that path one virtual call for every model.
+  //
+  // E_x and E_xx at one state, the same values as Gradient() and Hessian() (the solvers
+  // call this where both are needed).
   virtual void GradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
     Gradient(x, u, g);
     Hessian(x, u, h);
   }
   // E(x, u), E_x and E_xx at one state, the same values as Energy(), Gradient() and
-  // Hessian() (to the last bit); returns E. A model may fuse the three passes over its
-  // terms (a converged solve needs all three at its warm start).
+  // Hessian() (to the last bit); returns E (a converged solve needs all three at its warm
+  // start).
   virtual double EnergyGradientAndHessian(const Vec& x, const Vec& u, Vec* g, SparseMatrix* h) const {
     GradientAndHessian(x, u, g, h);
     return Energy(x, u);
-  }
-  // The same with E_xx written straight into band storage instead of a compressed
-  // matrix: the lower band of half-bandwidth `bandwidth` (linalg/banded_ldlt.h's layout,
-  // A(i, j), i >= j, at band[i (bandwidth + 1) + j - i + bandwidth]; every other slot of
-  // the NumStates() (bandwidth + 1) array is set to 0), the values Hessian() gives (to
-  // the last bit, but for the sign of a zero). Returns
-  // false, writing nothing, where the model cannot (the default; a chain with
-  // self-contact; another bandwidth than HessianBandwidth()). The solvers' banded
-  // factorisation then skips the copy from a compressed matrix.
-  virtual bool EnergyGradientAndBandHessian(const Vec& /*x*/, const Vec& /*u*/, Vec* /*g*/, double* /*band*/,
-                                            int /*bandwidth*/, double* /*energy*/) const {
-    return false;
   }
   // E_u, size NumControls(). The force on the grasp is F = -E_u (envelope theorem, §2.3.4).
   virtual void ControlGradient(const Vec& x, const Vec& u, Vec* eu) const = 0;
@@ -91,21 +94,13 @@ class Model {
   virtual void MixedHessian(const Vec& x, const Vec& u, Mat* exu) const = 0;
   // E_uu, NumControls() x NumControls().
   virtual void ControlHessian(const Vec& x, const Vec& u, Mat* euu) const = 0;
-  // E_u, E_xu and E_uu at one state, the same values as the three above; a model may
-  // fuse their passes over the terms that touch the controls (the tracker's force and K).
+  // E_u, E_xu and E_uu at one state, the same values as the three above (fused: the
+  // tracker's force and K).
   virtual void ControlDerivatives(const Vec& x, const Vec& u, Vec* eu, Mat* exu, Mat* euu) const {
     ControlGradient(x, u, eu);
     MixedHessian(x, u, exu);
     ControlHessian(x, u, euu);
   }
-  // A grasp that holds its orientation (GraspLayout::grip_rotation): the torque of the
-  // model on the hand about the grasp point, world frame, -dE/dδ for a small world
-  // rotation exp([δ]×) of the grasp (the rotation part of -E_u is that torque only while
-  // the rotation vector stays on one axis, and loses it at whole turns). false: none.
-  virtual bool GraspTorque(const Vec& /*x*/, const Vec& /*u*/, Eigen::Vector3d* /*torque*/) const {
-    return false;
-  }
-
   // A natural starting state for controls u (straight thread, wheel at theta = 0, ...).
   virtual Vec InitialState(const Vec& u) const = 0;
   // Node positions for drawing (3 x k, z = 0 for planar models). For zeeman: the
@@ -120,49 +115,26 @@ class Model {
   // not known (a pattern that changes: self-contact).
   virtual int HessianBandwidth() const = 0;
 
-  // Called by the tracker after it accepted the equilibrium x at controls u (after the
-  // force and stiffness of that update were computed). A model whose energy is written
-  // against lagged data (the rod's time-parallel reference frames, docs/models-rod.md)
-  // moves that data to the accepted state here; at x itself E and the equilibrium do not
-  // change. Models without history (zeeman, cusp, curve2d, thread3d) have nothing to do.
-  virtual void AcceptState(const Vec& /*x*/, const Vec& /*u*/) {}
-  // Called by the tracker's Reset before InitialState: forget the lagged data, so a
-  // reset starts from the same model a fresh one would be (the rod untwists: its grasp
-  // turn count goes back to the rest frames').
-  virtual void ResetHistory() {}
-
-  // Self-contact (issue 15; models/contact_terms.h), for models whose segments are
-  // capsules that must not pass through each other. Continuous collision detection: the
-  // largest alpha in (0, 1] such that the straight step from x to x + alpha dx at
-  // controls u moves no segment through another and keeps every pair's gap above a
-  // tenth of its value at x (0 if two segments already touch). Every solver step is
-  // scaled by it. Models without contact: 1.
-  virtual double MaxStepFraction(const Vec& /*x*/, const Vec& /*dx*/, const Vec& /*u*/) const { return 1.0; }
-  // The same for a motion that also moves the controls (the tracker's predictor): the
-  // node positions go on a straight line from those of (x0, u0) to those of (x1, u1).
-  virtual double MaxMotionFraction(const Vec& /*x0*/, const Vec& /*u0*/, const Vec& /*x1*/,
-                                   const Vec& /*u1*/) const {
-    return 1.0;
-  }
-  // The active contact pairs with their closest points (status and drawing; allocates).
-  virtual std::vector<contact::ContactPoint> ActiveContacts(const Vec& /*x*/, const Vec& /*u*/) const {
-    return {};
-  }
-
-  // Continuous symmetries: one-parameter groups of rotations x -> S_k(t) x (period 2 pi)
-  // that leave E(., u) unchanged for controls on the rotation's axis and nearly so near
-  // it (a thread3d grasp on the clamp axis lets the thread roll about it at no cost).
-  // Their generators span null directions of E_xx there, along which Newton steps are
-  // singular and straight steps crawl round the circle; the solvers step in the
-  // complement and move along the orbit itself (solvers/symmetry_orbits.h). The
-  // default is none: a model without such a symmetry has nothing to declare.
-  virtual int NumSymmetries() const { return 0; }
-  // The generator d/dt S_k(t) x at t = 0, size NumStates(). k < NumSymmetries().
-  virtual void SymmetryGenerator(int /*k*/, const Vec& x, const Vec& /*u*/, Vec* g) const {
-    g->setZero(x.size());
-  }
-  // y = S_k(t) x (t in radians). k < NumSymmetries().
-  virtual void ApplySymmetry(int /*k*/, double /*t*/, const Vec& x, const Vec& /*u*/, Vec* y) const { *y = x; }
+  // --- optional capabilities ------------------------------------------------------
+  // What only some models can do is asked through small interfaces, each with its own
+  // header (models/models.h includes them all). A caller asks once (the solver and the
+  // tracker when they are built, the sweep before its loop) and keeps the pointer for the
+  // model's lifetime: null means the model has no such capability, and the caller does
+  // what that means (a whole step, no history to move, no frames to draw, ...).
+  //
+  // Self-contact: continuous collision bounds and the active pairs (thread3d and the rod
+  // with contact enabled).
+  virtual const ContactCapability* contact() const { return nullptr; }
+  // Continuous symmetries of E (thread3d's roll about the clamp–grasp axis).
+  virtual const SymmetryCapability* symmetry() const { return nullptr; }
+  // Lagged data moved by the tracker at each accepted state (the rod's reference frames).
+  virtual HistoryCapability* history() { return nullptr; }
+  // Material frames for drawing (the rod).
+  virtual const FramesCapability* frames() const { return nullptr; }
+  // E, E_x and E_xx straight into band storage (the chains and the rod).
+  virtual const BandAssemblyCapability* band_assembly() const { return nullptr; }
+  // The torque of a grasp that holds its orientation (the rod).
+  virtual const GraspTorqueCapability* grasp_torque() const { return nullptr; }
 };
 
 }  // namespace snapthread

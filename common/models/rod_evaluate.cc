@@ -407,7 +407,7 @@ void RodModel::ControlGradient(const Vec& x, const Vec& u, Vec* eu) const {
   if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, gm), ContactControls(gm), eu->data());
 }
 
-bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const {
+void RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const {
   // The E_u of a grasp map differentiated in a world rotation δ instead of φ: the
   // rotation-vector gradient E_φ = J_l(φ)ᵀ E_δ loses the torque where J_l is singular
   // (|φ| = 2π, 4π: two turns of a roll).
@@ -420,7 +420,6 @@ bool RodModel::GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) 
   }
   if (contact_.enabled()) contact_.AddControlGradient(ContactNodes(x, gm), ContactControls(gm), e.data());
   *torque = -e.segment<3>(3);  // the first grasp's (edge 0's without a clamp)
-  return true;
 }
 
 void RodModel::MixedHessian(const Vec& x, const Vec& u, Mat* exu) const {

@@ -25,8 +25,13 @@
 
 #include <Eigen/Core>
 
+#include "models/band_assembly_capability.h"
+#include "models/contact_capability.h"
 #include "models/contact_terms.h"
+#include "models/frames_capability.h"
+#include "models/grasp_torque_capability.h"
 #include "models/hessian_assembly.h"
+#include "models/history_capability.h"
 #include "models/model.h"
 #include "models/rod_energy.h"
 
@@ -56,10 +61,23 @@ struct RodParams {
   bool IsValid(std::string* error) const;
 };
 
-class RodModel final : public Model {
+class RodModel final : public Model,
+                       public BandAssemblyCapability,
+                       public ContactCapability,
+                       public FramesCapability,
+                       public GraspTorqueCapability,
+                       public HistoryCapability {
  public:
   // Throws std::invalid_argument if !params.IsValid().
   explicit RodModel(const RodParams& params);
+
+  // Every capability but symmetries (the clamp and the grasp hold full poses); self-contact
+  // only where the params enable it.
+  const BandAssemblyCapability* band_assembly() const override { return this; }
+  const ContactCapability* contact() const override { return contact_.enabled() ? this : nullptr; }
+  const FramesCapability* frames() const override { return this; }
+  const GraspTorqueCapability* grasp_torque() const override { return this; }
+  HistoryCapability* history() override { return this; }
 
   std::string_view Name() const override { return "rod"; }
   int NumStates() const override { return nx_; }
@@ -86,7 +104,7 @@ class RodModel final : public Model {
   void ControlDerivatives(const Vec& x, const Vec& u, Vec* eu, Mat* exu, Mat* euu) const override;
   // -dE/dδ for a world rotation exp([δ]×) of the grasp: the torque about x_n (N m)
   // (free_start: of the first grasp, about x_0).
-  bool GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const override;
+  void GraspTorque(const Vec& x, const Vec& u, Eigen::Vector3d* torque) const override;
 
   // Nodes evenly spaced on the segment x_1 .. x_{n-1}, twist spread evenly.
   Vec InitialState(const Vec& u) const override;
@@ -101,7 +119,7 @@ class RodModel final : public Model {
   void AcceptState(const Vec& x, const Vec& u) override;
   // Back to the rest frames (straight along the clamp, no turns at the grasp).
   void ResetHistory() override;
-  // Self-contact (rod_contact.cc).
+  // Self-contact (rod_contact.cc): a whole step and no pairs without contact.
   double MaxStepFraction(const Vec& x, const Vec& dx, const Vec& u) const override;
   double MaxMotionFraction(const Vec& x0, const Vec& u0, const Vec& x1, const Vec& u1) const override;
   std::vector<contact::ContactPoint> ActiveContacts(const Vec& x, const Vec& u) const override;
@@ -120,7 +138,7 @@ class RodModel final : public Model {
   // [DVT (2)] averaged (edges 0 and n−1 have one interior vertex) over ℓ̄ = ℓ. A straight
   // rod whose held edges are turned by Φ against each other has Φ / ((n − 1) ℓ) on every
   // edge (the twist acts between the held edges' midpoints).
-  void MaterialFrames(const Vec& x, const Vec& u, Eigen::Matrix3Xd* d1, Vec* twist_density) const;
+  void MaterialFrames(const Vec& x, const Vec& u, Eigen::Matrix3Xd* d1, Vec* twist_density) const override;
   Vec TwistDensity(const Vec& x, const Vec& u) const;
   const RodParams& params() const { return p_; }
 

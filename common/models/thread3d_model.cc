@@ -24,8 +24,10 @@
 
 #include "models/chain_band_terms.h"
 #include "models/chain_model.h"
+#include "models/contact_capability.h"
 #include "models/contact_terms.h"
 #include "models/registry.h"
+#include "models/symmetry_capability.h"
 
 namespace snapthread {
 namespace {
@@ -48,7 +50,7 @@ int NumStatesFor(const ModelParams& p) {
 }
 int NumControlsFor(const ModelParams& p) { return p.Bool("grip_direction") ? 6 : 3; }
 
-class Thread3dModel final : public ChainModel<Thread3dModel> {
+class Thread3dModel final : public ChainModel<Thread3dModel>, public ContactCapability, public SymmetryCapability {
  public:
   explicit Thread3dModel(const ModelParams& params)
       : ChainModel(params, NumStatesFor(params), NumControlsFor(params)),
@@ -64,6 +66,9 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
 
   std::string_view Name() const override { return kName; }
   int SpatialDimension() const override { return 3; }
+  // Self-contact only where the scene enables it; the roll always.
+  const ContactCapability* contact() const override { return contact_.enabled() ? this : nullptr; }
+  const SymmetryCapability* symmetry() const override { return this; }
 
   // (3.7), (3.9) as the sums above: Σ γ/2 (l_i - L)² + Σ β/2 (1 - w_j·w_{j+1}) - N β B / 2.
   double Energy(const Vec& x, const Vec& u) const override {
@@ -386,19 +391,17 @@ class Thread3dModel final : public ChainModel<Thread3dModel> {
   }
 
  public:
+  // ContactCapability (contact() offers it only with contact enabled).
   double MaxStepFraction(const Vec& x, const Vec& dx, const Vec& u) const override {
-    if (!contact_.enabled()) return 1.0;
     contact_trial_ = x + dx;
     return MaxMotionFraction(x, u, contact_trial_, u);
   }
   double MaxMotionFraction(const Vec& x0, const Vec& u0, const Vec& x1, const Vec& u1) const override {
-    if (!contact_.enabled()) return 1.0;
     NodePositions(x0, u0, &contact_nodes_);
     NodePositions(x1, u1, &contact_to_);
     return contact_.self().MaxStepFraction(contact_nodes_, contact_to_);
   }
   std::vector<contact::ContactPoint> ActiveContacts(const Vec& x, const Vec& u) const override {
-    if (!contact_.enabled()) return {};
     Eigen::Matrix3Xd nodes;
     NodePositions(x, u, &nodes);
     return contact_.self().ActivePairs(nodes);

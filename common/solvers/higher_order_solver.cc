@@ -200,7 +200,7 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
     // Self-contact: the chord to the new state must not pass a segment through another
     // (CCD); a shorter step along the curve is tried instead.
     gm_ = xs_ - *x;
-    if (model().MaxStepFraction(*x, gm_, u) < 1.0) {
+    if (MaxStepFraction(*x, gm_, u) < 1.0) {
       alpha *= 0.5;
       continue;
     }

@@ -10,7 +10,11 @@
 namespace snapthread {
 
 SolverBase::SolverBase(const Model& model, const SolverOptions& options)
-    : model_(model), options_(options), n_(model.NumStates()) {
+    : model_(model),
+      contact_(model.contact()),
+      band_assembly_(model.band_assembly()),
+      options_(options),
+      n_(model.NumStates()) {
   if (n_ <= 0) throw std::invalid_argument("solver: the model has no state variables");
   Workspace& w = ws_;
   w.h = model_.HessianPattern();
@@ -97,7 +101,7 @@ void SolverBase::TakeNewtonStep(const Vec& u, Vec* x) {
   // Continuous collision detection (self-contact): a step that would carry one segment
   // through another is shortened to where every gap keeps a tenth of its size.
   ws_.dx_scratch = -ws_.dx;
-  const double alpha = model_.MaxStepFraction(*x, ws_.dx_scratch, u);
+  const double alpha = MaxStepFraction(*x, ws_.dx_scratch, u);
   if (alpha < 1.0) ws_.dx *= alpha;
   *x -= ws_.dx;
   factor_before_tiny_step_ = ws_.dx.lpNorm<Eigen::Infinity>() <= kReuseStep;
@@ -195,7 +199,8 @@ double SolverBase::EvalGradientAndHessian(const Vec& x, const Vec& u, SolverSumm
   // only if a globalised or reduction step asks for it, EnsureSparseHessian()).
   int bandwidth = -1;
   double* band = ws_.factor->AssemblyBand(&bandwidth);
-  if (band != nullptr && model_.EnergyGradientAndBandHessian(x, u, &ws_.g, band, bandwidth, &h_state_energy_)) {
+  if (band != nullptr && band_assembly_ != nullptr &&
+      band_assembly_->EnergyGradientAndBandHessian(x, u, &ws_.g, band, bandwidth, &h_state_energy_)) {
     band_ready_ = true;
     sparse_stale_ = true;
   } else {
@@ -214,7 +219,9 @@ bool SolverBase::AssembleBandAt(const Vec& x, const Vec& u) {
   int bandwidth = -1;
   double* band = ws_.factor->AssemblyBand(&bandwidth);
   double energy = 0.0;
-  if (band == nullptr || !model_.EnergyGradientAndBandHessian(x, u, &ws_.g_band, band, bandwidth, &energy)) return false;
+  if (band == nullptr || band_assembly_ == nullptr ||
+      !band_assembly_->EnergyGradientAndBandHessian(x, u, &ws_.g_band, band, bandwidth, &energy))
+    return false;
   sparse_stale_ = true;
   ws_.h_state = x;
   ws_.h_u = u;
@@ -364,7 +371,7 @@ bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, SolverSummary* s) {
   const double noise = 1e-13 * (1.0 + std::abs(e0));
   const double g0 = g->norm();
   // The line search starts where the step stops crossing nothing (self-contact CCD).
-  double alpha = model_.MaxStepFraction(*x, dx, u);
+  double alpha = MaxStepFraction(*x, dx, u);
   if (!(alpha > 0.0)) return false;
   for (int k = 0; k < 40; ++k) {
     w.trial = *x + alpha * dx;
@@ -442,11 +449,11 @@ bool SolverBase::MinimizeFully(const Vec& u, Vec* x, SolverSummary* s) {
       for (int k = 0; k < 30 && !moved; ++k, step *= 0.5) {
         // Either way only where no segment passes through another (self-contact CCD).
         ws_.dx_scratch = step * v;
-        const bool plus_ok = model_.MaxStepFraction(*x, ws_.dx_scratch, u) >= 1.0;
+        const bool plus_ok = MaxStepFraction(*x, ws_.dx_scratch, u) >= 1.0;
         trial = *x + ws_.dx_scratch;
         const double ep = plus_ok ? model_.Energy(trial, u) : kInf;
         ws_.dx_scratch = -ws_.dx_scratch;
-        const bool minus_ok = model_.MaxStepFraction(*x, ws_.dx_scratch, u) >= 1.0;
+        const bool minus_ok = MaxStepFraction(*x, ws_.dx_scratch, u) >= 1.0;
         trial = *x + ws_.dx_scratch;
         const double em = minus_ok ? model_.Energy(trial, u) : kInf;
         if (std::min(ep, em) < e0) {

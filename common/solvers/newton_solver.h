@@ -5,6 +5,8 @@
 #include <memory>
 #include <vector>
 
+#include "models/band_assembly_capability.h"
+#include "models/contact_capability.h"
 #include "solvers/eigen_tracking.h"
 #include "solvers/solver.h"
 #include "solvers/symmetry_orbits.h"
@@ -29,6 +31,11 @@ class SolverBase : public EquilibriumSolver {
 
  protected:
   const Model& model() const { return model_; }
+  // The model's collision bound on the step from x to x + dx (self-contact,
+  // ContactCapability::MaxStepFraction); 1, the whole step, for a model without.
+  double MaxStepFraction(const Vec& x, const Vec& dx, const Vec& u) const {
+    return contact_ == nullptr ? 1.0 : contact_->MaxStepFraction(x, dx, u);
+  }
   const SolverOptions& options() const { return options_; }
   int num_states() const { return n_; }
 
@@ -162,6 +169,9 @@ class SolverBase : public EquilibriumSolver {
   void LeaveSaddle(const Vec& u, Vec* x, SolverSummary* s);
 
   const Model& model_;
+  // The model's capabilities the solver uses, asked once (null: the model has none).
+  const ContactCapability* const contact_;
+  const BandAssemblyCapability* const band_assembly_;
   const SolverOptions options_;
   const int n_;
   Workspace ws_;

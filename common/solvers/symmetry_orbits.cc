@@ -14,7 +14,8 @@ constexpr int kGoldenSteps = 30;
 
 }  // namespace
 
-SymmetryOrbits::SymmetryOrbits(const Model& model) : model_(model) {
+SymmetryOrbits::SymmetryOrbits(const Model& model)
+    : model_(model), symmetry_(model.symmetry()), contact_(model.contact()) {
   const int n = model.NumStates();
   trial_.resize(n);
   best_.resize(n);
@@ -22,9 +23,10 @@ SymmetryOrbits::SymmetryOrbits(const Model& model) : model_(model) {
 
 bool SymmetryOrbits::MoveDownhill(const Vec& u, Vec* x) {
   bool moved = false;
-  for (int k = 0; k < model_.NumSymmetries(); ++k) {
+  if (symmetry_ == nullptr) return moved;
+  for (int k = 0; k < symmetry_->NumSymmetries(); ++k) {
     auto energy_at = [&](double t) {
-      model_.ApplySymmetry(k, t, *x, u, &trial_);
+      symmetry_->ApplySymmetry(k, t, *x, u, &trial_);
       return model_.Energy(trial_, u);
     };
     const double e0 = model_.Energy(*x, u);
@@ -67,11 +69,11 @@ bool SymmetryOrbits::MoveDownhill(const Vec& u, Vec* x) {
     }
     const double t = ec < ed ? c : d;
     if (std::min(ec, ed) < best_e) best_t = t;
-    model_.ApplySymmetry(k, best_t, *x, u, &best_);
+    symmetry_->ApplySymmetry(k, best_t, *x, u, &best_);
     // Self-contact: the move is a jump to the orbit's point; it must not carry a segment
     // through another on the way (CCD on the chord), else the orbit is left alone.
     trial_ = best_ - *x;
-    if (model_.MaxStepFraction(*x, trial_, u) < 1.0) continue;
+    if (contact_ != nullptr && contact_->MaxStepFraction(*x, trial_, u) < 1.0) continue;
     x->swap(best_);
     moved = true;
   }

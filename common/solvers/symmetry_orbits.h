@@ -1,4 +1,4 @@
-// Motion along a model's continuous symmetries (Model::NumSymmetries), for the snap
+// Motion along a model's continuous symmetries (SymmetryCapability), for the snap
 // minimiser. Where the grasp crosses a symmetry axis (a thread3d grasp crossing the clamp
 // axis), the followed state turns from a minimum into a saddle along the generator and
 // the new minimum lies half-way round the orbit. A Newton-type minimiser steps along
@@ -8,14 +8,17 @@
 // steps, whose quadratic model now holds (the rest of the state is the complement).
 #pragma once
 
+#include "models/contact_capability.h"
 #include "models/model.h"
+#include "models/symmetry_capability.h"
 
 namespace snapthread {
 
 class SymmetryOrbits {
  public:
   explicit SymmetryOrbits(const Model& model);
-  bool empty() const { return model_.NumSymmetries() == 0; }
+  // The model has no symmetry: MoveDownhill has nothing to do.
+  bool empty() const { return symmetry_ == nullptr; }
   // Moves x downhill along each symmetry orbit through it, as far as E keeps falling
   // (steps of 1/16 turn from t = 0 in the falling direction, the bottom refined by
   // golden section), when that lowers E beyond round-off. Returns true if x moved.
@@ -23,6 +26,9 @@ class SymmetryOrbits {
 
  private:
   const Model& model_;
+  // Asked once: the symmetries, and self-contact for the jump's collision check (null: none).
+  const SymmetryCapability* const symmetry_;
+  const ContactCapability* const contact_;
   Vec trial_, best_;
 };
 

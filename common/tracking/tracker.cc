@@ -7,7 +7,10 @@
 namespace snapthread {
 
 EquilibriumTracker::EquilibriumTracker(std::unique_ptr<Model> model, const SolverOptions& options)
-    : model_(std::move(model)), options_(options) {
+    : model_(std::move(model)),
+      history_(model_ ? model_->history() : nullptr),
+      contact_(model_ ? model_->contact() : nullptr),
+      options_(options) {
   if (!model_) throw std::invalid_argument("EquilibriumTracker: null model");
   solver_ = MakeSolver(*model_, options_);
   const int n = model_->NumStates(), m = model_->NumControls();
@@ -47,7 +50,7 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   if (u.size() != model_->NumControls())
     throw std::invalid_argument("EquilibriumTracker::Reset: control size mismatch");
   solver_->Reset();
-  model_->ResetHistory();
+  ResetModelHistory();
   x_ = model_->InitialState(u);
   u_ = u;
   // A reset must start on an equilibrium: unlimited, globalised solve.
@@ -80,7 +83,7 @@ const TrackResult& EquilibriumTracker::SolveAndStartHere() {
   ComputeForces();
   // After the force and K of this state (they use its factorisation): models with lagged
   // data (the rod's reference frames) move it to the accepted state.
-  model_->AcceptState(x_, u_);
+  AcceptModelState();
   return result_;
 }
 
@@ -90,12 +93,12 @@ const TrackResult& EquilibriumTracker::Resume(const Vec& x, const Vec& u) {
   if (!x.allFinite() || !u.allFinite())
     throw std::invalid_argument("EquilibriumTracker::Resume: non-finite state or controls");
   solver_->Reset();
-  model_->ResetHistory();
+  ResetModelHistory();
   x_ = x;
   u_ = u;
   // Lagged data (the rod's reference frames) from the model's start to the saved state,
   // so E(x, u) is the energy the state was accepted under.
-  model_->AcceptState(x_, u_);
+  AcceptModelState();
   return SolveAndStartHere();
 }
 
@@ -149,8 +152,16 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   // After a snap the secant would point along the jump: restart it (and during one).
   have_prev_ = !result_.snapped && result_.summary.status != EquilibriumStatus::kSnapping;
   ComputeForces();
-  model_->AcceptState(x_, u_);
+  AcceptModelState();
   return result_;
+}
+
+void EquilibriumTracker::ResetModelHistory() {
+  if (history_ != nullptr) history_->ResetHistory();
+}
+
+void EquilibriumTracker::AcceptModelState() {
+  if (history_ != nullptr) history_->AcceptState(x_, u_);
 }
 
 bool EquilibriumTracker::TangentPrediction(const Vec& u) {
@@ -179,11 +190,11 @@ void EquilibriumTracker::LimitPrediction(const Vec& u) {
   // old controls to x_pred_ at the new ones; it must not carry a segment through another.
   // Shorten the predicted change of the state (to none at all, where only the grasp
   // moves) until it does not.
-  if (model_->MaxMotionFraction(x_, u_, x_pred_, u) >= 1.0) return;
+  if (contact_ == nullptr || contact_->MaxMotionFraction(x_, u_, x_pred_, u) >= 1.0) return;
   scratch_ = x_pred_ - x_;
   for (int k = 1; k <= 4; ++k) {
     x_pred_ = x_ + std::ldexp(1.0, -k) * scratch_;
-    if (model_->MaxMotionFraction(x_, u_, x_pred_, u) >= 1.0) return;
+    if (contact_->MaxMotionFraction(x_, u_, x_pred_, u) >= 1.0) return;
   }
   x_pred_ = x_;
 }

@@ -4,7 +4,10 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
+#include "models/contact_capability.h"
+#include "models/history_capability.h"
 #include "models/model.h"
 #include "solvers/solver.h"
 
@@ -61,7 +64,10 @@ class EquilibriumTracker {
   const TrackResult& last() const { return result_; }
   // Self-contact of the current state: the active pairs and their closest points (the
   // server's solver_status_t.contacts and thread_shape_t.contacts; allocates).
-  std::vector<contact::ContactPoint> ActiveContacts() const { return model_->ActiveContacts(x_, u_); }
+  // None for a model without self-contact.
+  std::vector<contact::ContactPoint> ActiveContacts() const {
+    return contact_ == nullptr ? std::vector<contact::ContactPoint>{} : contact_->ActiveContacts(x_, u_);
+  }
   // A state change larger than this (max norm, model units) against the predicted
   // state counts as a jump to another branch (default 0.1; scenes set 0.1 l).
   void SetSnapThreshold(double t) { snap_threshold_ = t; }
@@ -71,14 +77,23 @@ class EquilibriumTracker {
   // state the start of the path (no predictor history, force and K, lagged model data).
   const TrackResult& SolveAndStartHere();
   // Shortens the predicted state change x_pred_ - x_ until the node motion from (x_, u_)
-  // to (x_pred_, u) passes no segment through another (self-contact; model.h).
+  // to (x_pred_, u) passes no segment through another (self-contact;
+  // ContactCapability::MaxMotionFraction). Nothing to do without self-contact.
   void LimitPrediction(const Vec& u);
   // x_pred_ -= the tangent step E_xx^-1 E_xu (u - u_) (capped at 5 snap thresholds);
   // false, x_pred_ unchanged, when there is no factorisation or the step is not finite.
   bool TangentPrediction(const Vec& u);
   void ComputeForces();
 
+  // Lagged model data (the rod's reference frames): forgotten at a reset, moved to every
+  // accepted state. Nothing to move for a model without history.
+  void ResetModelHistory();
+  void AcceptModelState();
+
   std::unique_ptr<Model> model_;
+  // The model's capabilities the tracker uses, asked once (null: the model has none).
+  HistoryCapability* const history_;
+  const ContactCapability* const contact_;
   SolverOptions options_;
   std::unique_ptr<EquilibriumSolver> solver_;
   Vec x_, x_prev_, u_, u_prev_;

@@ -1,4 +1,4 @@
-// The fused band assembly (Model::EnergyGradientAndBandHessian, model.h) against the
+// The fused band assembly (BandAssemblyCapability::EnergyGradientAndBandHessian) against the
 // separate calls, for the tests of the models that write E_xx straight into the banded
 // factorisation's storage (direct_assembly_test.cc, rod_evaluate_test.cc). Header-only:
 // for the test binaries that link the models.
@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "models/band_assembly_capability.h"
 #include "models/model.h"
 #include "numeric/types.h"
 
@@ -53,7 +54,8 @@ inline BandAssembly AssembleBand(const Model& m, const Vec& x, const Vec& u, int
   BandAssembly a;
   a.band.assign(static_cast<size_t>(m.NumStates()) * static_cast<size_t>(std::max(b, 0) + 1),
                 std::numeric_limits<double>::quiet_NaN());
-  a.written = m.EnergyGradientAndBandHessian(x, u, &a.g, a.band.data(), b, &a.e);
+  const BandAssemblyCapability* assembly = m.band_assembly();  // null: the model writes no band
+  a.written = assembly != nullptr && assembly->EnergyGradientAndBandHessian(x, u, &a.g, a.band.data(), b, &a.e);
   return a;
 }
 

@@ -77,7 +77,7 @@ struct PathRow {
   Spread backend_us;                  // the project's own backend: Factorize + Solve
   // Where an update's time goes, timed at the last row's state with the update's own
   // pieces: the model's E, E_x and E_xx written into the banded backend's band
-  // (Model::EnergyGradientAndBandHessian), FactorizeAssembled() of that band, one Solve().
+  // (BandAssemblyCapability), FactorizeAssembled() of that band, one Solve().
   // (count 0: the backend has no band, or the model does not write one)
   Spread assembly_us, factor_us, solve_us;
   CeresPathResult ceres;  // the first Ceres setting at the project's cutoff
