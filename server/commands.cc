@@ -1,7 +1,7 @@
 // The COMMAND channel: RESET, LOAD_SCENE and SET_METHOD, applied on the solve thread
 // between two updates. A refused command leaves the session as it was.
 //
-// Commands come from the network (issue 12 item 3): LOAD_SCENE takes a scene *name* from
+// Commands come from the network: LOAD_SCENE takes a scene *name* from
 // --scene-dir (scene_dir.h) and loads it on a loader thread with a time limit, so the
 // solve thread keeps serving the current scene; SET_METHOD is limited to --allow-methods.
 #include <chrono>
