@@ -52,22 +52,23 @@ int LcmServerTransport::Receive(int wait_ms, InboundSink* sink) {
 // LCM handlers must never throw; the sink does not.
 void LcmServerTransport::HandleDeviceState(const lcm::ReceiveBuffer* rbuf,
                                            const std::string& /*channel*/) {
-  if (sink_ == nullptr) return;
-  if (rbuf == nullptr) {
-    sink_->OnDeviceState(nullptr, 0);
-    return;
-  }
-  sink_->OnDeviceState(rbuf->data, rbuf->data_size);
+  Hand(rbuf, false);
 }
 
 void LcmServerTransport::HandleCommand(const lcm::ReceiveBuffer* rbuf,
                                        const std::string& /*channel*/) {
+  Hand(rbuf, true);
+}
+
+void LcmServerTransport::Hand(const lcm::ReceiveBuffer* rbuf, bool command) {
   if (sink_ == nullptr) return;
-  if (rbuf == nullptr) {
-    sink_->OnCommand(nullptr, 0);
-    return;
+  const void* data = rbuf != nullptr ? rbuf->data : nullptr;
+  const size_t size = rbuf != nullptr ? rbuf->data_size : 0;
+  if (command) {
+    sink_->OnCommand(data, size);
+  } else {
+    sink_->OnDeviceState(data, size);
   }
-  sink_->OnCommand(rbuf->data, rbuf->data_size);
 }
 
 }  // namespace snapthread::server

@@ -36,6 +36,8 @@ class LcmServerTransport final : public ServerTransport {
   void Subscribe();
   void HandleDeviceState(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void HandleCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  // The received bytes to the sink's OnCommand or OnDeviceState (during Receive only).
+  void Hand(const lcm::ReceiveBuffer* rbuf, bool command);
 
   std::unique_ptr<lcm::LCM> owned_;
   lcm::LCM* lcm_ = nullptr;

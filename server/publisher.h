@@ -7,6 +7,7 @@
 // Solve thread only.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 
@@ -32,9 +33,12 @@ class Publisher {
   bool SolverStatus(solver_status_t* msg);
 
  private:
-  // Signs msg for channel; false (and a publish failure counted) when it cannot be signed.
-  template <class Msg>
-  bool Sign(Msg* msg, const std::string& channel);
+  // Signs msg for channel and hands it to `publish` (a call of the transport); false (and
+  // a publish failure counted) when it cannot be signed or is refused; else counts it in
+  // *published (when given).
+  template <class Msg, class PublishFn>
+  bool Send(Msg* msg, const std::string& channel, PublishFn publish,
+            std::atomic<int64_t>* published);
 
   ServerTransport* transport_;
   messages::Channels channels_;

@@ -164,7 +164,7 @@ class ServerCheckpointTest : public ::testing::Test {
     ASSERT_TRUE(auth::Sign(&s, server_->channels().device_state, server_->epoch(),
                            auth_seq_.Next(), key_file_.key()));
     const int64_t before = server_->Stats().updates;
-    transport_->DeliverDeviceState(testing::Encoded(s));
+    transport_->DeliverDeviceState(test_support::Encode(s));
     ASSERT_TRUE(test_support::WaitUntil([&] { return server_->Stats().updates > before; }, kWaitS,
                                         0.0005));
   }
@@ -277,7 +277,7 @@ TEST_F(ServerCheckpointTest, LoadedSceneAndSwitchedMethodAreResumed) {
     command_t c = test_support::MakeCommand(code, argument);
     ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
                            key_file_.key()));
-    transport_->DeliverCommand(testing::Encoded(c));
+    transport_->DeliverCommand(test_support::Encode(c));
     ASSERT_TRUE(test_support::WaitUntil(
         [&] { return server_->Stats().commands_applied >= applied; }, kWaitS));
   };

@@ -86,7 +86,7 @@ class CommandsTest : public ::testing::Test {
         s.buttons = 1;
         if (auth::Sign(&s, server_->channels().device_state, server_->epoch(), auth_seq_.Next(),
                        key_file_.key())) {
-          transport_.DeliverDeviceState(testing::Encoded(s));
+          transport_.DeliverDeviceState(test_support::Encode(s));
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
@@ -106,7 +106,7 @@ class CommandsTest : public ::testing::Test {
     command_t c = MakeCommand(command, argument);
     ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
                            key_file_.key()));
-    transport_.DeliverCommand(testing::Encoded(c));
+    transport_.DeliverCommand(test_support::Encode(c));
   }
   bool WaitRefused(int64_t n) {
     return test_support::WaitUntil([&] { return server_->Stats().commands_refused >= n; }, kWaitS,

@@ -1,6 +1,7 @@
 // An in-memory ServerTransport (server/server_transport.h), so a whole Server runs in one
 // process without LCM: the test delivers datagrams as a device or an operator would send
-// them, and listens to what the server publishes, encoded as it would go on the wire.
+// them (test_support::Encode, sample_messages.h), and listens to what the server
+// publishes, encoded as it would go on the wire.
 #pragma once
 
 #include <atomic>
@@ -14,17 +15,10 @@
 #include <utility>
 #include <vector>
 
+#include "sample_messages.h"
 #include "server_transport.h"
 
 namespace snapthread::server::testing {
-
-// An LCM message as it would come off the wire.
-template <class Msg>
-std::vector<uint8_t> Encoded(const Msg& msg) {
-  std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
 
 // What the server publishes on.
 enum class Outbound { kForceModel, kShape, kSolverStatus };
@@ -87,7 +81,7 @@ class MemoryServerTransport final : public ServerTransport {
   template <class Msg>
   bool Send(Outbound channel, const Msg& msg) {
     if (refuse_) return false;
-    const std::vector<uint8_t> bytes = Encoded(msg);
+    const std::vector<uint8_t> bytes = test_support::Encode(msg);  // as on the wire
     for (const Listener& listener : listeners_) listener(channel, bytes);
     return true;
   }

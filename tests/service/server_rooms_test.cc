@@ -27,7 +27,7 @@ namespace snapthread::server {
 namespace {
 
 using server_test_support::MakePose;
-using testing::Encoded;
+using test_support::Encode;
 
 constexpr int64_t kEpoch = 0x1234;
 
@@ -39,12 +39,12 @@ class GateTest : public ::testing::Test {
     device_state_t s = MakePose(seq, Eigen::Vector3d(0.01, 0.0, 0.0));
     s.device_id = device;
     EXPECT_TRUE(auth::Sign(&s, channels_.device_state, epoch, auth_seq, key));
-    return Encoded(s);
+    return Encode(s);
   }
   std::vector<uint8_t> Command(int64_t epoch, int64_t auth_seq) {
     command_t c = test_support::MakeCommand(command_t::RESET, "");
     EXPECT_TRUE(auth::Sign(&c, channels_.command, epoch, auth_seq, key_));
-    return Encoded(c);
+    return Encode(c);
   }
   void GiveDeviceState(const std::vector<uint8_t>& bytes) { gate_.OnDeviceState(bytes.data(), bytes.size()); }
   void GiveCommand(const std::vector<uint8_t>& bytes) { gate_.OnCommand(bytes.data(), bytes.size()); }
@@ -72,7 +72,7 @@ TEST_F(GateTest, OnlyAuthenticFreshPosesReachTheInbox) {
   {
     device_state_t s = MakePose(5, Eigen::Vector3d::Zero());
     ASSERT_TRUE(auth::Sign(&s, channels_.command, kEpoch, 13, key_));
-    GiveDeviceState(Encoded(s));
+    GiveDeviceState(Encode(s));
   }
   EXPECT_EQ(counters_.rejected_messages.load(), 6);
   EXPECT_EQ(counters_.poses_received.load(), 1);

@@ -2,7 +2,7 @@
 // test delivers device states and commands as they would come off the wire and checks
 // the force models the server answers with against a direct EquilibriumTracker run, the
 // latest-wins rule, commands, and that bad packets are counted and dropped without ever
-// publishing a NaN. The LCM transport itself is checked over memq:// at the end.
+// publishing a NaN. The LCM transport itself: server_rooms_test.cc.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -18,9 +18,7 @@
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 
-#include "lcm_server_transport.h"
 #include "server_memory_transport.h"
 
 #include "command_message.h"
@@ -31,7 +29,6 @@
 #include "models/models.h"
 #include "scene/scene.h"
 #include "tracking/tracker.h"
-#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
@@ -93,13 +90,13 @@ class ServerTest : public ::testing::Test {
     device_state_t signed_state = s;
     ASSERT_TRUE(auth::Sign(&signed_state, server_->channels().device_state, server_->epoch(),
                            auth_seq_.Next(), key_file_.key()));
-    transport_.DeliverDeviceState(testing::Encoded(signed_state));
+    transport_.DeliverDeviceState(test_support::Encode(signed_state));
   }
   void Command(int8_t command, const std::string& argument) {
     command_t c = MakeCommand(command, argument);
     ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
                            key_file_.key()));
-    transport_.DeliverCommand(testing::Encoded(c));
+    transport_.DeliverCommand(test_support::Encode(c));
   }
   void PublishRaw(const std::string& channel, const std::vector<uint8_t>& bytes) {
     if (channel == server_->channels().command) {
@@ -421,11 +418,7 @@ TEST_F(ServerTest, BadPacketsAreCountedAndDropped) {
   const messages::Channels& ch = server_->channels();
   int bad = 0;
 
-  auto encode = [](const auto& msg) {
-    std::vector<uint8_t> buf(msg.getEncodedSize());
-    msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
-    return buf;
-  };
+  auto encode = [](const auto& msg) { return test_support::Encode(msg); };
   const device_state_t good = MakePose(1, Eigen::Vector3d(0.0, 0.0, 0.0));
   const std::vector<uint8_t> good_bytes = encode(good);
 
