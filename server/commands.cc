@@ -1,7 +1,7 @@
 // The COMMAND channel: RESET, LOAD_SCENE and SET_METHOD, applied on the solve thread
 // between two updates. A refused command leaves the session as it was.
 //
-// Commands come from the network (issue 12 item 3): LOAD_SCENE takes a scene *name* from
+// Commands come from the network: LOAD_SCENE takes a scene *name* from
 // --scene-dir (scene_dir.h) and loads it on a loader thread with a time limit, so the
 // solve thread keeps serving the current scene; SET_METHOD is limited to --allow-methods.
 #include <chrono>
@@ -13,14 +13,13 @@
 #include <spdlog/spdlog.h>
 
 #include "scene_dir.h"
-#include "server.h"
-#include "server_session.h"
+#include "solve_loop.h"
 #include "snapthread/force_model_t.hpp"
 #include "solvers/registry.h"
 
 namespace snapthread::server {
 
-void Server::ApplyCommand(const command_t& command) {
+void SolveLoop::ApplyCommand(const command_t& command) {
   std::string message;
   bool ok = true;
   bool rejected = false;
@@ -55,39 +54,9 @@ void Server::ApplyCommand(const command_t& command) {
       StartSceneLoad(command.argument);
       return;  // reported when the load ends (PollSceneLoad)
     }
-    case command_t::SET_METHOD: {
-      if (SolverRegistry::Global().Find(command.argument) == nullptr) {
-        ok = false;
-        message = "SET_METHOD refused: unknown method '" + command.argument + "' (expected " +
-                  SolverRegistry::Global().NamesText(", ", " or ") + ")";
-        break;
-      }
-      if (!params_.IsMethodAllowed(command.argument)) {
-        ok = false;
-        rejected = true;
-        message = "SET_METHOD refused: method '" + command.argument +
-                  "' is not in --allow-methods; keeping " + session_->tracker->options().method;
-        break;
-      }
-      // The loader builds the next session with method_override_: keep it fixed meanwhile.
-      if (load_.busy()) {
-        ok = false;
-        message = "SET_METHOD refused: LOAD_SCENE '" + load_name_ + "' is in progress, retry";
-        break;
-      }
-      try {
-        SolverOptions options = session_->tracker->options();
-        options.method = command.argument;
-        session_->tracker->SetOptions(options);
-        session_->scene.solver = options;
-        method_override_ = command.argument;
-        message = "SET_METHOD: now " + command.argument;
-      } catch (const std::exception& e) {
-        ok = false;
-        message = std::string("SET_METHOD failed: ") + e.what();
-      }
+    case command_t::SET_METHOD:
+      ok = SetMethod(command.argument, &message, &rejected);
       break;
-    }
     default:
       ok = false;
       message = "unknown command " + std::to_string(command.command);
@@ -95,27 +64,58 @@ void Server::ApplyCommand(const command_t& command) {
   FinishCommand(command.command, ok, message, rejected);
 }
 
-void Server::StartSceneLoad(const std::string& name) {
+bool SolveLoop::SetMethod(const std::string& method, std::string* message, bool* rejected) {
+  if (SolverRegistry::Global().Find(method) == nullptr) {
+    *message = "SET_METHOD refused: unknown method '" + method + "' (expected " +
+               SolverRegistry::Global().NamesText(", ", " or ") + ")";
+    return false;
+  }
+  if (!params_.IsMethodAllowed(method)) {
+    *rejected = true;
+    *message = "SET_METHOD refused: method '" + method +
+               "' is not in --allow-methods; keeping " + session_->tracker->options().method;
+    return false;
+  }
+  // The loader builds the next session with method_override_: keep it fixed meanwhile.
+  if (load_.busy()) {
+    *message = "SET_METHOD refused: LOAD_SCENE '" + load_name_ + "' is in progress, retry";
+    return false;
+  }
+  try {
+    SolverOptions options = session_->tracker->options();
+    options.method = method;
+    session_->tracker->SetOptions(options);
+    session_->scene.solver = options;
+    method_override_ = method;
+    *message = "SET_METHOD: now " + method;
+  } catch (const std::exception& e) {
+    *message = std::string("SET_METHOD failed: ") + e.what();
+    return false;
+  }
+  return true;
+}
+
+void SolveLoop::StartSceneLoad(const std::string& name) {
   load_name_ = name;
   const std::string dir = params_.scene_dir;
   const auto limit = std::chrono::duration_cast<BackgroundJob<Session>::Clock::duration>(
       std::chrono::duration<double>(params_.load_timeout_s));
   spdlog::info("server: LOAD_SCENE '{}': loading from {}", name, dir);
-  // The loader reads params_, hooks_ and method_override_ (fixed while it runs) and
+  // The loader reads hooks_ and the settings (fixed while it runs: SET_METHOD waits) and
   // builds a new session; it never touches session_.
   load_.Start(
-      [this, dir, name]() -> std::unique_ptr<Session> {
+      [this, dir, name, settings = Settings()]() -> std::unique_ptr<Session> {
         if (hooks_.before_load) hooks_.before_load();
         std::string path;
         const std::string text = ReadSceneByName(dir, name, &path);
-        std::unique_ptr<Session> session = MakeSession(ParseScene(text, path));
+        std::unique_ptr<Session> session = MakeSession(ParseScene(text, path), settings);
         session->scene_text = text;  // for checkpoints
         return session;
       },
       limit);
 }
 
-bool Server::PollSceneLoad() {
+bool SolveLoop::PollSceneLoad() {
   std::unique_ptr<Session> next;
   BackgroundJob<Session>::Failure failure;
   const std::string keeping = "keeping scene '" + session_->scene.name + "'";
@@ -150,23 +150,23 @@ bool Server::PollSceneLoad() {
   return false;
 }
 
-void Server::FinishCommand(int8_t command, bool ok, const std::string& message, bool rejected) {
+void SolveLoop::FinishCommand(int8_t command, bool ok, const std::string& message, bool rejected) {
   // The message first, then the counters: a caller that waits on a counter reads the
   // message of that command.
-  SetInfo(session_->scene.name, session_->tracker->options().method, &message);
+  SetInfo(&message);
   if (ok) {
     // A new start: the shape's snap count is "since the session (re)started".
     if (command != command_t::SET_METHOD) {
       snaps_since_reset_ = 0;
       last_status_ = force_model_t::STATUS_REGULAR;
-      for (double& f : last_force_n_) f = 0.0;
+      last_force_n_ = {0.0, 0.0, 0.0};
     }
     spdlog::info("server: {}", message);
-    commands_applied_.fetch_add(1);
+    counters_->commands_applied.fetch_add(1);
   } else {
     spdlog::warn("server: {}", message);
-    if (rejected) rejected_messages_.fetch_add(1);
-    commands_refused_.fetch_add(1);
+    if (rejected) counters_->rejected_messages.fetch_add(1);
+    counters_->commands_refused.fetch_add(1);
   }
 }
 

@@ -158,21 +158,13 @@ bool FoldBoundary::StillBeforeFold(const Vec& x, const Vec& u) const {
   return before;
 }
 
-void FoldBoundary::AfterUpdate(const EquilibriumTracker& tracker, const Vec& u,
-                               const Eigen::Vector4d& orientation) {
-  const TrackResult& r = tracker.last();
-  // A snap, a reset or a resume puts the tracker on another branch: its fold is another.
-  if (r.snapped || (have_last_ && (tracker.state() - x_last_).lpNorm<Eigen::Infinity>() >
-                                      10.0 * jump_threshold_)) {
-    if (!StillBeforeFold(tracker.state(), u)) NewBranch();
-  }
-  Collect();
-  // The hand went past the predicted boundary and the branch goes on: that fold is not
-  // this branch's here. A grip's controls are periodic and a branch is not: after a whole
-  // turn the state differs (thread3d_loop: the loop), so a fold found one turn on lies at
-  // controls the branch passes again without a snap, and the device must not switch
-  // there. Nor is a boundary the hand has passed without a snap (a device ignoring folds,
-  // one whose models came late) still ahead of it.
+// The hand went past the predicted boundary and the branch goes on: that fold is not
+// this branch's here. A grip's controls are periodic and a branch is not: after a whole
+// turn the state differs (thread3d_loop: the loop), so a fold found one turn on lies at
+// controls the branch passes again without a snap, and the device must not switch
+// there. Nor is a boundary the hand has passed without a snap (a device ignoring folds,
+// one whose models came late) still ahead of it.
+void FoldBoundary::DropPassedPrediction(const TrackResult& r, const Vec& u) {
   if (prediction_ != nullptr && !r.snapped && r.summary.IsSolutionUsable() &&
       prediction_->normal.size() == u.size() && prediction_->normal.dot(u - prediction_->u_fold) > 0.0) {
     if (spdlog::should_log(spdlog::level::debug)) {
@@ -182,6 +174,18 @@ void FoldBoundary::AfterUpdate(const EquilibriumTracker& tracker, const Vec& u,
     prediction_.reset();
     fold_id_ = 0;
   }
+}
+
+void FoldBoundary::AfterUpdate(const EquilibriumTracker& tracker, const Vec& u,
+                               const Eigen::Vector4d& orientation) {
+  const TrackResult& r = tracker.last();
+  // A snap, a reset or a resume puts the tracker on another branch: its fold is another.
+  if (r.snapped || (have_last_ && (tracker.state() - x_last_).lpNorm<Eigen::Infinity>() >
+                                      10.0 * jump_threshold_)) {
+    if (!StillBeforeFold(tracker.state(), u)) NewBranch();
+  }
+  Collect();
+  DropPassedPrediction(r, u);
 
   // Is a fold within reach? The square-root law: lambda^2 falls linearly with the
   // distance to the fold, so distance = lambda^2 / (lambda_prev^2 - lambda^2) * |du|.

@@ -86,6 +86,8 @@ class FoldBoundary {
   bool StillBeforeFold(const Vec& x, const Vec& u) const;
   // Takes a finished search's prediction (when it is for the current branch).
   void Collect();
+  // Forgets the prediction when the hand went past its boundary without a snap.
+  void DropPassedPrediction(const TrackResult& r, const Vec& u);
 
   Scene scene_;
   FoldSearch search_;  // used only by the running job

@@ -1,12 +1,12 @@
-// The hand-over from the LCM receive thread to the solve thread: the newest device pose
-// of each grasp (issue 15; device_state_t.grasp) (latest wins: a pose that arrives before
-// the solver took the previous one of its grasp replaces it,
-// so the solver never works through a queue of stale poses) and a short FIFO of commands
-// (commands are rare and must not be lost). One mutex and one condition variable; the
-// receive thread is not real-time, so blocking for a few microseconds is fine there.
-// Only authenticated messages enter it (the server's handlers put a pose or command here
-// after its MAC and freshness passed), so a grasp slot is never made from a forged name
-// and nothing unchecked can take the place of a genuine message.
+// The hand-over from the receive thread to the solve thread: the newest device pose of
+// each grasp (device_state_t.grasp; latest wins: a pose that arrives before the solver
+// took the previous one of its grasp replaces it, so the solver never works through a
+// queue of stale poses) and a short FIFO of commands (commands are rare and must not be
+// lost). One mutex and one condition variable; the receive thread is not real-time, so
+// blocking for a few microseconds is fine there. Only authenticated messages enter it
+// (the inbound gate, inbound_gate.h, puts a pose or command here after its MAC and
+// freshness passed), so a grasp slot is never made from a forged name and nothing
+// unchecked can take the place of a genuine message.
 #pragma once
 
 #include <chrono>

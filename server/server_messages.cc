@@ -64,6 +64,29 @@ double PlanarStiffness(const DeviceMapping& mapping) {
   return 0.5 * mapping.max_stiffness_n_per_m;
 }
 
+namespace {
+
+// The rod's grasp u = (p, φ): the wrench in the pose chart (server_wrench.h). Device
+// units: forces x N (n_per_f), torques x N/s (energy -> N m), position columns x s (per
+// model length -> per metre), rotation columns in radians as they are. Nothing when the
+// chart is singular there.
+void FillWrench(const Eigen::Matrix<double, 6, 1>& u, const Eigen::Matrix<double, 6, 1>& force,
+                const Mat6& stiffness, double n_per_f, double s, force_model_t* m) {
+  GraspWrench w;
+  if (!GraspWrenchFromControls(u, force, stiffness, &w)) return;
+  const double row_scale[6] = {n_per_f, n_per_f, n_per_f, n_per_f / s, n_per_f / s, n_per_f / s};
+  const double col_scale[6] = {s, s, s, 1.0, 1.0, 1.0};
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) m->K6[i][j] = row_scale[i] * col_scale[j] * w.k6(i, j);
+  }
+  for (int i = 0; i < 3; ++i) m->torque0[i] = (n_per_f / s) * w.torque[i];
+  for (int i = 0; i < 4; ++i) m->q0[i] = w.q0[i];
+  m->has_torque = 1;
+  m->has_wrench = 1;
+}
+
+}  // namespace
+
 force_model_t BuildForceModel(const ForceModelInputs& in) {
   force_model_t m{};
   m.utime = in.utime;
@@ -112,22 +135,8 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
   const bool rotation = in.layout != nullptr && in.layout->grip_rotation;
   const bool grip = in.layout != nullptr ? in.layout->grip_direction : gnu >= dim + 3;
   if (rotation && dim == 3 && gnu >= 6) {
-    // The rod's grasp u = (p, φ): the wrench in the pose chart (server_wrench.h). Device
-    // units: forces x N (n_per_f), torques x N/s (energy -> N m), position columns x s
-    // (per model length -> per metre), rotation columns in radians as they are.
-    GraspWrench w;
-    if (GraspWrenchFromControls(in.u.segment<6>(off), r.force.segment<6>(off),
-                                r.stiffness.block<6, 6>(off, off), &w)) {
-      const double row_scale[6] = {n_per_f, n_per_f, n_per_f, n_per_f / s, n_per_f / s, n_per_f / s};
-      const double col_scale[6] = {s, s, s, 1.0, 1.0, 1.0};
-      for (int i = 0; i < 6; ++i) {
-        for (int j = 0; j < 6; ++j) m.K6[i][j] = row_scale[i] * col_scale[j] * w.k6(i, j);
-      }
-      for (int i = 0; i < 3; ++i) m.torque0[i] = (n_per_f / s) * w.torque[i];
-      for (int i = 0; i < 4; ++i) m.q0[i] = w.q0[i];
-      m.has_torque = 1;
-      m.has_wrench = 1;
-    }
+    FillWrench(in.u.segment<6>(off), r.force.segment<6>(off), r.stiffness.block<6, 6>(off, off),
+               n_per_f, s, &m);
   } else if (grip && gnu >= dim + 3 && dim == 3) {
     // Grip direction d = u[3:6] (unit): the generalised force F_d = -E_d gives the torque
     // on the grip tau = d x F_d (a rotation w moves d by w x d, dE = w . (d x E_d)).

@@ -1,4 +1,4 @@
-// The server's checkpoints in one process over memq:// (issue 12 item 5): a server driven
+// The server's checkpoints in one process over an in-memory transport: a server driven
 // past the snap of curve2d_snap and back to a grasp where both branches exist is stopped;
 // a new server on the same --state-dir starts on the snapped branch (not the scene's
 // start), with a new epoch; LOAD_SCENE and SET_METHOD are resumed; a refused checkpoint
@@ -19,7 +19,6 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>
 
@@ -29,9 +28,10 @@
 #include "command_message.h"
 #include "environment.h"
 #include "messages/pose_mapping.h"
-#include "messages/subscribe.h"
+#include "messages/validate.h"
 #include "scene/scene.h"
 #include "server.h"
+#include "server_memory_transport.h"
 #include "session_key_file.h"
 #include "snapthread/thread_shape_t.hpp"
 #include "temp_dir.h"
@@ -60,7 +60,6 @@ double ShapeDistance(const thread_shape_t& a, const thread_shape_t& b) {
 class ServerCheckpointTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_TRUE(lcm_.good());
     scene_ = LoadScene(test_support::ScenePath("curve2d_snap.yaml"));
     previous_logger_ = spdlog::default_logger();
     ResetLog();
@@ -92,23 +91,30 @@ class ServerCheckpointTest : public ::testing::Test {
         last_state_ = t.state();
       };
     }
-    server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
-    shape_sub_ = messages::Subscribe<&ServerCheckpointTest::OnShape>(lcm_, server_->channels().shape,
-                                                                 this);
+    // A new transport per server (a restarted process), listened to before it starts.
+    transport_ = std::make_unique<testing::MemoryServerTransport>();
+    transport_->AddListener([this](testing::Outbound channel, const std::vector<uint8_t>& bytes) {
+      thread_shape_t shape;
+      if (channel == testing::Outbound::kShape &&
+          messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &shape, nullptr)) {
+        OnShape(shape);
+      }
+    });
+    server_ = std::make_unique<Server>(params, transport_.get(), std::move(hooks));
     server_->Start();
   }
   void StartServer() { StartServer(Params()); }
   void StopServer() {
     if (!server_) return;
     server_->Stop();
-    lcm_.unsubscribe(shape_sub_);
     server_.reset();
+    transport_.reset();
   }
 
-  void OnShape(const lcm::ReceiveBuffer*, const std::string&, const thread_shape_t* msg) {
+  void OnShape(const thread_shape_t& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (first_shapes_.count(msg->epoch) == 0) first_shapes_[msg->epoch] = *msg;
-    last_shape_ = *msg;
+    if (first_shapes_.count(msg.epoch) == 0) first_shapes_[msg.epoch] = msg;
+    last_shape_ = msg;
     ++shapes_;
   }
   // The first shape the running server published.
@@ -158,7 +164,7 @@ class ServerCheckpointTest : public ::testing::Test {
     ASSERT_TRUE(auth::Sign(&s, server_->channels().device_state, server_->epoch(),
                            auth_seq_.Next(), key_file_.key()));
     const int64_t before = server_->Stats().updates;
-    ASSERT_EQ(lcm_.publish(server_->channels().device_state, &s), 0);
+    transport_->DeliverDeviceState(test_support::Encode(s));
     ASSERT_TRUE(test_support::WaitUntil([&] { return server_->Stats().updates > before; }, kWaitS,
                                         0.0005));
   }
@@ -212,10 +218,9 @@ class ServerCheckpointTest : public ::testing::Test {
 
   test_support::SessionKeyFile key_file_;
   test_support::ScopedTempDir state_{"server-checkpoint"};
-  lcm::LCM lcm_{"memq://"};
+  std::unique_ptr<testing::MemoryServerTransport> transport_;
   Scene scene_;
   std::unique_ptr<Server> server_;
-  lcm::Subscription* shape_sub_ = nullptr;
   auth::AuthSequence auth_seq_;
   int64_t pose_seq_ = 0;
   std::mutex mutex_;
@@ -272,7 +277,7 @@ TEST_F(ServerCheckpointTest, LoadedSceneAndSwitchedMethodAreResumed) {
     command_t c = test_support::MakeCommand(code, argument);
     ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
                            key_file_.key()));
-    ASSERT_EQ(lcm_.publish(server_->channels().command, &c), 0);
+    transport_->DeliverCommand(test_support::Encode(c));
     ASSERT_TRUE(test_support::WaitUntil(
         [&] { return server_->Stats().commands_applied >= applied; }, kWaitS));
   };

@@ -1,4 +1,4 @@
-// Commands from the network (issue 12 item 3), the server in one process over memq://:
+// Commands from the network, the server in one process over an in-memory transport:
 // LOAD_SCENE by name only from --scene-dir (every way out of the directory refused and
 // counted), loads off the solve thread with a time limit while force models keep flowing,
 // and --allow-methods.
@@ -17,7 +17,6 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 
 #include "command_message.h"
 #include "auth/message_mac.h"
@@ -26,10 +25,10 @@
 #include "arrival_log.h"
 #include "environment.h"
 #include "messages/pose_mapping.h"
-#include "messages/subscribe.h"
 #include "scene/scene.h"
 #include "scene_dir.h"
 #include "server.h"
+#include "server_memory_transport.h"
 #include "temp_dir.h"
 
 namespace snapthread::server {
@@ -42,12 +41,11 @@ constexpr double kWaitS = 20.0;  // generous: the machine is shared
 
 using test_support::MakeCommand;
 
-// A server on memq:// answering a pose stream at ~200 Hz; records when each force model
+// A server in memory answering a pose stream at ~200 Hz; records when each force model
 // arrives so a test can bound the longest gap.
 class CommandsTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_TRUE(lcm_.good());
     scene_dir_ = std::make_unique<test_support::ScopedTempDir>("scene_dir");
     CopyScene("zeeman.yaml");
   }
@@ -55,7 +53,6 @@ class CommandsTest : public ::testing::Test {
   void TearDown() override {
     StopPoses();
     if (server_) server_->Stop();
-    if (sub_ != nullptr) lcm_.unsubscribe(sub_);
     server_.reset();
   }
 
@@ -70,8 +67,10 @@ class CommandsTest : public ::testing::Test {
     params.scene_dir = dir();
     params.log_level = "off";
     params.key_path = key_file_.path();
-    server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
-    sub_ = messages::Subscribe<&CommandsTest::OnModel>(lcm_, server_->channels().force_model, this);
+    server_ = std::make_unique<Server>(params, &transport_, std::move(hooks));
+    transport_.AddListener([this](testing::Outbound channel, const std::vector<uint8_t>&) {
+      if (channel == testing::Outbound::kForceModel) arrivals_.Mark();
+    });
     server_->Start();
     const Scene scene = LoadScene(params.scene_path);
     pose_ = messages::ControlsToPosition(scene.device, scene.grasp_layout, scene.grasp_start);
@@ -87,7 +86,7 @@ class CommandsTest : public ::testing::Test {
         s.buttons = 1;
         if (auth::Sign(&s, server_->channels().device_state, server_->epoch(), auth_seq_.Next(),
                        key_file_.key())) {
-          lcm_.publish(server_->channels().device_state, &s);
+          transport_.DeliverDeviceState(test_support::Encode(s));
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
@@ -100,7 +99,6 @@ class CommandsTest : public ::testing::Test {
     if (poser_.joinable()) poser_.join();
   }
 
-  void OnModel(const lcm::ReceiveBuffer*, const std::string&) { arrivals_.Mark(); }
   size_t Models() { return arrivals_.count(); }
   double MaxGapSince(size_t from) { return arrivals_.MaxGapSince(from); }
 
@@ -108,7 +106,7 @@ class CommandsTest : public ::testing::Test {
     command_t c = MakeCommand(command, argument);
     ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
                            key_file_.key()));
-    ASSERT_EQ(lcm_.publish(server_->channels().command, &c), 0);
+    transport_.DeliverCommand(test_support::Encode(c));
   }
   bool WaitRefused(int64_t n) {
     return test_support::WaitUntil([&] { return server_->Stats().commands_refused >= n; }, kWaitS,
@@ -121,10 +119,9 @@ class CommandsTest : public ::testing::Test {
 
   test_support::SessionKeyFile key_file_;
   auth::AuthSequence auth_seq_;
-  lcm::LCM lcm_{"memq://"};
+  testing::MemoryServerTransport transport_;
   std::unique_ptr<test_support::ScopedTempDir> scene_dir_;
   std::unique_ptr<Server> server_;
-  lcm::Subscription* sub_ = nullptr;
   Eigen::Vector3d pose_ = Eigen::Vector3d::Zero();
   std::thread poser_;
   std::atomic<bool> stop_poses_{false};

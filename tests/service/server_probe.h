@@ -1,5 +1,6 @@
 // What the in-process server tests (server_test.cc) observe and send: a probe that
-// collects the server's force models, shapes and statuses, and a device pose.
+// collects the server's force models, shapes and statuses from an in-memory transport
+// (server_memory_transport.h), and a device pose.
 #pragma once
 
 #include <chrono>
@@ -10,11 +11,9 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <lcm/lcm-cpp.hpp>
 
-#include "messages/channels.h"
-#include "messages/subscribe.h"
 #include "messages/validate.h"
+#include "server_memory_transport.h"
 #include "snapthread/device_state_t.hpp"
 #include "snapthread/force_model_t.hpp"
 #include "snapthread/solver_status_t.hpp"
@@ -25,24 +24,26 @@ namespace snapthread::server::server_test_support {
 // Generous: the machine is shared and noisy.
 inline constexpr std::chrono::seconds kWait{20};
 
-// Collects what the server publishes on the session's output channels. Its handlers run
-// on the server's receive thread (the server spins the shared LCM instance).
+// Collects what the server publishes, decoded and validated as a receiver would. It
+// listens on the server's solve thread; make it before the server starts and keep it
+// until the server stopped.
 class Probe {
  public:
-  Probe(lcm::LCM* lcm, const messages::Channels& ch) : lcm_(lcm) {
-    subs_.push_back(messages::Subscribe<&Probe::OnModel>(lcm, ch.force_model, this));
-    subs_.push_back(messages::Subscribe<&Probe::OnShape>(lcm, ch.shape, this));
-    subs_.push_back(messages::Subscribe<&Probe::OnStatus>(lcm, ch.solver_status, this));
+  explicit Probe(testing::MemoryServerTransport* transport) {
+    transport->AddListener([this](testing::Outbound channel, const std::vector<uint8_t>& bytes) {
+      switch (channel) {
+        case testing::Outbound::kForceModel:
+          Keep<force_model_t>(bytes, &models_);  // DecodeAndValidate: the one force-model check
+          break;
+        case testing::Outbound::kShape:
+          Keep<thread_shape_t>(bytes, &shapes_);
+          break;
+        case testing::Outbound::kSolverStatus:
+          Keep<solver_status_t>(bytes, &statuses_);
+          break;
+      }
+    });
   }
-  ~Probe() {
-    for (auto* s : subs_) lcm_->unsubscribe(s);
-  }
-
-  void OnModel(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    Keep<force_model_t>(rbuf, &models_);  // DecodeAndValidate: the one force-model check
-  }
-  void OnShape(const lcm::ReceiveBuffer* rbuf, const std::string&) { Keep<thread_shape_t>(rbuf, &shapes_); }
-  void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string&) { Keep<solver_status_t>(rbuf, &statuses_); }
 
   // Waits for a force model answering device_seq.
   bool WaitModel(int64_t device_seq, force_model_t* out) {
@@ -78,10 +79,11 @@ class Probe {
  private:
   // Decodes and validates a message into *kept; counts the rest.
   template <typename T>
-  void Keep(const lcm::ReceiveBuffer* rbuf, std::vector<T>* kept) {
+  void Keep(const std::vector<uint8_t>& bytes, std::vector<T>* kept) {
     T msg;
     std::string why;
-    const bool ok = messages::DecodeAndValidate(rbuf, &msg, &why);
+    const bool ok =
+        messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &msg, &why);
     std::lock_guard<std::mutex> lock(mutex_);
     if (!ok) {
       ++invalid_;
@@ -105,8 +107,6 @@ class Probe {
     });
   }
 
-  lcm::LCM* lcm_;
-  std::vector<lcm::Subscription*> subs_;
   std::mutex mutex_;
   std::condition_variable cv_;
   std::vector<force_model_t> models_;

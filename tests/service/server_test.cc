@@ -1,7 +1,8 @@
-// The server in one process over memq://: the test publishes device states and commands
-// on the same LCM instance the server uses and checks the force models it answers with
-// against a direct EquilibriumTracker run, the latest-wins rule, commands, and that bad
-// packets are counted and dropped without ever publishing a NaN.
+// The server in one process over an in-memory transport (server_memory_transport.h): the
+// test delivers device states and commands as they would come off the wire and checks
+// the force models the server answers with against a direct EquilibriumTracker run, the
+// latest-wins rule, commands, and that bad packets are counted and dropped without ever
+// publishing a NaN. The LCM transport itself: server_rooms_test.cc.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -17,7 +18,8 @@
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
+
+#include "server_memory_transport.h"
 
 #include "command_message.h"
 #include "messages/pose_mapping.h"
@@ -27,7 +29,6 @@
 #include "models/models.h"
 #include "scene/scene.h"
 #include "tracking/tracker.h"
-#include "messages/subscribe.h"
 #include "messages/validate.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
@@ -57,7 +58,6 @@ class ServerTest : public ::testing::Test {
  protected:
   void SetUp() override {
     ASSERT_FALSE(SourceDir().empty()) << "SNAPTHREAD_SOURCE_DIR is not set (run through ctest)";
-    ASSERT_TRUE(lcm_.good());
   }
 
   void StartServer(const std::string& scene_file, ServerTestHooks hooks = {},
@@ -68,8 +68,8 @@ class ServerTest : public ::testing::Test {
     params.scene_dir = scene_dir;
     params.log_level = "warn";
     params.key_path = key_file_.path();
-    server_ = std::make_unique<Server>(params, &lcm_, std::move(hooks));
-    probe_ = std::make_unique<Probe>(&lcm_, server_->channels());
+    server_ = std::make_unique<Server>(params, &transport_, std::move(hooks));
+    probe_ = std::make_unique<Probe>(&transport_);
     server_->Start();
   }
 
@@ -90,21 +90,26 @@ class ServerTest : public ::testing::Test {
     device_state_t signed_state = s;
     ASSERT_TRUE(auth::Sign(&signed_state, server_->channels().device_state, server_->epoch(),
                            auth_seq_.Next(), key_file_.key()));
-    ASSERT_EQ(lcm_.publish(server_->channels().device_state, &signed_state), 0);
+    transport_.DeliverDeviceState(test_support::Encode(signed_state));
   }
   void Command(int8_t command, const std::string& argument) {
     command_t c = MakeCommand(command, argument);
     ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
                            key_file_.key()));
-    ASSERT_EQ(lcm_.publish(server_->channels().command, &c), 0);
+    transport_.DeliverCommand(test_support::Encode(c));
   }
   void PublishRaw(const std::string& channel, const std::vector<uint8_t>& bytes) {
-    ASSERT_EQ(lcm_.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size())), 0);
+    if (channel == server_->channels().command) {
+      transport_.DeliverCommand(bytes);
+    } else {
+      ASSERT_EQ(channel, server_->channels().device_state);
+      transport_.DeliverDeviceState(bytes);
+    }
   }
 
   test_support::SessionKeyFile key_file_;
   auth::AuthSequence auth_seq_;
-  lcm::LCM lcm_{"memq://"};
+  testing::MemoryServerTransport transport_;
   std::unique_ptr<Server> server_;
   std::unique_ptr<Probe> probe_;
 };
@@ -413,11 +418,7 @@ TEST_F(ServerTest, BadPacketsAreCountedAndDropped) {
   const messages::Channels& ch = server_->channels();
   int bad = 0;
 
-  auto encode = [](const auto& msg) {
-    std::vector<uint8_t> buf(msg.getEncodedSize());
-    msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
-    return buf;
-  };
+  auto encode = [](const auto& msg) { return test_support::Encode(msg); };
   const device_state_t good = MakePose(1, Eigen::Vector3d(0.0, 0.0, 0.0));
   const std::vector<uint8_t> good_bytes = encode(good);
 
