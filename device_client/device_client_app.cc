@@ -1,25 +1,23 @@
 #include "device_client_app.h"
 
-#include <signal.h>
-
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <stdexcept>
-#include <thread>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "app/command_line.h"
+#include "app/common_flags.h"
+#include "app/exit_codes.h"
+#include "app/stop_signals.h"
 #include "auth/key_file.h"
 #include "auth/session_key.h"
 #include "device_client.h"
 #include "device_factory.h"
 #include "lcm_transport.h"
-#include "messages/channels.h"
 #include "messages/lcm_url.h"
 #include "realtime/clock.h"
 #include "safety.h"
@@ -29,19 +27,7 @@
 namespace snapthread::device {
 namespace {
 
-// Set by the SIGINT/SIGTERM handler (async-signal-safe: a lock-free atomic store).
-std::atomic<bool> g_stop_requested{false};
-static_assert(std::atomic<bool>::is_always_lock_free);
-
-void OnSignal(int) { g_stop_requested.store(true); }
-
-void InstallSignalHandlers() {
-  struct sigaction sa {};
-  sa.sa_handler = &OnSignal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
+constexpr const char* kProgram = "snapthread-device";
 
 double Seconds(int64_t us) { return 1e-6 * static_cast<double>(us); }
 
@@ -79,7 +65,7 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
       "  \"torque_slew_limits\": %llu,\n  \"wrench_models\": %llu,\n"
       "  \"statuses_accepted\": %llu,\n  \"statuses_rejected\": %llu,\n"
       "  \"statuses_superseded\": %llu,\n  \"statuses_oversized\": %llu,\n  \"realtime\": %s\n}\n",
-      o.backend.c_str(), o.session.c_str(), s.duration_s, u(s.ticks), s.tick_rate_hz,
+      o.backend.c_str(), o.common.session.c_str(), s.duration_s, u(s.ticks), s.tick_rate_hz,
       s.lateness_us.p50, s.lateness_us.p99, s.lateness_us_max, s.round_trip_us.p50,
       s.round_trip_us.p99, u(s.models_received), u(s.models_rejected), u(s.invalid_models),
       u(s.poses_rejected), u(s.force_clamps), u(s.stiffness_clamps), u(s.slew_limits),
@@ -95,7 +81,7 @@ bool WriteSummaryJson(const std::string& path, const DeviceClientOptions& o,
 // "Go on" from a step that may end the program with an exit code.
 constexpr int kContinue = -1;
 
-void PrintError(const std::string& what) { std::fprintf(stderr, "snapthread-device: %s\n", what.c_str()); }
+void PrintError(const std::string& what) { std::fprintf(stderr, "%s: %s\n", kProgram, what.c_str()); }
 
 // What RunDeviceClient sets up before the transport: the key, the scene and its grasp,
 // the backend (built, not open).
@@ -107,14 +93,9 @@ struct ClientSetup {
   Backend backend;
 };
 
-// The session name and the ranges CLI11's checks let through ("nan" fails no
-// comparison): kExitBadArguments naming the flag, or kContinue.
+// The ranges CLI11's checks let through ("nan" fails no comparison): app::kExitUsage
+// naming the flag, or kContinue.
 int CheckOptions(const DeviceClientOptions& o) {
-  if (!messages::IsValidSessionName(o.session)) {
-    std::fprintf(stderr, "snapthread-device: --session '%s': expected [A-Za-z0-9_]+\n",
-                 o.session.c_str());
-    return kExitBadArguments;
-  }
   const struct {
     const char* flag;
     bool ok;
@@ -135,7 +116,7 @@ int CheckOptions(const DeviceClientOptions& o) {
   for (const auto& range : ranges) {
     if (!range.ok) {
       std::fprintf(stderr, "snapthread-device: %s: out of range (see --help)\n", range.flag);
-      return kExitBadArguments;
+      return app::kExitUsage;
     }
   }
   return kContinue;
@@ -143,14 +124,10 @@ int CheckOptions(const DeviceClientOptions& o) {
 
 // The session key: without it nothing the server sends can be trusted.
 int LoadSessionKey(const DeviceClientOptions& o, ClientSetup* setup) {
-  try {
-    const auth::KeyLocation where = auth::ResolveKeyPath(o.key_path);
-    setup->key.emplace(auth::LoadKey(where));
-    spdlog::info("device: session key {} ({}), key id {}", where.path, where.origin, setup->key->Id());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "snapthread-device: --key: %s\n", e.what());
-    return kExitBadArguments;
-  }
+  auth::KeyLocation where;
+  setup->key = app::LoadSessionKey(o.common, kProgram, &where);  // says why it failed
+  if (!setup->key) return app::kExitUsage;
+  spdlog::info("device: session key {} ({}), key id {}", where.path, where.origin, setup->key->Id());
   return kContinue;
 }
 
@@ -161,7 +138,7 @@ int LoadSceneAndGrasp(const DeviceClientOptions& o, ClientSetup* setup) {
       setup->scene = LoadScene(o.scene_file);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "snapthread-device: --scene: %s\n", e.what());
-      return kExitBadArguments;
+      return app::kExitUsage;
     }
   }
   if (o.grasp.empty()) return kContinue;
@@ -170,13 +147,13 @@ int LoadSceneAndGrasp(const DeviceClientOptions& o, ClientSetup* setup) {
   if (setup->grasp >= 0) return kContinue;
   if (!scene) {
     PrintError("--grasp: needs --scene (the scene names the grasps)");
-    return kExitBadArguments;
+    return app::kExitUsage;
   }
   std::string names;
   for (const SceneGrasp& g : scene->grasps) names += (names.empty() ? "" : ", ") + g.name;
   PrintError("--grasp: no grasp '" + o.grasp + "' in the scene (its grasps: " +
              (names.empty() ? "one, unnamed" : names) + ")");
-  return kExitBadArguments;
+  return app::kExitUsage;
 }
 
 // The scripted path (--path-csv, or the scene's grasp path for a simulated backend) and
@@ -194,13 +171,13 @@ int MakeConfiguredBackend(const DeviceClientOptions& o, ClientSetup* setup) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "snapthread-device: %s: %s\n",
                  o.path_csv.empty() ? "--scene" : "--path-csv", e.what());
-    return kExitBadArguments;
+    return app::kExitUsage;
   }
   std::string error;
   setup->backend = MakeBackend(config, &error);
   if (!setup->backend.device) {
     std::fprintf(stderr, "snapthread-device: --backend %s: %s\n", o.backend.c_str(), error.c_str());
-    return kExitBadArguments;
+    return app::kExitUsage;
   }
   return kContinue;
 }
@@ -212,7 +189,7 @@ int OpenDevice(const DeviceClientOptions& o, const Backend& backend) {
   if (!backend.device->Open(&error)) {
     std::fprintf(stderr, "snapthread-device: backend %s failed to open: %s\n", o.backend.c_str(),
                  error.c_str());
-    return kExitRuntimeFailure;
+    return app::kExitFailure;
   }
   if (o.sim_render_file.empty()) return kContinue;
   bool started = false;
@@ -224,7 +201,7 @@ int OpenDevice(const DeviceClientOptions& o, const Backend& backend) {
   if (!started) {
     std::fprintf(stderr, "snapthread-device: --sim-render-file: %s\n", error.c_str());
     backend.device->Close();
-    return kExitBadArguments;
+    return app::kExitUsage;
   }
   return kContinue;
 }
@@ -260,7 +237,7 @@ void FillClientConfig(const DeviceClientOptions& o, const ClientSetup& setup, co
   cc->loop.realtime = o.realtime;
   cc->trace_file = o.trace_file;
   cc->key = &*setup.key;
-  cc->session = o.session;
+  cc->session = o.common.session;
   cc->snap_ahead = o.snap_ahead;
 }
 
@@ -269,7 +246,7 @@ void LogStart(const DeviceClientOptions& o, const std::string& url, const Device
   const SafetyLimits& limits = cc.limits;
   spdlog::info("device: {} session {} on {}; limits |F| <= {} N, stiffness <= {} N/m, "
                "slew {} N/s, timeout {} ms, fade {} ms, workspace {} m; orientation {}, torque {}",
-               cc.device_id, o.session, url, limits.max_force_n, limits.max_stiffness_n_per_m,
+               cc.device_id, o.common.session, url, limits.max_force_n, limits.max_stiffness_n_per_m,
                limits.max_force_rate_n_per_s, 1e3 * limits.model_timeout_s,
                1e3 * limits.fade_time_s, limits.workspace_radius_m,
                caps.has_orientation ? "sensed" : "not sensed",
@@ -280,7 +257,7 @@ void LogStart(const DeviceClientOptions& o, const std::string& url, const Device
 }
 
 // The open device's client configuration (limits checked, the path's reach warned
-// about, the start logged); the device closed and kExitBadArguments on invalid limits.
+// about, the start logged); the device closed and app::kExitUsage on invalid limits.
 int ConfigureClient(const DeviceClientOptions& o, const ClientSetup& setup, const std::string& url,
                     DeviceClientConfig* cc) {
   HapticDevice& device = *setup.backend.device;
@@ -289,7 +266,7 @@ int ConfigureClient(const DeviceClientOptions& o, const ClientSetup& setup, cons
   if (!MakeLimits(o, setup, caps, &cc->limits, &error)) {
     PrintError(error);
     device.Close();
-    return kExitBadArguments;
+    return app::kExitUsage;
   }
   const SafetyLimits& limits = cc->limits;
   const std::optional<ScriptedPath>& path = setup.config.path;
@@ -305,17 +282,18 @@ int ConfigureClient(const DeviceClientOptions& o, const ClientSetup& setup, cons
 
 // Runs the client until the duration elapses or SIGINT / SIGTERM arrives, then fades the
 // force to zero within the safety ramp (fade_time_s) before the servo loop stops.
-void RunUntilStopped(const DeviceClientOptions& o, double fade_time_s, DeviceClient* client) {
-  g_stop_requested.store(false);
-  InstallSignalHandlers();
+void RunUntilStopped(const DeviceClientOptions& o, double fade_time_s, app::StopSignals* stop,
+                     DeviceClient* client) {
   std::string notes;
   client->Start(&notes);
   if (!notes.empty()) spdlog::warn("{}", notes);
   if (o.realtime && client->realtime_active()) spdlog::info("servo: SCHED_FIFO active");
-  const int64_t start_us = client->start_us();
-  while (!g_stop_requested.load()) {
-    if (o.duration_s > 0.0 && Seconds(realtime::MonotonicMicros() - start_us) >= o.duration_s) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  // The main thread waits; the servo thread runs on (the signals are blocked in it).
+  if (o.duration_s <= 0.0) {
+    stop->Wait(0.0);  // no limit
+  } else if (const double left = o.duration_s - Seconds(realtime::MonotonicMicros() - client->start_us());
+             left > 0.0) {
+    stop->Wait(left);
   }
   if (!client->FadeOut(fade_time_s + 0.3)) {
     spdlog::warn("device: the force did not fade to zero within {} ms; stopping anyway",
@@ -324,7 +302,7 @@ void RunUntilStopped(const DeviceClientOptions& o, double fade_time_s, DeviceCli
   client->Stop();
 }
 
-// The run's summary: logged, and written to --summary (kExitRuntimeFailure when it
+// The run's summary: logged, and written to --summary (app::kExitFailure when it
 // cannot be).
 int ReportSummary(const DeviceClientOptions& o, DeviceClient& client, const LcmDeviceTransport& lcm) {
   DeviceClientSummary summary = client.Summary(realtime::MonotonicMicros());
@@ -333,34 +311,34 @@ int ReportSummary(const DeviceClientOptions& o, DeviceClient& client, const LcmD
   LogSummary(summary);
   if (!o.summary_file.empty() && !WriteSummaryJson(o.summary_file, o, summary)) {
     std::fprintf(stderr, "snapthread-device: --summary: cannot write %s\n", o.summary_file.c_str());
-    return kExitRuntimeFailure;
+    return app::kExitFailure;
   }
-  return kExitOk;
+  return app::kExitOk;
 }
 
 // The watchdog, path-speed and torque options of ParseDeviceClientArgs.
-void AddSafetyOptions(CLI::App& app, DeviceClientOptions* o) {
-  app.add_option("--model-timeout-ms", o->model_timeout_ms, "fade the force when the model is older")
+void AddSafetyOptions(CLI::App& cli, DeviceClientOptions* o) {
+  cli.add_option("--model-timeout-ms", o->model_timeout_ms, "fade the force when the model is older")
       ->check(CLI::Range(1.0, 10000.0))
       ->capture_default_str();
-  app.add_option("--fade-ms", o->fade_ms, "fade-out / fade-in time")
+  cli.add_option("--fade-ms", o->fade_ms, "fade-out / fade-in time")
       ->check(CLI::Range(1.0, 10000.0))
       ->capture_default_str();
-  app.add_option("--speed-m-per-s", o->speed_m_per_s, "scripted path speed")
+  cli.add_option("--speed-m-per-s", o->speed_m_per_s, "scripted path speed")
       ->check(CLI::Range(1e-6, 10.0))
       ->capture_default_str();
-  app.add_option("--angular-speed-deg-per-s", o->angular_speed_deg_per_s,
+  cli.add_option("--angular-speed-deg-per-s", o->angular_speed_deg_per_s,
                  "scripted path turning speed (a rod scene's roll_deg)")
       ->check(CLI::Range(1e-3, 3600.0))
       ->capture_default_str();
-  app.add_option("--max-torque-nm", o->max_torque_nm,
+  cli.add_option("--max-torque-nm", o->max_torque_nm,
                  "torque bound for devices with torque output (never above the device's own)")
       ->check(CLI::Range(0.0, 10.0))
       ->capture_default_str();
-  app.add_option("--max-torque-rate", o->max_torque_rate_nm_per_s, "torque slew limit, N m/s")
+  cli.add_option("--max-torque-rate", o->max_torque_rate_nm_per_s, "torque slew limit, N m/s")
       ->check(CLI::Range(1e-6, 1e4))
       ->capture_default_str();
-  app.add_option("--max-torque-stiffness", o->max_torque_stiffness_nm_per_rad,
+  cli.add_option("--max-torque-stiffness", o->max_torque_stiffness_nm_per_rad,
                  "bound on the rotational stiffness of a 6-DoF model, N m/rad")
       ->check(CLI::Range(0.0, 1e3))
       ->capture_default_str();
@@ -368,79 +346,63 @@ void AddSafetyOptions(CLI::App& app, DeviceClientOptions* o) {
 
 }  // namespace
 
-int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
-  CLI::App app{"snapthread-device: 1 kHz haptic device client (servo loop, local force model, "
+std::optional<int> ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* o) {
+  CLI::App cli{"snapthread-device: 1 kHz haptic device client (servo loop, local force model, "
                "safety) for a snapthread session"};
-  app.add_option("--backend", o->backend, "sim-path | virtual-hand | phantom | delta")
+  cli.add_option("--backend", o->backend, "sim-path | virtual-hand | phantom | delta")
       ->check(CLI::IsMember(KnownBackends()))
       ->capture_default_str();
-  app.add_option("--scene", o->scene_file, "scene YAML (device mapping, limits, grasp path)")
+  cli.add_option("--scene", o->scene_file, "scene YAML (device mapping, limits, grasp path)")
       ->check(CLI::ExistingFile);
-  app.add_option("--grasp", o->grasp, "the scene grasp this device holds (a scene with grasps:; default: the first)");
-  app.add_option("--path-csv", o->path_csv, "scripted path CSV x,y[,z] in metres (instead of the scene's)")
+  cli.add_option("--grasp", o->grasp, "the scene grasp this device holds (a scene with grasps:; default: the first)");
+  cli.add_option("--path-csv", o->path_csv, "scripted path CSV x,y[,z] in metres (instead of the scene's)")
       ->check(CLI::ExistingFile);
-  app.add_option("--session", o->session, "session name, [A-Za-z0-9_]+")->capture_default_str();
-  app.add_option("--lcm-url", o->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or udpm loopback)");
-  app.add_option("--duration", o->duration_s, "seconds to run, 0 = until SIGINT/SIGTERM")
+  app::CommonFlagSet common;
+  common.log_level = true;
+  app::AddCommonFlags(&cli, &o->common, common);
+  cli.add_option("--duration", o->duration_s, "seconds to run, 0 = until SIGINT/SIGTERM")
       ->check(CLI::Range(0.0, 1e7))
       ->capture_default_str();
-  app.add_option("--rate-hz", o->rate_hz, "servo rate")->check(CLI::Range(100.0, 10000.0))->capture_default_str();
-  app.add_option("--publish-divisor", o->publish_divisor, "publish every k-th pose")
+  cli.add_option("--rate-hz", o->rate_hz, "servo rate")->check(CLI::Range(100.0, 10000.0))->capture_default_str();
+  cli.add_option("--publish-divisor", o->publish_divisor, "publish every k-th pose")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
-  AddSafetyOptions(app, o);
+  AddSafetyOptions(cli, o);
   bool no_rt = false;
-  app.add_flag("--no-rt", no_rt, "do not try SCHED_FIFO / mlockall");
+  cli.add_flag("--no-rt", no_rt, "do not try SCHED_FIFO / mlockall");
   bool no_snap_ahead = false;
-  app.add_flag("--no-snap-ahead", no_snap_ahead,
+  cli.add_flag("--no-snap-ahead", no_snap_ahead,
                "render only the server's models: no switch to a post-snap model at a fold "
                "boundary (docs/snap-ahead.md)");
-  app.add_option("--log-level", o->log_level, "trace | debug | info | warn | error | off")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}))
-      ->capture_default_str();
-  app.add_option("--trace", o->trace_file, "write a per-tick CSV trace");
-  app.add_option("--trace-divisor", o->trace_divisor, "trace every k-th tick")
+  cli.add_option("--trace", o->trace_file, "write a per-tick CSV trace");
+  cli.add_option("--trace-divisor", o->trace_divisor, "trace every k-th tick")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  app.add_option("--summary", o->summary_file, "write a JSON summary at exit");
-  app.add_option("--key", o->key_path,
-                 "session key file (default: $SNAPTHREAD_KEY_FILE, else "
-                 "$XDG_CONFIG_HOME/snapthread/session.key)");
-  app.add_option("--sim-render-file", o->sim_render_file,
+  cli.add_option("--summary", o->summary_file, "write a JSON summary at exit");
+  cli.add_option("--sim-render-file", o->sim_render_file,
                  "sim-path / virtual-hand: run the device's own render thread and publish what "
                  "it renders (zero once the servo's command is 5 ms old) in this file");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitBadArguments;
-  }
+  if (auto code = app::ParseCommandLine(cli, argc, argv, app::kExitUsage)) return code;
   o->realtime = !no_rt;
   o->snap_ahead = !no_snap_ahead;
-  if (!messages::IsValidSessionName(o->session)) {
-    std::fprintf(stderr, "snapthread-device: --session '%s': expected [A-Za-z0-9_]+\n",
-                 o->session.c_str());
-    return kExitBadArguments;
-  }
-  return -1;
+  return app::CheckCommonFlags(o->common, kProgram, app::kExitUsage);
 }
 
-int RunDeviceClient(const DeviceClientOptions& o) {
-  spdlog::set_level(spdlog::level::from_str(o.log_level));
-  // Configuration, in this order; bad input ends the program with kExitBadArguments.
+int RunDeviceClient(const DeviceClientOptions& o, app::StopSignals* stop) {
+  spdlog::set_level(spdlog::level::from_str(o.common.log_level));
+  // Configuration, in this order; bad input ends the program with app::kExitUsage.
   ClientSetup setup;
   if (const int code = CheckOptions(o); code != kContinue) return code;
   if (const int code = LoadSessionKey(o, &setup); code != kContinue) return code;
   if (const int code = LoadSceneAndGrasp(o, &setup); code != kContinue) return code;
   if (const int code = MakeConfiguredBackend(o, &setup); code != kContinue) return code;
 
-  const std::string url =
-      messages::WithReceiveBuffer(messages::ResolveLcmUrl(o.lcm_url), messages::kServiceBufferBytes);
-  LcmDeviceTransport lcm(url, o.session);
+  const std::string url = app::LcmUrl(o.common, messages::kServiceBufferBytes);
+  LcmDeviceTransport lcm(url, o.common.session);
   if (!lcm.good()) {
     std::fprintf(stderr, "snapthread-device: LCM could not start with URL '%s'.\n  hint: %s\n",
                  url.c_str(), messages::LcmStartHint(url).c_str());
-    return kExitRuntimeFailure;
+    return app::kExitFailure;
   }
   if (const int code = OpenDevice(o, setup.backend); code != kContinue) return code;
   DeviceClientConfig cc;
@@ -453,9 +415,9 @@ int RunDeviceClient(const DeviceClientOptions& o) {
   } catch (const std::exception& e) {
     PrintError(e.what());
     device.Close();
-    return kExitRuntimeFailure;
+    return app::kExitFailure;
   }
-  RunUntilStopped(o, cc.limits.fade_time_s, client.get());
+  RunUntilStopped(o, cc.limits.fade_time_s, stop, client.get());
   device.Close();
   return ReportSummary(o, *client, lcm);
 }

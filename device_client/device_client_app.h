@@ -3,7 +3,11 @@
 // client itself - servo loop, model receiver, io - is DeviceClient (device_client.h).
 #pragma once
 
+#include <optional>
 #include <string>
+
+#include "app/common_flags.h"
+#include "app/stop_signals.h"
 
 namespace snapthread::device {
 
@@ -12,8 +16,7 @@ struct DeviceClientOptions {
   std::string scene_file;                // scene YAML: DeviceMapping + grasp path
   std::string grasp;                     // scene grasp to hold (--grasp); "" = the first
   std::string path_csv;                  // alternative scripted path, metres
-  std::string session = "SNAPTHREAD";
-  std::string lcm_url;                   // empty: LCM_DEFAULT_URL or the udpm default
+  app::CommonFlags common;               // --session, --lcm-url, --key, --log-level
   double duration_s = 0.0;               // 0 = until SIGINT / SIGTERM
   double rate_hz = 1000.0;
   int publish_divisor = 1;               // publish every k-th pose
@@ -27,26 +30,24 @@ struct DeviceClientOptions {
   double max_torque_stiffness_nm_per_rad = 0.1;
   bool realtime = true;                  // --no-rt turns off SCHED_FIFO / mlockall
   bool snap_ahead = true;                // --no-snap-ahead: never switch at a fold boundary
-  std::string log_level = "info";
   std::string trace_file;                // CSV, empty = none
   int trace_divisor = 1;
   std::string summary_file;              // JSON at exit, empty = none
-  std::string key_path;                  // --key; "" = $SNAPTHREAD_KEY_FILE or the XDG default
   // --sim-render-file: a simulated backend runs its render thread ("firmware",
   // sim_renderer.h) and publishes what it renders in this memory-mapped file.
   std::string sim_render_file;
 };
 
-// Exit codes of snapthread-device.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitRuntimeFailure = 1;
-inline constexpr int kExitBadArguments = 2;
+// Exit codes of snapthread-device (app/exit_codes.h): app::kExitOk, app::kExitFailure
+// when the device, LCM or the --summary file fails, app::kExitUsage for bad arguments.
 
-// Parses argv into *options. Returns -1 to continue, or an exit code (0 after --help,
-// kExitBadArguments with a message on stderr naming the argument).
-int ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* options);
+// Parses argv into *options. nullopt: go on; otherwise the exit code (app::kExitOk after
+// --help, app::kExitUsage with a message on stderr naming the argument).
+std::optional<int> ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* options);
 
-// Runs the client until the duration elapses or a signal arrives; returns an exit code.
-int RunDeviceClient(const DeviceClientOptions& options);
+// Runs the client until the duration elapses or `stop` sees SIGINT / SIGTERM (the main
+// thread waits on it; the servo thread never does); returns an exit code. `stop` must
+// exist before any thread does (app/stop_signals.h).
+int RunDeviceClient(const DeviceClientOptions& options, app::StopSignals* stop);
 
 }  // namespace snapthread::device

@@ -37,11 +37,6 @@ Server::Server(const ServerParams& params, ServerTestHooks hooks)
 Server::Server(const ServerParams& params, ServerTransport* transport, ServerTestHooks hooks)
     : Server(params, transport, TransportMaker(), std::move(hooks)) {}
 
-Server::Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks)
-    : Server(params, nullptr,
-             [lcm](const ServerParams& p) { return std::make_unique<LcmServerTransport>(lcm, p.session); },
-             std::move(hooks)) {}
-
 Server::Server(const ServerParams& params, ServerTransport* transport,
                TransportMaker make_transport, ServerTestHooks hooks)
     : params_(params),

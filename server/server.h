@@ -41,10 +41,6 @@
 #include "server_transport.h"
 #include "solve_loop.h"
 
-namespace lcm {
-class LCM;
-}
-
 namespace snapthread::server {
 
 class Server {
@@ -57,9 +53,6 @@ class Server {
   explicit Server(const ServerParams& params, ServerTestHooks hooks = {});
   // The same over the caller's transport, which must outlive the server.
   Server(const ServerParams& params, ServerTransport* transport, ServerTestHooks hooks = {});
-  // Over the caller's LCM instance (tests of the LCM path on memq://), which must outlive
-  // the server; its own subscriptions are dispatched on the server's receive thread.
-  Server(const ServerParams& params, lcm::LCM* lcm, ServerTestHooks hooks = {});
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;

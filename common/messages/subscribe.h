@@ -12,7 +12,8 @@
 // section; also dotnet/runtime#73927, "ubsan failure when calling through pointer to
 // member function", GCC 10-12). Here the member function is a template argument, so the
 // call is direct, and liblcm calls a plain function with a context (subscribeFunction).
-// Usage: sub = messages::Subscribe<&Server::HandleDeviceState>(lcm, channel, this);
+// Usage (server/lcm_server_transport.cc):
+//   sub = messages::Subscribe<&LcmServerTransport::HandleDeviceState>(lcm, channel, this);
 // the handler is (const lcm::ReceiveBuffer*, const std::string& channel) or, typed,
 // (const lcm::ReceiveBuffer*, const std::string& channel, const Msg*). Unsubscribe with
 // lcm.unsubscribe(sub) as before.

@@ -1,5 +1,5 @@
 // One scene -> tracker path (MakeTracker): the sweep and an in-process server over
-// memq:// follow curve2d_snap through both of its snaps, and every row of the sweep has
+// an in-memory transport (server_memory_transport.h) follow curve2d_snap through both of its snaps, and every row of the sweep has
 // the server's state and force to 1e-12. Before MakeTracker the server kept the default
 // snap threshold while the sweep used 0.1 l, so the two could disagree on a scene.
 #include <chrono>
@@ -10,8 +10,6 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
-
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "messages/pose_mapping.h"
@@ -19,6 +17,7 @@
 #include "models/models.h"
 #include "scene/scene.h"
 #include "server.h"
+#include "server_memory_transport.h"
 #include "sweep.h"
 #include "tracking/make_tracker.h"
 
@@ -75,8 +74,7 @@ TEST(ScenePath, SweepAndServerFollowTheSameEquilibria) {
   const std::string file = ScenePath("curve2d_snap.yaml");
   const Scene scene = LoadScene(file);
   Recorder recorder;
-  lcm::LCM lcm("memq://");
-  ASSERT_TRUE(lcm.good());
+  testing::MemoryServerTransport transport;
   const test_support::SessionKeyFile key_file;  // the server's key; poses signed with it
   auth::AuthSequence auth_seq;
   ServerParams params;
@@ -86,7 +84,7 @@ TEST(ScenePath, SweepAndServerFollowTheSameEquilibria) {
   params.log_level = "warn";
   ServerTestHooks hooks;
   hooks.after_update = [&](const Vec& u, const EquilibriumTracker& t) { recorder.Record(u, t); };
-  Server server(params, &lcm, std::move(hooks));
+  Server server(params, &transport, std::move(hooks));
   server.Start();
 
   // Up through the snap at Y ~ 3.4 and back down through the one at Y ~ -3.4, one pose
@@ -96,7 +94,7 @@ TEST(ScenePath, SweepAndServerFollowTheSameEquilibria) {
     device_state_t s = Pose(static_cast<int64_t>(i), messages::ControlsToPosition(scene.device, scene.grasp_layout, path[i]));
     ASSERT_TRUE(auth::Sign(&s, server.channels().device_state, server.epoch(), auth_seq.Next(),
                            key_file.key()));
-    ASSERT_EQ(lcm.publish(server.channels().device_state, &s), 0);
+    transport.DeliverDeviceState(test_support::Encode(s));
     ASSERT_TRUE(recorder.WaitCount(i)) << "no update for pose " << i;
   }
   server.Stop();

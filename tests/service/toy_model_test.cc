@@ -2,8 +2,8 @@
 // bead on a hardening spring pulled by the grasp,
 //   E(x, u) = k/2 (x - X)^2 + c/4 x^4,   u = (X, Y) (Y is free: nothing pulls on it).
 // Registered once, it loads from a scene, runs through the sweep and through an
-// in-process server over memq://, and both find the equilibrium k (x - X) + c x^3 = 0
-// with the force F = -E_u = (k (x - X), 0).
+// in-process server over an in-memory transport (server_memory_transport.h), and both
+// find the equilibrium k (x - X) + c x^3 = 0 with the force F = -E_u = (k (x - X), 0).
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -14,7 +14,6 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <unistd.h>
 
 #include "auth/message_mac.h"
@@ -24,6 +23,7 @@
 #include "models/models.h"
 #include "scene/scene.h"
 #include "server.h"
+#include "server_memory_transport.h"
 #include "sweep.h"
 #include "tracking/make_tracker.h"
 
@@ -193,8 +193,7 @@ TEST(ToyModel, InProcessServerAnswersWithTheEquilibriumForce) {
   std::mutex mutex;
   std::condition_variable cv;
   std::vector<Row> rows;
-  lcm::LCM lcm("memq://");
-  ASSERT_TRUE(lcm.good());
+  server::testing::MemoryServerTransport transport;
   const test_support::SessionKeyFile key_file;  // the server's key; poses signed with it
   auth::AuthSequence auth_seq;
   server::ServerParams params;
@@ -208,7 +207,7 @@ TEST(ToyModel, InProcessServerAnswersWithTheEquilibriumForce) {
     rows.push_back({u, t.state(), t.last().force});
     cv.notify_all();
   };
-  server::Server srv(params, &lcm, std::move(hooks));
+  server::Server srv(params, &transport, std::move(hooks));
   srv.Start();
   const std::vector<Vec> path = PathControls(scene, 20);
   for (size_t i = 1; i < path.size(); ++i) {
@@ -222,7 +221,7 @@ TEST(ToyModel, InProcessServerAnswersWithTheEquilibriumForce) {
     s.buttons = 1;
     ASSERT_TRUE(auth::Sign(&s, srv.channels().device_state, srv.epoch(), auth_seq.Next(),
                            key_file.key()));
-    ASSERT_EQ(lcm.publish(srv.channels().device_state, &s), 0);
+    transport.DeliverDeviceState(test_support::Encode(s));
     std::unique_lock<std::mutex> lock(mutex);
     ASSERT_TRUE(cv.wait_for(lock, 20s, [&] { return rows.size() >= i; })) << "no update for pose " << i;
   }
