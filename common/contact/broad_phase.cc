@@ -27,11 +27,8 @@ inline std::int64_t FloorToInt(double x) {
 
 }  // namespace
 
-void BroadPhase::Overlaps(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi,
-                          std::vector<std::pair<int, int>>* pairs, int min_index_gap) {
-  pairs->clear();
+void BroadPhase::FillCells(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi) {
   const int m = static_cast<int>(lo.cols());
-  if (m < 2) return;
   double extent = 0.0, scene = 0.0;
   for (int i = 0; i < m; ++i) {
     extent += (hi.col(i) - lo.col(i)).maxCoeff();
@@ -66,6 +63,10 @@ void BroadPhase::Overlaps(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi
     if (!too_many) break;
     cell *= 2.0;
   }
+}
+
+void BroadPhase::FindPairs(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi,
+                           std::vector<std::pair<int, int>>* pairs, int min_index_gap) {
   // Counting sort by hash bucket.
   const int count = static_cast<int>(entries_.size());
   int buckets = 1;
@@ -101,6 +102,9 @@ void BroadPhase::Overlaps(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi
       }
     }
   }
+}
+
+void BroadPhase::SortPairs(int m, std::vector<std::pair<int, int>>* pairs) {
   // Sorted by (i, j) in O(m + pairs): a counting sort by i (stable), then each i's few
   // partners by j (insertion sort; a box overlaps O(1) others).
   const int count_pairs = static_cast<int>(pairs->size());
@@ -120,6 +124,16 @@ void BroadPhase::Overlaps(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi
       (*pairs)[q + 1] = key;
     }
   }
+}
+
+void BroadPhase::Overlaps(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi,
+                          std::vector<std::pair<int, int>>* pairs, int min_index_gap) {
+  pairs->clear();
+  const int m = static_cast<int>(lo.cols());
+  if (m < 2) return;
+  FillCells(lo, hi);
+  FindPairs(lo, hi, pairs, min_index_gap);
+  SortPairs(m, pairs);
 }
 
 }  // namespace snapthread::contact

@@ -31,6 +31,13 @@ class BroadPhase {
     std::int64_t cell[3];
     int box;
   };
+  // Overlaps' steps, in order: every box's cells into entries_ (the cell size doubled
+  // while a box spans too many); the entries bucketed by cell hash and the overlapping
+  // pairs of each shared lower-corner cell; the pairs sorted by (i, j).
+  void FillCells(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi);
+  void FindPairs(const Eigen::Matrix3Xd& lo, const Eigen::Matrix3Xd& hi, std::vector<std::pair<int, int>>* pairs,
+                 int min_index_gap);
+  void SortPairs(int m, std::vector<std::pair<int, int>>* pairs);
   std::vector<Entry> entries_;
   std::vector<Entry> sorted_;
   std::vector<int> bucket_start_;

@@ -90,17 +90,8 @@ cholmod_sparse CholmodLdlt::ViewOfS() {
   return s;
 }
 
-LinearSolverStatus CholmodLdlt::Analyze(const SparseMatrix& a) {
-  factorized_ = false;
-  FreeFactor();
-  pattern_.Clear();
-  if (!internal::ValidateForAnalysis(a, &message_)) {
-    message_ = "cholmod: " + message_;
-    return LinearSolverStatus::kInvalidInput;
-  }
-  const int n = static_cast<int>(a.cols());
-  n_ = n;
-
+bool CholmodLdlt::OrderAmd(const SparseMatrix& a) {
+  const int n = n_;
   // 1. AMD ordering of A's lower triangle (what cholmod_analyze would use).
   cholmod_sparse view = ViewOf(a, -1);
   cc_.nmethods = 1;
@@ -112,14 +103,19 @@ LinearSolverStatus CholmodLdlt::Analyze(const SparseMatrix& a) {
     message_ = "cholmod: cholmod_analyze (AMD) failed";
     AppendCholmodStatus();
     if (ordering != nullptr) cholmod_free_factor(&ordering, &cc_);
-    return LinearSolverStatus::kInvalidInput;
+    return false;
   }
   const int* p = static_cast<const int*>(ordering->Perm);
   perm_.assign(p, p + n);
   cholmod_free_factor(&ordering, &cc_);
+  return true;
+}
+
+void CholmodLdlt::BuildPermutedPattern(const SparseMatrix& a) {
+  const int n = n_;
+  // inverse[i]: where row i of A goes under P.
   std::vector<int> inverse(n);
   for (int k = 0; k < n; ++k) inverse[perm_[k]] = k;
-
   // 2. Pattern of S = triu(P A P^T) and the scatter map from A's lower triangle: entry
   //    A(i,j), i >= j, lands at S(min(pi, pj), max(pi, pj)) with pi = inverse[i].
   pattern_.Assign(a);
@@ -151,7 +147,9 @@ LinearSolverStatus CholmodLdlt::Analyze(const SparseMatrix& a) {
     scatter_[slots[k].source] = static_cast<int>(k);
   }
   for (int j = 0; j < n; ++j) s_outer_[j + 1] += s_outer_[j];
+}
 
+bool CholmodLdlt::AnalyzeNaturalOrder() {
   // 3. Symbolic analysis of S in its own (natural) order: cholmod_factorize then works
   //    on S directly instead of allocating a permuted copy per call.
   cc_.method[0].ordering = CHOLMOD_NATURAL;
@@ -164,8 +162,13 @@ LinearSolverStatus CholmodLdlt::Analyze(const SparseMatrix& a) {
     AppendCholmodStatus();
     FreeFactor();
     pattern_.Clear();
-    return LinearSolverStatus::kInvalidInput;
+    return false;
   }
+  return true;
+}
+
+void CholmodLdlt::WarmUp() {
+  const int n = n_;
   permuted_rhs_.setZero(n);
   // Warm-up: one numeric factorisation (the identity on S's pattern) and one solve
   // allocate the factor's numeric storage and cholmod_solve2's workspaces now, so that
@@ -174,6 +177,7 @@ LinearSolverStatus CholmodLdlt::Analyze(const SparseMatrix& a) {
   for (int j = 0; j < n; ++j) {
     for (int q = s_outer_[j]; q < s_outer_[j + 1]; ++q) s_values_[q] = s_inner_[q] == j ? 1.0 : 0.0;
   }
+  cholmod_sparse s = ViewOfS();
   cc_.status = CHOLMOD_OK;
   if (cholmod_factorize(&s, factor_, &cc_) && cc_.status == CHOLMOD_OK) {
     factorized_ = true;
@@ -182,6 +186,21 @@ LinearSolverStatus CholmodLdlt::Analyze(const SparseMatrix& a) {
     Solve(zero, &x);
     factorized_ = false;
   }
+}
+
+LinearSolverStatus CholmodLdlt::Analyze(const SparseMatrix& a) {
+  factorized_ = false;
+  FreeFactor();
+  pattern_.Clear();
+  if (!internal::ValidateForAnalysis(a, &message_)) {
+    message_ = "cholmod: " + message_;
+    return LinearSolverStatus::kInvalidInput;
+  }
+  n_ = static_cast<int>(a.cols());
+  if (!OrderAmd(a)) return LinearSolverStatus::kInvalidInput;
+  BuildPermutedPattern(a);
+  if (!AnalyzeNaturalOrder()) return LinearSolverStatus::kInvalidInput;
+  WarmUp();
   std::fill(s_values_.begin(), s_values_.end(), 0.0);
   message_.clear();
   return LinearSolverStatus::kSuccess;

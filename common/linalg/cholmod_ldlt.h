@@ -42,6 +42,14 @@ class CholmodLdlt final : public SymmetricLinearSolver {
   // Appends CHOLMOD's status (cc_.status) as text to message_.
   void AppendCholmodStatus();
   cholmod_sparse ViewOfS();
+  // Analyze()'s steps, in order: the AMD permutation perm_ (false: CHOLMOD failed, with
+  // message_); S's pattern and the scatter map from A; the symbolic analysis of S in its
+  // natural order (false: failed, message_ set, the pattern cleared); the warm-up that
+  // allocates the numeric storage and the solve workspaces now.
+  bool OrderAmd(const SparseMatrix& a);
+  void BuildPermutedPattern(const SparseMatrix& a);
+  bool AnalyzeNaturalOrder();
+  void WarmUp();
 
   mutable cholmod_common cc_;
   cholmod_factor* factor_ = nullptr;  // of S, natural ordering

@@ -1,6 +1,6 @@
 // A 3D chain's interior terms written straight into E_x and band storage
 // (thread3d_model.cc's EnergyGradientAndBandHessian): the derivatives of StretchTerm<3>
-// and BendTerm<3> (hessian_assembly.h) of a term whose variables are the consecutive
+// and BendTerm<3> (chain_terms.h) of a term whose variables are the consecutive
 // states v0, v0 + 1, ..., from the unit segment directions and inverse lengths the caller
 // computed once per segment, the lower triangle only.
 #pragma once
@@ -12,7 +12,7 @@ namespace snapthread::internal {
 // The interior terms' derivatives, written into E_x and the band (banded_ldlt.h's layout)
 // at their first state v0: A(v0 + r, v0 + q), r >= q, is base[r b + q] with
 // base = band + v0 (b + 1) + b. Each entry is computed by the operations Eigen performs
-// for StretchTerm's and BendTerm's expressions (hessian_assembly.h), in their order (Eigen
+// for StretchTerm's and BendTerm's expressions (chain_terms.h), in their order (Eigen
 // evaluates a scalar times an outer product, k (p q^T), as (k p) q^T), so E_xx and E_x
 // are Hessian()'s and Gradient()'s to the last bit. The inputs are copied into locals
 // first and every result is computed before the first store, so the compiler keeps them

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "models/band_assembly_capability.h"
+#include "models/chain_terms.h"
 #include "models/hessian_assembly.h"
 #include "models/model.h"
 #include "models/params.h"
@@ -192,7 +193,7 @@ class ChainModel : public Model, public BandAssemblyCapability {
   }
 
   // shift + the sum, in term order, of the stretching terms stretch (|v| - rest)² and
-  // the bending terms bend (1 - w·w') (hessian_assembly.h), nodes from Derived::Node.
+  // the bending terms bend (1 - w·w') (chain_terms.h), nodes from Derived::Node.
   template <int D>
   double ChainEnergy(const Vec& x, const Vec& u, double shift, double bend, double stretch,
                      double rest) const {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "models/chain_model.h"
+#include "models/chain_terms.h"
 #include "models/registry.h"
 
 namespace snapthread {

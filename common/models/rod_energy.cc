@@ -25,56 +25,33 @@ inline void LowerBlock(int j, int c, double s, const M3& m, Mat8* h) {
   }
 }
 
-}  // namespace
+// VertexEnergy's intermediate values, shared by its steps (BendAndTwist, GradientParts,
+// AddOuterProducts, AddEdgeBlocks): the curvature binormal κb over χ, each edge's
+// material curvatures and their residuals, the total twist τ, and the first derivatives.
+struct VertexParts {
+  double chi = 0.0, inv_chi = 0.0, tau = 0.0, ct = 0.0;
+  V3 kb;
+  double p[2], q[2], r1[2], r2[2];
+  V3 gchi[2];
+  Vec8 dphi[2], gq[2], gp[2], jm1[2], jm2[2];
+  Vec8 gtau;
+};
 
-void ComputeEdgeFrame(const V3& e, double theta, const FrameSource& s, bool want_h, EdgeFrame* f) {
-  f->e = e;
-  f->theta = theta;
-  f->l = e.norm();
-  f->t = e / f->l;
-  V3 b;
-  ReferenceFrame(s, f->t, &f->a, &b);
-  const double c = std::cos(theta), sn = std::sin(theta);
-  f->m1 = c * f->a + sn * b;
-  f->m2 = -sn * f->a + c * b;
-  const double inv_l = 1.0 / f->l;
-  const double den = 1.0 / (1.0 + s.t.dot(f->t));
-  const V3 ahat = f->t.cross(s.t) * den;  // Â (TwistRate)
-  f->alpha = ahat * inv_l;
-  if (want_h) {
-    // (dÂ/dt)(I - t tᵀ) - Â tᵀ, dÂ/dt = -([t_s]× + Â t_sᵀ)/(1 + t_s·t) (TwistRateJacobian).
-    const M3 da = -(Cross(s.t) + ahat * s.t.transpose()) * den;
-    f->dalpha = (da - (da * f->t + ahat) * f->t.transpose()) * (inv_l * inv_l);
-  }
-}
-
-double ReferenceTwist(const V3& e0, const V3& e1, const FrameSource& s0, const FrameSource& s1,
-                      double near) {
-  const V3 t0 = e0.normalized(), t1 = e1.normalized();
-  V3 a0, b0, a1, b1;
-  ReferenceFrame(s0, t0, &a0, &b0);
-  ReferenceFrame(s1, t1, &a1, &b1);
-  return AngleAbout(t1, Transport(t0, t1, a0), a1, near);
-}
-
-double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
-                    const FrameSource& s0, const FrameSource& s1, double twist_near,
-                    const VertexStiffness& k, Vec8* g, Mat8* h) {
-  EdgeFrame f0, f1;
-  ComputeEdgeFrame(e0, theta0, s0, h != nullptr, &f0);
-  ComputeEdgeFrame(e1, theta1, s1, h != nullptr, &f1);
-  return VertexEnergy(f0, f1, twist_near, k, g, h);
-}
-
-double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
-                    const VertexStiffness& k, Vec8* g, Mat8* h, double* reference_twist) {
+// The energy: bending (the material curvatures p, q) and twist (τ).
+double BendAndTwist(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near, const VertexStiffness& k,
+                    VertexParts* vp, double* reference_twist) {
   const EdgeFrame* f[2] = {&f0, &f1};
   const V3& e0 = f0.e;
   const V3& e1 = f1.e;
-  const double chi = f0.l * f1.l + e0.dot(e1);
-  const V3 kb = (2.0 / chi) * e0.cross(e1);  // [DER (1)]
+  vp->chi = f0.l * f1.l + e0.dot(e1);
+  const double chi = vp->chi;
+  vp->kb = (2.0 / chi) * e0.cross(e1);  // [DER (1)]
+  const V3& kb = vp->kb;
   // Material curvatures of each edge [DER §4.2]: κ^j = (κb·m2_j, -κb·m1_j) = (q_j, -p_j).
-  double p[2], q[2], r1[2], r2[2];
+  double(&p)[2] = vp->p;
+  double(&q)[2] = vp->q;
+  double(&r1)[2] = vp->r1;
+  double(&r2)[2] = vp->r2;
   double bend = 0.0;
   for (int j = 0; j < 2; ++j) {
     p[j] = kb.dot(f[j]->m1);
@@ -85,16 +62,31 @@ double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
   }
   const double mref = AngleAbout(f1.t, Transport(f0.t, f1.t, f0.a), f1.a, twist_near);
   if (reference_twist != nullptr) *reference_twist = mref;
-  const double tau = f1.theta - f0.theta + mref;
+  vp->tau = f1.theta - f0.theta + mref;
+  const double tau = vp->tau;
   // Bending: the mean of the two edges' energies [DER (4)]; twist [DVT (4)].
-  const double energy = 0.25 * bend + 0.5 * k.ct * tau * tau;
-  if (g == nullptr && h == nullptr) return energy;
+  return 0.25 * bend + 0.5 * k.ct * tau * tau;
+}
 
+// The first derivatives of q, p and τ in the edge coordinates and angles.
+void GradientParts(const EdgeFrame& f0, const EdgeFrame& f1, VertexParts* vp) {
+  const EdgeFrame* f[2] = {&f0, &f1};
+  const V3& e0 = f0.e;
+  const V3& e1 = f1.e;
+  const double(&p)[2] = vp->p;
+  const double(&q)[2] = vp->q;
   // ∂κb/∂e_c = (±2[e_other]× - κb ∇χ_cᵀ)/χ [DER §6], ∇χ = (|e1| t0 + e1, |e0| t1 + e0);
   // applied transposed to a vector v: ((2 e1 × v, -2 e0 × v) - (κb·v) ∇χ)/χ.
-  const double inv_chi = 1.0 / chi;
-  const V3 gchi[2] = {f1.l * f0.t + e1, f0.l * f1.t + e0};
-  Vec8 dphi[2], gq[2], gp[2], jm1[2], jm2[2];
+  vp->inv_chi = 1.0 / vp->chi;
+  const double inv_chi = vp->inv_chi;
+  vp->gchi[0] = f1.l * f0.t + e1;
+  vp->gchi[1] = f0.l * f1.t + e0;
+  const V3(&gchi)[2] = vp->gchi;
+  Vec8(&dphi)[2] = vp->dphi;
+  Vec8(&gq)[2] = vp->gq;
+  Vec8(&gp)[2] = vp->gp;
+  Vec8(&jm1)[2] = vp->jm1;
+  Vec8(&jm2)[2] = vp->jm2;
   for (int j = 0; j < 2; ++j) {
     const V3& m1 = f[j]->m1;
     const V3& m2 = f[j]->m2;
@@ -108,19 +100,30 @@ double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
     gq[j] = jm2[j] - p[j] * dphi[j];
     gp[j] = jm1[j] + q[j] * dphi[j];
   }
-  Vec8 gtau;
-  gtau << kb / (2.0 * f0.l) - f0.alpha, kb / (2.0 * f1.l) + f1.alpha, -1.0, 1.0;
-  if (g != nullptr) {
-    *g = k.ct * tau * gtau;
-    for (int j = 0; j < 2; ++j) *g += 0.5 * (k.c1 * r1[j] * gq[j] - k.c2 * r2[j] * gp[j]);
-  }
-  if (h == nullptr) return energy;
+  vp->gtau << vp->kb / (2.0 * f0.l) - f0.alpha, vp->kb / (2.0 * f1.l) + f1.alpha, -1.0, 1.0;
+}
 
+// The Hessian's outer products and diagonal blocks into *h (lower triangle; zeroed
+// first); returns W, the weight of the d²κb contraction (AddEdgeBlocks).
+V3 AddOuterProducts(const EdgeFrame& f0, const EdgeFrame& f1, const VertexStiffness& k, VertexParts* vp, Mat8* h) {
+  const EdgeFrame* f[2] = {&f0, &f1};
+  const V3& kb = vp->kb;
+  const double(&p)[2] = vp->p;
+  const double(&q)[2] = vp->q;
+  const double(&r1)[2] = vp->r1;
+  const double(&r2)[2] = vp->r2;
+  const Vec8(&dphi)[2] = vp->dphi;
+  const Vec8(&gq)[2] = vp->gq;
+  const Vec8(&gp)[2] = vp->gp;
+  const Vec8(&jm1)[2] = vp->jm1;
+  const Vec8(&jm2)[2] = vp->jm2;
+  const Vec8& gtau = vp->gtau;
   // The lower triangle of every piece (rod_energy.cc's header for the derivation), then
   // the mirror.
   Mat8& hh = *h;
   hh.setZero();
-  const double ct = k.ct * tau;
+  vp->ct = k.ct * vp->tau;
+  const double ct = vp->ct;
   V3 w = V3::Zero();
   Vec8 v[2];
   M3 blk[2];
@@ -179,6 +182,18 @@ double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
   both.template operator()<6, 2>(6);
   both.template operator()<6, 2>(7);
   LowerBlock(1, 1, 1.0, blk[1], &hh);
+  return w;
+}
+
+// The Hessian's 3x3 edge blocks (lower triangle).
+void AddEdgeBlocks(const EdgeFrame& f0, const EdgeFrame& f1, const VertexParts& vp, const V3& w, Mat8* h) {
+  const V3& e0 = f0.e;
+  const V3& e1 = f1.e;
+  const V3& kb = vp.kb;
+  const V3(&gchi)[2] = vp.gchi;
+  const double inv_chi = vp.inv_chi;
+  const double ct = vp.ct;
+  Mat8& hh = *h;
   // The 3x3 edge blocks (0, 0), (1, 0), (1, 1), entry by entry in the order of the terms:
   //  * twist: ct ∂(κb/(2|e_j|))/∂e_c;
   //  * W·d²κb for W = w: the Hessian of W·κb = W·(2 e0 × e1)/χ as a quotient,
@@ -221,6 +236,71 @@ double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
       x += s11 * p11(rr, cc);
     }
   }
+}
+
+}  // namespace
+
+void ComputeEdgeFrame(const V3& e, double theta, const FrameSource& s, bool want_h, EdgeFrame* f) {
+  f->e = e;
+  f->theta = theta;
+  f->l = e.norm();
+  f->t = e / f->l;
+  V3 b;
+  ReferenceFrame(s, f->t, &f->a, &b);
+  const double c = std::cos(theta), sn = std::sin(theta);
+  f->m1 = c * f->a + sn * b;
+  f->m2 = -sn * f->a + c * b;
+  const double inv_l = 1.0 / f->l;
+  const double den = 1.0 / (1.0 + s.t.dot(f->t));
+  const V3 ahat = f->t.cross(s.t) * den;  // Â (TwistRate)
+  f->alpha = ahat * inv_l;
+  if (want_h) {
+    // (dÂ/dt)(I - t tᵀ) - Â tᵀ, dÂ/dt = -([t_s]× + Â t_sᵀ)/(1 + t_s·t) (TwistRateJacobian).
+    const M3 da = -(Cross(s.t) + ahat * s.t.transpose()) * den;
+    f->dalpha = (da - (da * f->t + ahat) * f->t.transpose()) * (inv_l * inv_l);
+  }
+}
+
+double ReferenceTwist(const V3& e0, const V3& e1, const FrameSource& s0, const FrameSource& s1,
+                      double near) {
+  const V3 t0 = e0.normalized(), t1 = e1.normalized();
+  V3 a0, b0, a1, b1;
+  ReferenceFrame(s0, t0, &a0, &b0);
+  ReferenceFrame(s1, t1, &a1, &b1);
+  return AngleAbout(t1, Transport(t0, t1, a0), a1, near);
+}
+
+double VertexEnergy(const V3& e0, const V3& e1, double theta0, double theta1,
+                    const FrameSource& s0, const FrameSource& s1, double twist_near,
+                    const VertexStiffness& k, Vec8* g, Mat8* h) {
+  EdgeFrame f0, f1;
+  ComputeEdgeFrame(e0, theta0, s0, h != nullptr, &f0);
+  ComputeEdgeFrame(e1, theta1, s1, h != nullptr, &f1);
+  return VertexEnergy(f0, f1, twist_near, k, g, h);
+}
+
+double VertexEnergy(const EdgeFrame& f0, const EdgeFrame& f1, double twist_near,
+                    const VertexStiffness& k, Vec8* g, Mat8* h, double* reference_twist) {
+  VertexParts vp;
+  const double energy = BendAndTwist(f0, f1, twist_near, k, &vp, reference_twist);
+  if (g == nullptr && h == nullptr) return energy;
+
+  GradientParts(f0, f1, &vp);
+  const double tau = vp.tau;
+  const double(&r1)[2] = vp.r1;
+  const double(&r2)[2] = vp.r2;
+  const Vec8(&gq)[2] = vp.gq;
+  const Vec8(&gp)[2] = vp.gp;
+  const Vec8& gtau = vp.gtau;
+  if (g != nullptr) {
+    *g = k.ct * tau * gtau;
+    for (int j = 0; j < 2; ++j) *g += 0.5 * (k.c1 * r1[j] * gq[j] - k.c2 * r2[j] * gp[j]);
+  }
+  if (h == nullptr) return energy;
+
+  const V3 w = AddOuterProducts(f0, f1, k, &vp, h);
+  AddEdgeBlocks(f0, f1, vp, w, h);
+  Mat8& hh = *h;
   for (int c = 0; c < 8; ++c) {
     for (int r = c + 1; r < 8; ++r) hh(c, r) = hh(r, c);
   }

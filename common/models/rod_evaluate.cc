@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "models/chain_terms.h"
 #include "models/rod_model.h"
 
 namespace snapthread {
@@ -72,69 +73,65 @@ double RodModel::StretchEnergy(int j, Eigen::Matrix<double, 6, 1>* g, Eigen::Mat
   return e;
 }
 
-template <class F>
-double RodModel::Local(int t, const GraspMaps& gms, bool want_h, F&& f) const {
-  const Term& term = terms_[t];
-  Eigen::Matrix<double, kMaxLocal, 1> gy;
-  Eigen::Matrix<double, kMaxLocal, kMaxLocal> hy;
+double RodModel::TermDerivatives(const Term& term, bool want_h, LocalGradient* gy, LocalHessian* hy) const {
   const int i = term.index;
   double energy = 0.0;
   if (!term.vertex) {
     Eigen::Matrix<double, 6, 1> g6;
     Eigen::Matrix<double, 6, 6> h6;
     energy = StretchEnergy(i, &g6, want_h ? &h6 : nullptr);
-    gy.head<6>() = g6;
-    if (want_h) hy.topLeftCorner<6, 6>() = h6;
+    gy->head<6>() = g6;
+    if (want_h) hy->topLeftCorner<6, 6>() = h6;
   } else {
     rod::Vec8 g8;
     rod::Mat8 h8;
     energy = rod::VertexEnergy(edges_[i - 1], edges_[i], twist_near_[i], stiffness_, &g8, want_h ? &h8 : nullptr,
                                &twist_cache_[i]);
     // (e0, e1) = (x_i - x_{i-1}, x_{i+1} - x_i).
-    gy.segment<3>(0) = -g8.segment<3>(0);
-    gy.segment<3>(3) = g8.segment<3>(0) - g8.segment<3>(3);
-    gy.segment<3>(6) = g8.segment<3>(3);
-    gy.segment<2>(9) = g8.tail<2>();
+    gy->segment<3>(0) = -g8.segment<3>(0);
+    gy->segment<3>(3) = g8.segment<3>(0) - g8.segment<3>(3);
+    gy->segment<3>(6) = g8.segment<3>(3);
+    gy->segment<2>(9) = g8.tail<2>();
     if (want_h) {
       // Hy = Lᵀ H8 L with node a's edge coefficients (-1, 0), (1, -1), (0, 1): the lower
       // node blocks from the edge blocks H_ef (H8 is symmetric to the bit), then their mirror.
       const M3 h00 = h8.block<3, 3>(0, 0), h10 = h8.block<3, 3>(3, 0), h11 = h8.block<3, 3>(3, 3);
-      hy.block<3, 3>(0, 0) = h00;
-      hy.block<3, 3>(3, 0) = h10 - h00;
-      hy.block<3, 3>(6, 0) = -h10;
-      hy.block<3, 3>(3, 3) = (h00 + h11) - (h10 + h10.transpose());  // symmetric to the bit
-      hy.block<3, 3>(6, 3) = h10 - h11;
-      hy.block<3, 3>(6, 6) = h11;
-      hy.block<3, 3>(0, 3) = hy.block<3, 3>(3, 0).transpose();
-      hy.block<3, 3>(0, 6) = hy.block<3, 3>(6, 0).transpose();
-      hy.block<3, 3>(3, 6) = hy.block<3, 3>(6, 3).transpose();
+      hy->block<3, 3>(0, 0) = h00;
+      hy->block<3, 3>(3, 0) = h10 - h00;
+      hy->block<3, 3>(6, 0) = -h10;
+      hy->block<3, 3>(3, 3) = (h00 + h11) - (h10 + h10.transpose());  // symmetric to the bit
+      hy->block<3, 3>(6, 3) = h10 - h11;
+      hy->block<3, 3>(6, 6) = h11;
+      hy->block<3, 3>(0, 3) = hy->block<3, 3>(3, 0).transpose();
+      hy->block<3, 3>(0, 6) = hy->block<3, 3>(6, 0).transpose();
+      hy->block<3, 3>(3, 6) = hy->block<3, 3>(6, 3).transpose();
       const Eigen::Matrix<double, 3, 2> s0 = h8.block<3, 2>(0, 6), s1 = h8.block<3, 2>(3, 6);
-      hy.block<3, 2>(0, 9) = -s0;
-      hy.block<3, 2>(3, 9) = s0 - s1;
-      hy.block<3, 2>(6, 9) = s1;
-      hy.block<2, 9>(9, 0) = hy.block<9, 2>(0, 9).transpose();
-      hy.block<2, 2>(9, 9) = h8.block<2, 2>(6, 6);
+      hy->block<3, 2>(0, 9) = -s0;
+      hy->block<3, 2>(3, 9) = s0 - s1;
+      hy->block<3, 2>(6, 9) = s1;
+      hy->block<2, 9>(9, 0) = hy->block<9, 2>(0, 9).transpose();
+      hy->block<2, 2>(9, 9) = h8.block<2, 2>(6, 6);
     }
   }
-  if (!term.grasp) {
-    f(gy.data(), hy.data(), kMaxLocal);
-    return energy;
-  }
+  return energy;
+}
+
+void RodModel::GraspChainRule(int t, const GraspMaps& gms, bool want_h, const LocalGradient& gy, const LocalHessian& hy,
+                              TermGradient* ga, TermHessian* ha) const {
   // Chain rule through the grasp map y = y(z): state coordinates map one to one, the
   // grasp coordinates G through rows J_G of the map's Jacobian (over the 6 controls at
   // local columns s0..s0+5), plus the map's curvature in φ weighted by E_y:
   //   E_z = (E_y(states), J_Gᵀ E_y(G)),
   //   E_zz = [[H_SS, H_SG J_G], [J_Gᵀ H_GS, J_Gᵀ H_GG J_G + Σ_G E_y ∂²y/∂φ²]].
+  const Term& term = terms_[t];
   const GraspMap& gm = term.at_start ? gms.start : gms.end;
   const int nloc = term.nloc;
   const int s0 = assembly_.TermSize(t) - 6;
   int rows[kMaxLocal], coord[kMaxLocal];
   int ng = 0;
-  Eigen::Matrix<double, kMaxVars, 1> ga;
-  Eigen::Matrix<double, kMaxVars, kMaxVars> ha;
   for (int r = 0; r < nloc; ++r) {
     if (term.code[r] >= 0) {
-      ga[term.pos[r]] = gy[r];
+      (*ga)[term.pos[r]] = gy[r];
     } else if (term.code[r] <= -2) {
       rows[ng] = r;
       coord[ng++] = GraspCoordinate(term.code[r]);
@@ -143,7 +140,7 @@ double RodModel::Local(int t, const GraspMaps& gms, bool want_h, F&& f) const {
   for (int c = 0; c < 6; ++c) {
     double sum = 0.0;
     for (int q = 0; q < ng; ++q) sum += gy[rows[q]] * gm.jac(coord[q], c);
-    ga[s0 + c] = sum;
+    (*ga)[s0 + c] = sum;
   }
   if (want_h) {
     Eigen::Matrix<double, kMaxLocal, 6> m;  // H_yG J_G, rows 0..nloc-1
@@ -158,11 +155,11 @@ double RodModel::Local(int t, const GraspMaps& gms, bool want_h, F&& f) const {
       if (term.code[b] < 0) continue;
       const int pb = term.pos[b];
       for (int a = 0; a < nloc; ++a) {
-        if (term.code[a] >= 0) ha(term.pos[a], pb) = hy(a, b);
+        if (term.code[a] >= 0) (*ha)(term.pos[a], pb) = hy(a, b);
       }
       for (int c = 0; c < 6; ++c) {
-        ha(pb, s0 + c) = m(b, c);
-        ha(s0 + c, pb) = m(b, c);
+        (*ha)(pb, s0 + c) = m(b, c);
+        (*ha)(s0 + c, pb) = m(b, c);
       }
     }
     // The control block: its lower triangle, then the mirror (symmetric to the bit).
@@ -173,16 +170,35 @@ double RodModel::Local(int t, const GraspMaps& gms, bool want_h, F&& f) const {
         if (c >= 3) {
           for (int q = 0; q < ng; ++q) sum += gy[rows[q]] * gm.hess_phi[coord[q]](r - 3, c - 3);
         }
-        ha(s0 + r, s0 + c) = sum;
-        ha(s0 + c, s0 + r) = sum;
+        (*ha)(s0 + r, s0 + c) = sum;
+        (*ha)(s0 + c, s0 + r) = sum;
       }
     }
   }
+}
+
+template <class F>
+double RodModel::Local(int t, const GraspMaps& gms, bool want_h, F&& f) const {
+  const Term& term = terms_[t];
+  LocalGradient gy;
+  LocalHessian hy;
+  const double energy = TermDerivatives(term, want_h, &gy, &hy);
+  if (!term.grasp) {
+    f(gy.data(), hy.data(), kMaxLocal);
+    return energy;
+  }
+  TermGradient ga;
+  TermHessian ha;
+  GraspChainRule(t, gms, want_h, gy, hy, &ga, &ha);
   f(ga.data(), ha.data(), kMaxVars);
   return energy;
 }
 
 double RodModel::AddInteriorTerm(const Term& term, double* g, double* band, int b) const {
+  return term.vertex ? AddInteriorVertex(term, g, band, b) : AddInteriorEdge(term, g, band, b);
+}
+
+double RodModel::AddInteriorEdge(const Term& term, double* g, double* band, int b) const {
   // The term's state block starts at v = term.first; A(v + r, v + c), r >= c, is at
   // row[c] with row = band + (v + r)(b + 1) + b - r (linalg/banded_ldlt.h's layout). The
   // values are Local()'s (Lᵀ H L for a vertex, by the same operations), each added once
@@ -191,25 +207,31 @@ double RodModel::AddInteriorTerm(const Term& term, double* g, double* band, int 
   const int ld = b + 1;
   auto row = [&](int r) { return band + static_cast<std::ptrdiff_t>(v + r) * ld + b - r; };
   const int i = term.index;
-  if (!term.vertex) {
-    // Edge i: x_i at v, x_{i+1} at v + 4 (θ_i, at v + 3, is not touched).
-    Eigen::Matrix<double, 6, 1> g6;
-    Eigen::Matrix<double, 6, 6> h6;
-    const double e = StretchEnergy(i, &g6, band != nullptr ? &h6 : nullptr);
-    for (int k = 0; k < 3; ++k) {
-      g[v + k] += g6[k];
-      g[v + 4 + k] += g6[3 + k];
-    }
-    if (band == nullptr) return e;
-    for (int r = 0; r < 3; ++r) {
-      double* d0 = row(r);
-      for (int c = 0; c <= r; ++c) d0[c] += h6(r, c);
-      double* d1 = row(4 + r);
-      for (int c = 0; c < 3; ++c) d1[c] += h6(3 + r, c);
-      for (int c = 0; c <= r; ++c) d1[4 + c] += h6(3 + r, 3 + c);
-    }
-    return e;
+  // Edge i: x_i at v, x_{i+1} at v + 4 (θ_i, at v + 3, is not touched).
+  Eigen::Matrix<double, 6, 1> g6;
+  Eigen::Matrix<double, 6, 6> h6;
+  const double e = StretchEnergy(i, &g6, band != nullptr ? &h6 : nullptr);
+  for (int k = 0; k < 3; ++k) {
+    g[v + k] += g6[k];
+    g[v + 4 + k] += g6[3 + k];
   }
+  if (band == nullptr) return e;
+  for (int r = 0; r < 3; ++r) {
+    double* d0 = row(r);
+    for (int c = 0; c <= r; ++c) d0[c] += h6(r, c);
+    double* d1 = row(4 + r);
+    for (int c = 0; c < 3; ++c) d1[c] += h6(3 + r, c);
+    for (int c = 0; c <= r; ++c) d1[4 + c] += h6(3 + r, 3 + c);
+  }
+  return e;
+}
+
+double RodModel::AddInteriorVertex(const Term& term, double* g, double* band, int b) const {
+  // The band layout as in AddInteriorEdge.
+  const int v = term.first;
+  const int ld = b + 1;
+  auto row = [&](int r) { return band + static_cast<std::ptrdiff_t>(v + r) * ld + b - r; };
+  const int i = term.index;
   // Vertex i: x_{i-1}, θ_{i-1}, x_i, θ_i, x_{i+1} at v, v + 3, v + 4, v + 7, v + 8; the
   // edges (e0, e1) = (x_i - x_{i-1}, x_{i+1} - x_i) (Local()'s chain rule).
   rod::Vec8 g8;

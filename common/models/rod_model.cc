@@ -1,44 +1,16 @@
 #include "models/rod_model.h"
 
-#include "models/registry.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
+#include <numbers>
 #include <stdexcept>
 
 namespace snapthread {
 
 using rod::FrameSource;
 using V3 = Eigen::Vector3d;
-using M3 = Eigen::Matrix3d;
 constexpr int kMaxVars = internal::HessianAssembly::kMaxTermVars;
-bool RodParams::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& why) {
-    if (error != nullptr) *error = "rod: " + why;
-    return false;
-  };
-  if (n < 3) return fail("n must be at least 3 (the clamp and the grasp hold one edge each)");
-  if (free_start && n < 5) return fail("n must be at least 5 without a clamp (two grasps)");
-  if (!(length > 0.0) || !std::isfinite(length)) return fail("length must be positive");
-  const double stiffnesses[] = {stretch_stiffness, bend_stiffness, bend_stiffness_2,
-                                twist_stiffness};
-  for (double s : stiffnesses) {
-    if (!(s > 0.0) || !std::isfinite(s)) return fail("stiffnesses must be positive and finite");
-  }
-  if (!std::isfinite(natural_curvature) || !std::isfinite(natural_curvature_2))
-    return fail("natural curvature must be finite");
-  if (!(radius >= 0.0) || !std::isfinite(radius)) return fail("radius must be >= 0");
-  if (!clamp_position.allFinite()) return fail("clamp position must be finite");
-  for (const M3* r : {&clamp_rotation, &grasp_rotation}) {
-    if (!r->allFinite() || ((*r).transpose() * (*r) - M3::Identity()).norm() > 1e-9 ||
-        r->determinant() < 0.0) {
-      return fail("clamp and grasp rotations must be proper rotation matrices");
-    }
-  }
-  return true;
-}
 
 RodModel::RodModel(const RodParams& params) : p_(params) {
   std::string error;
@@ -281,71 +253,6 @@ void RodModel::AcceptState(const Vec& x, const Vec& u) {
     sources_[j].a = (a - a.dot(t) * t).normalized();
   }
   InvalidateCaches();  // the grasp maps and energies depend on the frames and angles moved here
-}
-
-// ---------------------------------------------------------------------------------
-// Registration: the scene's `model: rod`. The clamp sits at the origin with its body
-// axes along the world's (the rod leaves along +x); the grasp starts with the same
-// orientation, so u = (X, Y, Z, φ) with φ = 0 holds the last edge along +x and a roll
-// about the tangent is φ = (roll, 0, 0).
-ModelRegistration RodRegistration() {
-  ModelRegistration r;
-  r.name = "rod";
-  r.doc = "discrete elastic rod that twists (Bergou et al. 2008/2010): full-pose clamp at the origin "
-          "along +x and grasp u = (X, Y, Z, rotation vector)";
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  auto positive = [&](const char* name, double def, const char* units, const char* doc) {
-    return ParamSpec{.name = name, .default_value = def, .min = 0.0, .min_inclusive = false,
-                     .max = kInf, .units = units, .doc = doc};
-  };
-  r.params = {
-      {.name = "n", .kind = ParamKind::kInteger, .default_value = 20, .min = 3,
-       .doc = "number of edges (the clamp and the grasp hold one each)"},
-      positive("length", 1.0, "m", "rest length L (every edge L / n)"),
-      positive("stretch_stiffness", 1000.0, "N", "EA in 1/2 EA (|e|/l - 1)^2 l per edge"),
-      positive("bend_stiffness", 1.0, "N m^2", "B1 = EI for bending towards m1 (kappa1) [DER (4)]"),
-      {.name = "bend_stiffness_2", .default_value = 0.0, .min = 0.0, .units = "N m^2",
-       .doc = "B2 for bending towards m2 (kappa2); 0 = bend_stiffness (a round rod), >> B1 a ribbon"},
-      positive("twist_stiffness", 1.0, "N m^2", "GJ in 1/2 GJ (twist)^2 / l [DVT (4)]"),
-      {.name = "natural_curvature", .default_value = 0.0, .units = "1/m",
-       .doc = "natural material curvature kappa1-bar (bending towards m1)"},
-      {.name = "natural_curvature_2", .default_value = 0.0, .units = "1/m",
-       .doc = "natural material curvature kappa2-bar (bending towards m2)"},
-      {.name = "clamp", .kind = ParamKind::kBool, .default_value = 1.0,
-       .doc = "false: no clamp, a first grasp holds edge 0 (u = (its pose, the last edge's pose))"},
-      {.name = "radius", .default_value = 0.01, .min = 0.0, .units = "m",
-       .doc = "tube radius (drawing; the capsule radius of self-contact)"},
-  };
-  for (ParamSpec& spec : internal::ContactParamSpecs()) r.params.push_back(std::move(spec));
-  r.factory = [](const ModelParams& mp) -> std::unique_ptr<Model> {
-    RodParams p;
-    p.n = mp.Integer("n");
-    p.length = mp.Number("length");
-    p.stretch_stiffness = mp.Number("stretch_stiffness");
-    p.bend_stiffness = mp.Number("bend_stiffness");
-    const double b2 = mp.Number("bend_stiffness_2");
-    p.bend_stiffness_2 = b2 > 0.0 ? b2 : p.bend_stiffness;
-    p.twist_stiffness = mp.Number("twist_stiffness");
-    p.natural_curvature = mp.Number("natural_curvature");
-    p.natural_curvature_2 = mp.Number("natural_curvature_2");
-    p.radius = mp.Number("radius");
-    p.free_start = !mp.Bool("clamp");
-    p.contact = internal::ReadContactParams(mp);
-    return std::make_unique<RodModel>(p);
-  };
-  r.check = [](const ModelParams& mp, std::string* error) {
-    if (mp.Bool("clamp") || mp.Integer("n") >= 5) return true;
-    if (error != nullptr) *error = "params.n: expected an integer >= 5 with clamp: false (two grasps)";
-    return false;
-  };
-  r.capabilities.grasp_sites = [](const ModelParams& mp) {
-    const std::string last = "edge " + std::to_string(mp.Integer("n") - 1);
-    return mp.Bool("clamp") ? std::vector<std::string>{last} : std::vector<std::string>{"edge 0", last};
-  };
-  r.capabilities.grasp_layout = [](const ModelParams&) {
-    return GraspLayout{.spatial_dimension = 3, .grip_rotation = true};
-  };
-  return r;
 }
 
 }  // namespace snapthread

@@ -34,32 +34,9 @@
 #include "models/history_capability.h"
 #include "models/model.h"
 #include "models/rod_energy.h"
+#include "models/rod_params.h"
 
 namespace snapthread {
-
-struct RodParams {
-  int n = 10;                       // edges (≥ 3)
-  double length = 1.0;              // rest length L (m); every edge ℓ = L / n
-  double stretch_stiffness = 1000;  // EA (N)
-  double bend_stiffness = 1.0;      // B1 = EI about m2, for κ1 (N m²)
-  double bend_stiffness_2 = 1.0;    // B2 about m1, for κ2 (N m²)
-  double twist_stiffness = 1.0;     // GJ (N m²)
-  double natural_curvature = 0.0;   // κ̄1 (1/m), bending towards m1
-  double natural_curvature_2 = 0.0; // κ̄2 (1/m), bending towards m2
-  double radius = 0.01;             // tube radius: drawing, and contact (m)
-  // Self-contact (issue 15): capsules of `radius` with IPC's barrier; off by default.
-  // contact.radius is ignored: `radius` is the capsule radius.
-  contact::ContactParams contact{};
-  Eigen::Vector3d clamp_position = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d clamp_rotation = Eigen::Matrix3d::Identity();
-  Eigen::Matrix3d grasp_rotation = Eigen::Matrix3d::Identity();  // R_start (φ = 0)
-  // No clamp (issue 15): edge 0 is held by a first grasp u[0..5] = (p, φ) with
-  // x_0 = p, x_1 = p + ℓ R e_x, R = exp([φ]×) clamp_rotation, m1_0 = R e_y, and the
-  // grasp above takes u[6..11]. Both ends held by full poses leave no rigid-body motion.
-  bool free_start = false;
-
-  bool IsValid(std::string* error) const;
-};
 
 class RodModel final : public Model,
                        public BandAssemblyCapability,
@@ -203,9 +180,24 @@ class RodModel final : public Model,
   // assembly variables, with its edges in edges_ (PrepareEdges); returns the term's energy.
   template <class F>
   double Local(int t, const GraspMaps& gm, bool want_h, F&& f) const;
+  // Local()'s steps: the term's energy and its derivatives in its own coordinates y (the
+  // nodes and angles it touches; g and h may be uninitialised past the term's size), and,
+  // for a term that touches a grasp, the chain rule through the grasp map to its
+  // assembly variables (states, then the 6 controls).
+  using LocalGradient = Eigen::Matrix<double, kMaxLocal, 1>;
+  using LocalHessian = Eigen::Matrix<double, kMaxLocal, kMaxLocal>;
+  using TermGradient = Eigen::Matrix<double, internal::HessianAssembly::kMaxTermVars, 1>;
+  using TermHessian =
+      Eigen::Matrix<double, internal::HessianAssembly::kMaxTermVars, internal::HessianAssembly::kMaxTermVars>;
+  double TermDerivatives(const Term& term, bool want_h, LocalGradient* gy, LocalHessian* hy) const;
+  void GraspChainRule(int t, const GraspMaps& gms, bool want_h, const LocalGradient& gy, const LocalHessian& hy,
+                      TermGradient* ga, TermHessian* ha) const;
   // An interior term (Term::first >= 0) straight into g and, when band is not null, the
   // lower band of half-bandwidth b: the values Local() and the assembly give, the same bits.
   double AddInteriorTerm(const Term& term, double* g, double* band, int b) const;
+  // Its two kinds: an edge's stretching, a vertex's bending and twist.
+  double AddInteriorEdge(const Term& term, double* g, double* band, int b) const;
+  double AddInteriorVertex(const Term& term, double* g, double* band, int b) const;
 
   RodParams p_;
   int n_;

@@ -24,6 +24,7 @@
 
 #include "models/chain_band_terms.h"
 #include "models/chain_model.h"
+#include "models/chain_terms.h"
 #include "models/contact_capability.h"
 #include "models/contact_terms.h"
 #include "models/registry.h"
@@ -225,6 +226,75 @@ class Thread3dModel final : public ChainModel<Thread3dModel>, public ContactCapa
     terms_.push_back(term);
   }
 
+  // Local()'s chain rule for a term at the grip: from the term's node coordinates
+  // (lg, lh) to its assembly variables (gg, hh), through the grip's node p_{N-1}.
+  // lh: null unless want_h.
+  void GripChainRule(int t, const Vec& x, const Vec& u, bool want_h, const Eigen::Matrix<double, 9, 1>& lg,
+                     const Eigen::Matrix<double, 9, 9>* lh, LocalVec* gg, LocalMat* hh) const {
+    // Chain rule to the term's variables through p_{N-1} = P - s d̂, d̂ = d/ρ, ρ = |d|.
+    // Its Jacobian w.r.t. g = (s, X, Y, Z, dx, dy, dz) is A = [-d̂ | I | -s Q/ρ] with
+    // Q = I - d̂ d̂^T; the other nodes' coordinates map one-to-one. So (G = grip rows)
+    //   E_g = A^T e_G,  E_rg = (H_rG A),  E_gg = A^T H_GG A + curvature, where
+    //   Σ_k e_k ∂²p_k/∂s∂d_j   = -(Q e)_j / ρ,
+    //   Σ_k e_k ∂²p_k/∂d_i∂d_j = s [e_i d̂_j + d̂_i e_j + (e·d̂)(δ_ij - 3 d̂_i d̂_j)] / ρ².
+    // Variables shared with node N (X, Y, Z) simply accumulate.
+    const V3 d = u.segment<3>(3);
+    const double rho = d.norm();
+    const V3 dh = d / rho;
+    const double s = x[nx_ - 1];
+    Eigen::Matrix3d q = -dh * dh.transpose();
+    q.diagonal().array() += 1.0;
+    Eigen::Matrix<double, 3, 7> jac_grip;
+    jac_grip.col(0) = -dh;
+    jac_grip.middleCols<3>(1).setIdentity();
+    jac_grip.rightCols<3>() = (-s / rho) * q;
+    const Term& term = terms_[t];
+    const int nodes = term.bend ? 3 : 2;
+    const int g0 = 3 * term.grip_local;
+    const int k = assembly_.TermSize(t);
+    const V3 eg = lg.segment<3>(g0);
+    gg->head(k).setZero();
+    for (int r = 0; r < 3 * nodes; ++r) {
+      if (r < g0 || r >= g0 + 3) {
+        if (term.coord_pos[r] >= 0) (*gg)[term.coord_pos[r]] += lg[r];
+      }
+    }
+    const Eigen::Matrix<double, 7, 1> ag = jac_grip.transpose() * eg;
+    for (int m = 0; m < 7; ++m) (*gg)[term.grip_pos[m]] += ag[m];
+    if (want_h) {
+      hh->topLeftCorner(k, k).setZero();
+      const Eigen::Matrix<double, 9, 7> b = lh->middleCols<3>(g0) * jac_grip;
+      for (int c = 0; c < 3 * nodes; ++c) {
+        if (c >= g0 && c < g0 + 3) continue;
+        const int pc = term.coord_pos[c];
+        if (pc < 0) continue;
+        for (int r = 0; r < 3 * nodes; ++r) {
+          if (r >= g0 && r < g0 + 3) continue;
+          if (term.coord_pos[r] >= 0) (*hh)(term.coord_pos[r], pc) += (*lh)(r, c);
+        }
+        for (int m = 0; m < 7; ++m) {
+          (*hh)(pc, term.grip_pos[m]) += b(c, m);
+          (*hh)(term.grip_pos[m], pc) += b(c, m);
+        }
+      }
+      Eigen::Matrix<double, 7, 7> gg_block = jac_grip.transpose() * b.middleRows<3>(g0);
+      const V3 qe = q * eg / rho;
+      const double ed = eg.dot(dh);
+      const double cs = s / (rho * rho);
+      for (int j = 0; j < 3; ++j) {
+        gg_block(0, 4 + j) -= qe[j];
+        gg_block(4 + j, 0) -= qe[j];
+        for (int i = 0; i < 3; ++i) {
+          gg_block(4 + i, 4 + j) +=
+              cs * (eg[i] * dh[j] + dh[i] * eg[j] + ed * ((i == j ? 1.0 : 0.0) - 3.0 * dh[i] * dh[j]));
+        }
+      }
+      for (int m2 = 0; m2 < 7; ++m2) {
+        for (int m = 0; m < 7; ++m) (*hh)(term.grip_pos[m], term.grip_pos[m2]) += gg_block(m, m2);
+      }
+    }
+  }
+
   // Calls f(local gradient, local Hessian (valid if want_h), leading dimension) for
   // term t, in the term's assembly variables; returns the term's energy (the value
   // ChainEnergy adds for it).
@@ -258,69 +328,9 @@ class Thread3dModel final : public ChainModel<Thread3dModel>, public ContactCapa
       f(lg.data(), lh.data(), 9);
       return energy;
     }
-    // Chain rule to the term's variables through p_{N-1} = P - s d̂, d̂ = d/ρ, ρ = |d|.
-    // Its Jacobian w.r.t. g = (s, X, Y, Z, dx, dy, dz) is A = [-d̂ | I | -s Q/ρ] with
-    // Q = I - d̂ d̂^T; the other nodes' coordinates map one-to-one. So (G = grip rows)
-    //   E_g = A^T e_G,  E_rg = (H_rG A),  E_gg = A^T H_GG A + curvature, where
-    //   Σ_k e_k ∂²p_k/∂s∂d_j   = -(Q e)_j / ρ,
-    //   Σ_k e_k ∂²p_k/∂d_i∂d_j = s [e_i d̂_j + d̂_i e_j + (e·d̂)(δ_ij - 3 d̂_i d̂_j)] / ρ².
-    // Variables shared with node N (X, Y, Z) simply accumulate.
-    const V3 d = u.segment<3>(3);
-    const double rho = d.norm();
-    const V3 dh = d / rho;
-    const double s = x[nx_ - 1];
-    Eigen::Matrix3d q = -dh * dh.transpose();
-    q.diagonal().array() += 1.0;
-    Eigen::Matrix<double, 3, 7> jac_grip;
-    jac_grip.col(0) = -dh;
-    jac_grip.middleCols<3>(1).setIdentity();
-    jac_grip.rightCols<3>() = (-s / rho) * q;
-    const int nodes = term.bend ? 3 : 2;
-    const int g0 = 3 * term.grip_local;
-    const int k = assembly_.TermSize(t);
-    const V3 eg = lg.segment<3>(g0);
     LocalVec gg;
-    gg.head(k).setZero();
-    for (int r = 0; r < 3 * nodes; ++r) {
-      if (r < g0 || r >= g0 + 3) {
-        if (term.coord_pos[r] >= 0) gg[term.coord_pos[r]] += lg[r];
-      }
-    }
-    const Eigen::Matrix<double, 7, 1> ag = jac_grip.transpose() * eg;
-    for (int m = 0; m < 7; ++m) gg[term.grip_pos[m]] += ag[m];
     LocalMat hh;
-    if (want_h) {
-      hh.topLeftCorner(k, k).setZero();
-      const Eigen::Matrix<double, 9, 7> b = lh.middleCols<3>(g0) * jac_grip;
-      for (int c = 0; c < 3 * nodes; ++c) {
-        if (c >= g0 && c < g0 + 3) continue;
-        const int pc = term.coord_pos[c];
-        if (pc < 0) continue;
-        for (int r = 0; r < 3 * nodes; ++r) {
-          if (r >= g0 && r < g0 + 3) continue;
-          if (term.coord_pos[r] >= 0) hh(term.coord_pos[r], pc) += lh(r, c);
-        }
-        for (int m = 0; m < 7; ++m) {
-          hh(pc, term.grip_pos[m]) += b(c, m);
-          hh(term.grip_pos[m], pc) += b(c, m);
-        }
-      }
-      Eigen::Matrix<double, 7, 7> gg_block = jac_grip.transpose() * b.middleRows<3>(g0);
-      const V3 qe = q * eg / rho;
-      const double ed = eg.dot(dh);
-      const double cs = s / (rho * rho);
-      for (int j = 0; j < 3; ++j) {
-        gg_block(0, 4 + j) -= qe[j];
-        gg_block(4 + j, 0) -= qe[j];
-        for (int i = 0; i < 3; ++i) {
-          gg_block(4 + i, 4 + j) +=
-              cs * (eg[i] * dh[j] + dh[i] * eg[j] + ed * ((i == j ? 1.0 : 0.0) - 3.0 * dh[i] * dh[j]));
-        }
-      }
-      for (int m2 = 0; m2 < 7; ++m2) {
-        for (int m = 0; m < 7; ++m) hh(term.grip_pos[m], term.grip_pos[m2]) += gg_block(m, m2);
-      }
-    }
+    GripChainRule(t, x, u, want_h, lg, want_h ? &lh : nullptr, &gg, &hh);
     f(gg.data(), hh.data(), kMaxVars);
     return energy;
   }

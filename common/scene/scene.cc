@@ -332,6 +332,59 @@ void ApplyOverrides(YAML::Node root, const std::vector<SceneOverride>& overrides
   }
 }
 
+// The scene's solver: block (what it says about solving; the method is checked where the
+// solver is made).
+void ReadSolver(const YAML::Node& s, const Reader& rd, Scene* sc) {
+  rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "time_budget_us", "max_time_us",
+                             "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor",
+                             "max_update_hz"});
+  sc->max_update_hz = rd.Number(s, "max_update_hz", "solver.max_update_hz", 0.0);
+  if (!(sc->max_update_hz >= 0.0 && sc->max_update_hz <= 100000.0))
+    throw SceneError(sc->file + ": solver.max_update_hz: expected a rate in [0, 100000] Hz (0 = no cap), got " +
+                     std::to_string(sc->max_update_hz));
+  if (s["method"]) {
+    // A registered solver's name: checked where the solver is made (MakeSolver), since
+    // a scene links no solver code (the device client reads scenes).
+    sc->solver.method = rd.Get<std::string>(s["method"], "solver.method", "a method name");
+  }
+  sc->solver.cutoff = rd.Positive(s, "cutoff", "solver.cutoff", sc->solver.cutoff);
+  if (s["max_iterations"]) {
+    sc->solver.max_iterations = rd.Get<int>(s["max_iterations"], "solver.max_iterations", "an integer >= 0");
+  }
+  // time_budget_us; max_time_us is its earlier spelling, still read.
+  if (s["time_budget_us"] && s["max_time_us"])
+    throw SceneError(sc->file + ": solver.time_budget_us: also given as solver.max_time_us; keep one");
+  sc->solver.max_time_us = s["time_budget_us"]
+                              ? rd.Number(s, "time_budget_us", "solver.time_budget_us", 0.0)
+                              : rd.Number(s, "max_time_us", "solver.max_time_us", 0.0);
+  if (s["linear_solver"])
+    sc->solver.linear_solver = rd.Get<std::string>(s["linear_solver"], "solver.linear_solver", "a backend name");
+  sc->solver.degeneracy_ratio = rd.Number(s, "degeneracy_ratio", "solver.degeneracy_ratio", sc->solver.degeneracy_ratio);
+  sc->solver.max_reduction_step =
+      rd.Number(s, "max_reduction_step", "solver.max_reduction_step", sc->solver.max_reduction_step);
+  if (s["secant_predictor"])
+    sc->solver.secant_predictor = rd.Get<bool>(s["secant_predictor"], "solver.secant_predictor", "true or false");
+  std::string error;
+  if (!sc->solver.IsValid(&error)) throw SceneError(sc->file + ": " + error);
+}
+
+// The scene's device: block (the map between the model and the haptic device).
+void ReadDevice(const YAML::Node& d, const Reader& rd, DeviceMapping* device) {
+  rd.CheckKeys(d, "device", {"model_units_per_metre", "newtons_per_model_force", "max_force_n",
+                             "max_stiffness_n_per_m", "workspace_radius_m", "model_origin"});
+  DeviceMapping& dm = *device;
+  dm.model_units_per_metre = rd.Positive(d, "model_units_per_metre", "device.model_units_per_metre", dm.model_units_per_metre);
+  dm.newtons_per_model_force =
+      rd.Positive(d, "newtons_per_model_force", "device.newtons_per_model_force", dm.newtons_per_model_force);
+  dm.max_force_n = rd.Positive(d, "max_force_n", "device.max_force_n", dm.max_force_n);
+  dm.max_stiffness_n_per_m = rd.Positive(d, "max_stiffness_n_per_m", "device.max_stiffness_n_per_m", dm.max_stiffness_n_per_m);
+  dm.workspace_radius_m = rd.Positive(d, "workspace_radius_m", "device.workspace_radius_m", dm.workspace_radius_m);
+  if (d["model_origin"]) {
+    const Vec o = rd.Vector(d["model_origin"], "device.model_origin", 3);
+    dm.model_origin = {o[0], o[1], o[2]};
+  }
+}
+
 }  // namespace
 
 SceneOverride ParseOverride(const std::string& text) {
@@ -398,56 +451,8 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
     sc.path = std::move(g.path);
   }
 
-  if (root["solver"]) {
-    const YAML::Node s = root["solver"];
-    rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "time_budget_us", "max_time_us",
-                               "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor",
-                               "max_update_hz"});
-    sc.max_update_hz = rd.Number(s, "max_update_hz", "solver.max_update_hz", 0.0);
-    if (!(sc.max_update_hz >= 0.0 && sc.max_update_hz <= 100000.0))
-      throw SceneError(file_label + ": solver.max_update_hz: expected a rate in [0, 100000] Hz (0 = no cap), got " +
-                       std::to_string(sc.max_update_hz));
-    if (s["method"]) {
-      // A registered solver's name: checked where the solver is made (MakeSolver), since
-      // a scene links no solver code (the device client reads scenes).
-      sc.solver.method = rd.Get<std::string>(s["method"], "solver.method", "a method name");
-    }
-    sc.solver.cutoff = rd.Positive(s, "cutoff", "solver.cutoff", sc.solver.cutoff);
-    if (s["max_iterations"]) {
-      sc.solver.max_iterations = rd.Get<int>(s["max_iterations"], "solver.max_iterations", "an integer >= 0");
-    }
-    // time_budget_us (issue 13); max_time_us is its earlier spelling, still read.
-    if (s["time_budget_us"] && s["max_time_us"])
-      throw SceneError(file_label + ": solver.time_budget_us: also given as solver.max_time_us; keep one");
-    sc.solver.max_time_us = s["time_budget_us"]
-                                ? rd.Number(s, "time_budget_us", "solver.time_budget_us", 0.0)
-                                : rd.Number(s, "max_time_us", "solver.max_time_us", 0.0);
-    if (s["linear_solver"])
-      sc.solver.linear_solver = rd.Get<std::string>(s["linear_solver"], "solver.linear_solver", "a backend name");
-    sc.solver.degeneracy_ratio = rd.Number(s, "degeneracy_ratio", "solver.degeneracy_ratio", sc.solver.degeneracy_ratio);
-    sc.solver.max_reduction_step =
-        rd.Number(s, "max_reduction_step", "solver.max_reduction_step", sc.solver.max_reduction_step);
-    if (s["secant_predictor"])
-      sc.solver.secant_predictor = rd.Get<bool>(s["secant_predictor"], "solver.secant_predictor", "true or false");
-    if (!sc.solver.IsValid(&error)) throw SceneError(file_label + ": " + error);
-  }
-
-  if (root["device"]) {
-    const YAML::Node d = root["device"];
-    rd.CheckKeys(d, "device", {"model_units_per_metre", "newtons_per_model_force", "max_force_n",
-                               "max_stiffness_n_per_m", "workspace_radius_m", "model_origin"});
-    DeviceMapping& dm = sc.device;
-    dm.model_units_per_metre = rd.Positive(d, "model_units_per_metre", "device.model_units_per_metre", dm.model_units_per_metre);
-    dm.newtons_per_model_force =
-        rd.Positive(d, "newtons_per_model_force", "device.newtons_per_model_force", dm.newtons_per_model_force);
-    dm.max_force_n = rd.Positive(d, "max_force_n", "device.max_force_n", dm.max_force_n);
-    dm.max_stiffness_n_per_m = rd.Positive(d, "max_stiffness_n_per_m", "device.max_stiffness_n_per_m", dm.max_stiffness_n_per_m);
-    dm.workspace_radius_m = rd.Positive(d, "workspace_radius_m", "device.workspace_radius_m", dm.workspace_radius_m);
-    if (d["model_origin"]) {
-      const Vec o = rd.Vector(d["model_origin"], "device.model_origin", 3);
-      dm.model_origin = {o[0], o[1], o[2]};
-    }
-  }
+  if (root["solver"]) ReadSolver(root["solver"], rd, &sc);
+  if (root["device"]) ReadDevice(root["device"], rd, &sc.device);
   if (root["targets"]) {
     const YAML::Node t = root["targets"];
     rd.CheckKeys(t, "targets", {"force_error", "rate_hz"});

@@ -128,6 +128,19 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
   v.cwiseAbs().maxCoeff(&k);
   if (FactorRestricted(k, s) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
 
+  if (!ReductionDirections(k)) return StepResult::kFailed;
+  // e0 before the differences: a model may keep the energy of the state it evaluated last.
+  const double e0 = model().Energy(*x, u);
+  ReducedQuartic q;
+  if (!ReducedQuarticAt(u, *x, k, s, &q)) return StepResult::kFailed;
+
+  double s_star = 0.0;
+  if (!FollowedMinimum(q, options().max_reduction_step, &s_star)) return StepResult::kSnap;
+
+  return BacktrackAlongCurve(u, x, s_star, e0);
+}
+
+bool HigherOrderSolver::ReductionDirections(int k) {
   // DESIGN.md #2: the graph tangent v' with v'_k = 1, H_{-k,-k} v'_{-k} = -H_{-k,k}.
   // It equals v at the fold and makes the correction exactly Newton on a quadratic.
   rhs_.setZero();
@@ -139,21 +152,24 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
     for (int p = outer[k]; p < outer[k + 1]; ++p) rhs_[inner[p]] = -val[p];
   }
   rhs_[k] = 1.0;
-  if (SolveModified(rhs_, &vt_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+  if (SolveModified(rhs_, &vt_) != LinearSolverStatus::kSuccess) return false;
 
   // Newton in the complement: delta with delta_k = 0 and (E_x + H delta)_{-k} = 0.
   const Vec& g = Gradient();
   rhs_ = -g;
   rhs_[k] = 0.0;
-  if (SolveModified(rhs_, &delta_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+  if (SolveModified(rhs_, &delta_) != LinearSolverStatus::kSuccess) return false;
+  return true;
+}
 
+bool HigherOrderSolver::ReducedQuarticAt(const Vec& u, const Vec& x, int k, SolverSummary* s, ReducedQuartic* q) {
   // r = D^3E[v', v'] by central differences of the analytic gradient (2.37), and
   // q = (g+ - g-)/2h = H v' + h^2/6 D^4E[v',v',v'] for the quartic coefficient.
-  const double e0 = model().Energy(*x, u);
+  const Vec& g = Gradient();
   const double h = kDifferenceStep;
-  xs_ = *x + h * vt_;
+  xs_ = x + h * vt_;
   EvalGradient(xs_, u, &gp_, s);
-  xs_ = *x - h * vt_;
+  xs_ = x - h * vt_;
   EvalGradient(xs_, u, &gm_, s);
   // r into rhs_ (scratch), q into gp_.
   rhs_ = (gp_ - 2.0 * g + gm_) / (h * h);
@@ -174,22 +190,21 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
   // (2.52): H_{-k,-k} w_{-k} = -1/2 r_{-k}, w_k = 0.
   gm_ = -0.5 * rhs_;
   gm_[k] = 0.0;
-  if (SolveModified(gm_, &w_) != LinearSolverStatus::kSuccess) return StepResult::kFailed;
+  if (SolveModified(gm_, &w_) != LinearSolverStatus::kSuccess) return false;
   const double r_w = rhs_.dot(w_);            // D^3E[v',v',w]
 
   // (2.54-2.55) along c(s) = x + delta + s v' + s^2 w. With (Hv')_{-k} = 0, w_k = 0
   // and (E_x + H delta)_{-k} = 0 the cross terms collapse:
   //   phi1 = E_x.v'   phi2 = 1/2 v'^T H v'   phi3 = 1/6 D^3[v'^3] + v'^T H w = 1/6 D^3[v'^3]
   //   phi4 = 1/2 w^T H w + 1/2 D^3[v',v',w] + 1/24 D^4[v'^4] = 1/4 r.w + 1/24 D^4[v'^4]
-  ReducedQuartic q;
-  q.phi1 = g.dot(vt_);
-  q.phi2 = 0.5 * hvv;
-  q.phi3 = r_v / 6.0;
-  q.phi4 = 0.25 * r_w + d4 / 24.0;
+  q->phi1 = g.dot(vt_);
+  q->phi2 = 0.5 * hvv;
+  q->phi3 = r_v / 6.0;
+  q->phi4 = 0.25 * r_w + d4 / 24.0;
+  return true;
+}
 
-  double s_star = 0.0;
-  if (!FollowedMinimum(q, options().max_reduction_step, &s_star)) return StepResult::kSnap;
-
+HigherOrderSolver::StepResult HigherOrderSolver::BacktrackAlongCurve(const Vec& u, Vec* x, double s_star, double e0) {
   // Energy decrease (Armijo-type) on every higher-order step (DESIGN.md #4): backtrack
   // along the curve; a step that cannot decrease the energy is refused (e0 from before
   // the differences: a model may keep the energy of the state it evaluated last).
@@ -219,6 +234,101 @@ bool HigherOrderSolver::FinishSnap(const Vec& u, Vec* x, SolverSummary* s) {
   return MinimizeFully(u, x, s);
 }
 
+void HigherOrderSolver::SnapAndStop(const Vec& u, Vec* x, SolverSummary* s, double* r) {
+  if (!FinishSnap(u, x, s)) {
+    s->termination = Termination::kLinearSolverFailed;
+    s->message = "snap minimiser did not converge";
+  }
+  *r = EvalGradient(*x, u, s);
+  if (s->termination != Termination::kLinearSolverFailed && *r < options().cutoff)
+    s->termination = Termination::kConverged;
+}
+
+HigherOrderSolver::NewtonCheck HigherOrderSolver::CheckNewtonStep(const Vec& u, const Vec& x, double lambda0,
+                                                                  SolverSummary* s, bool* trial_gradient) {
+  // Regular: the Newton step (2.18).
+  if (ComputeNewtonStep() != LinearSolverStatus::kSuccess) return NewtonCheck::kFailed;
+  // A Newton step longer than the reduction's cap leaves the region where the
+  // quadratic model holds: the control step has carried the state over a fold while
+  // lambda_0 still looked regular (DESIGN.md's open case). Finish it as a snap.
+  if (NewtonStep().lpNorm<Eigen::Infinity>() > options().max_reduction_step) return NewtonCheck::kSnap;
+  // Approaching a fold (lambda_0 below its reference) a Newton step must also
+  // lower the energy; one that raises it is aimed at the saddle that is about to
+  // meet the followed minimum, so this iteration uses the reduction instead.
+  const double ref = ReferenceLambda() > 0.0 ? ReferenceLambda() : lambda0;
+  bool take_newton = true;
+  *trial_gradient = false;
+  if (lambda0 < 1.0 * ref) {
+    // E at x first (a model may keep the energy of the state it evaluated last: the
+    // pass that gave E_xx or E_x here), then E_x at the trial state, which the
+    // iteration needs there if the step is taken, and E with it.
+    const double e_here = model().Energy(x, u);
+    xs_ = x - NewtonStep();
+    EvalGradient(xs_, u, &g_trial_, s);
+    take_newton = model().Energy(xs_, u) <= e_here;
+    *trial_gradient = true;
+  }
+  return take_newton ? NewtonCheck::kTake : NewtonCheck::kRefused;
+}
+
+bool HigherOrderSolver::NewtonIteration(const Vec& u, Vec* x, bool trial_gradient, double* r, SolverSummary* s) {
+  TakeNewtonStep(u, x);
+  // Where E_xx is regular Newton converges quadratically; a step that does not
+  // even halve |E_x| says the quadratic model has failed (a fold is close): the
+  // next iteration uses the reduction. (The step goes to the trial state, unless a
+  // collision bound shortened it: then its gradient is not the one there.)
+  const double r_before = *r;
+  const bool at_trial = trial_gradient && std::memcmp(x->data(), xs_.data(), sizeof(double) * x->size()) == 0;
+  if (at_trial) {
+    *r = AdoptGradient(&g_trial_);
+  } else {
+    // After a step that was not tiny E_xx is needed here next (the next iteration
+    // or Finish()): one pass gives it with E_x.
+    *r = LastStepTiny() ? EvalGradient(*x, u, s) : EvalGradientAndHessian(*x, u, s);
+  }
+  return !(*r < 0.5 * r_before);
+}
+
+bool HigherOrderSolver::ReductionIteration(const Vec& u, Vec* x, LinearSolverStatus st, int* reduction_stalls,
+                                           double* r, SolverSummary* s) {
+  // A factorisation that failed on an exactly singular E_xx still allows the
+  // reduction: it needs only the restricted factor and the last eigenvector.
+  const bool many_negative = st == LinearSolverStatus::kSuccess && HessianFactor().NegativePivots() > 1;
+  StepResult res = StepResult::kFailed;
+  if (!many_negative) {
+    EnsureEigenvector();
+    res = ReductionStep(u, x, s);
+  }
+  if (res == StepResult::kSnap || many_negative) {
+    SnapAndStop(u, x, s, r);
+    return false;
+  }
+  if (res == StepResult::kFailed) {
+    // The reduction could not decrease the energy: one globalised step instead.
+    if (!GlobalizedStep(u, x, s)) {
+      s->termination = Termination::kLinearSolverFailed;
+      s->message = "no descent step found";
+      return false;
+    }
+  }
+  // On the quartic the reduction converges like Newton. Where the followed minimum
+  // has just vanished its ghost still attracts the quartic model, and the steps
+  // crawl through the bottleneck: two steps in a row that do not halve |E_x| mean
+  // the minimum is gone — finish the snap now rather than over the next updates.
+  // A reduction step that raises |E_x| (the energy fell, the force grew) says the
+  // same at once.
+  // E_xx is needed at the new state next (the next iteration, Finish() or the snap
+  // minimiser's first step): one pass gives it with E_x.
+  const double r_before = *r;
+  *r = EvalGradientAndHessian(*x, u, s);
+  *reduction_stalls = (*r < 0.5 * r_before) ? 0 : *reduction_stalls + 1;
+  if (*reduction_stalls >= 2 || *r > r_before) {
+    SnapAndStop(u, x, s, r);
+    return false;
+  }
+  return true;
+}
+
 SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   SolverSummary s;
   if (!BeginSolve(u, *x, &s) || ContinueSnap(u, x, &s)) return s;
@@ -228,16 +338,6 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   bool newton_stalled = false;
   bool trial_gradient = false;  // g_trial_ holds E_x at xs_ (the Newton trial state)
   int reduction_stalls = 0;
-  // Finishes a snap inside this update (DESIGN.md #4) and ends the iteration loop.
-  auto snap_and_stop = [&] {
-    if (!FinishSnap(u, &xr, &s)) {
-      s.termination = Termination::kLinearSolverFailed;
-      s.message = "snap minimiser did not converge";
-    }
-    r = EvalGradient(xr, u, &s);
-    if (s.termination != Termination::kLinearSolverFailed && r < options().cutoff)
-      s.termination = Termination::kConverged;
-  };
   while (NextIteration(r, x, &s)) {
     const LinearSolverStatus st = FactorAt(xr, u, &s);
     bool degenerate = true;
@@ -251,94 +351,22 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
                    newton_stalled;
     }
     if (!degenerate) {
-      // Regular: the Newton step (2.18).
-      if (ComputeNewtonStep() != LinearSolverStatus::kSuccess) {
+      const NewtonCheck check = CheckNewtonStep(u, xr, lambda0, &s, &trial_gradient);
+      if (check == NewtonCheck::kFailed) {
         s.termination = Termination::kLinearSolverFailed;
         break;
       }
-      // A Newton step longer than the reduction's cap leaves the region where the
-      // quadratic model holds: the control step has carried the state over a fold while
-      // lambda_0 still looked regular (DESIGN.md's open case). Finish it as a snap.
-      if (NewtonStep().lpNorm<Eigen::Infinity>() > options().max_reduction_step) {
-        snap_and_stop();
+      if (check == NewtonCheck::kSnap) {
+        SnapAndStop(u, &xr, &s, &r);
         break;
       }
-      // Approaching a fold (lambda_0 below its reference) a Newton step must also
-      // lower the energy; one that raises it is aimed at the saddle that is about to
-      // meet the followed minimum, so this iteration uses the reduction instead.
-      const double ref = ReferenceLambda() > 0.0 ? ReferenceLambda() : lambda0;
-      bool take_newton = true;
-      trial_gradient = false;
-      if (lambda0 < 1.0 * ref) {
-        // E at xr first (a model may keep the energy of the state it evaluated last: the
-        // pass that gave E_xx or E_x here), then E_x at the trial state, which the
-        // iteration needs there if the step is taken, and E with it.
-        const double e_here = model().Energy(xr, u);
-        xs_ = xr - NewtonStep();
-        EvalGradient(xs_, u, &g_trial_, &s);
-        take_newton = model().Energy(xs_, u) <= e_here;
-        trial_gradient = true;
-      }
-      if (!take_newton) {
-        degenerate = true;
-      }
+      degenerate = check == NewtonCheck::kRefused;
     }
     if (!degenerate) {
-      TakeNewtonStep(u, &xr);
-      // Where E_xx is regular Newton converges quadratically; a step that does not
-      // even halve |E_x| says the quadratic model has failed (a fold is close): the
-      // next iteration uses the reduction. (The step goes to the trial state, unless a
-      // collision bound shortened it: then its gradient is not the one there.)
-      const double r_before = r;
-      const bool at_trial = trial_gradient && std::memcmp(xr.data(), xs_.data(), sizeof(double) * xr.size()) == 0;
-      if (at_trial) {
-        r = AdoptGradient(&g_trial_);
-      } else {
-        // After a step that was not tiny E_xx is needed here next (the next iteration
-        // or Finish()): one pass gives it with E_x.
-        r = LastStepTiny() ? EvalGradient(xr, u, &s) : EvalGradientAndHessian(xr, u, &s);
-      }
-      newton_stalled = !(r < 0.5 * r_before);
+      newton_stalled = NewtonIteration(u, &xr, trial_gradient, &r, &s);
       continue;
     }
-    {
-      // A factorisation that failed on an exactly singular E_xx still allows the
-      // reduction: it needs only the restricted factor and the last eigenvector.
-      const bool many_negative = st == LinearSolverStatus::kSuccess && HessianFactor().NegativePivots() > 1;
-      StepResult res = StepResult::kFailed;
-      if (!many_negative) {
-        EnsureEigenvector();
-        res = ReductionStep(u, &xr, &s);
-      }
-      if (res == StepResult::kSnap || many_negative) {
-        snap_and_stop();
-        break;
-      }
-      if (res == StepResult::kFailed) {
-        // The reduction could not decrease the energy: one globalised step instead.
-        if (!GlobalizedStep(u, &xr, &s)) {
-          s.termination = Termination::kLinearSolverFailed;
-          s.message = "no descent step found";
-          break;
-        }
-      }
-      // On the quartic the reduction converges like Newton. Where the followed minimum
-      // has just vanished its ghost still attracts the quartic model, and the steps
-      // crawl through the bottleneck: two steps in a row that do not halve |E_x| mean
-      // the minimum is gone — finish the snap now rather than over the next updates.
-      // A reduction step that raises |E_x| (the energy fell, the force grew) says the
-      // same at once.
-      // E_xx is needed at the new state next (the next iteration, Finish() or the snap
-      // minimiser's first step): one pass gives it with E_x.
-      const double r_before = r;
-      r = EvalGradientAndHessian(xr, u, &s);
-      reduction_stalls = (r < 0.5 * r_before) ? 0 : reduction_stalls + 1;
-      if (reduction_stalls >= 2 || r > r_before) {
-        snap_and_stop();
-        break;
-      }
-      continue;
-    }
+    if (!ReductionIteration(u, &xr, st, &reduction_stalls, &r, &s)) break;
   }
   // A budget spent on an indefinite E_xx finishes the snap in this update (Conclude).
   Conclude(u, x, &s, /*leave_saddles=*/true, /*finish_snap_on_spent_budget=*/true);

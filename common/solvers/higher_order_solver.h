@@ -2,7 +2,7 @@
 // operational choices of shared/DESIGN.md ("What a prototype of this method showed").
 #pragma once
 
-#include "solvers/newton_solver.h"
+#include "solvers/solver_base.h"
 
 namespace snapthread {
 
@@ -33,6 +33,27 @@ class HigherOrderSolver final : public SolverBase {
   // Finishes a snap inside this control step (DESIGN.md #4): inertia-corrected Newton
   // with Armijo backtracking until converged, past the iteration budget.
   bool FinishSnap(const Vec& u, Vec* x, SolverSummary* s);
+  // ReductionStep's parts, in order: the graph tangent v' (vt_) and the complement's
+  // Newton step delta_ with the restricted factorisation; the reduced quartic (2.54-2.55)
+  // from central differences of E_x along v' (and w_, (2.52)); the energy-decreasing
+  // backtrack along the curve x + delta + s v' + s^2 w from energy e0.
+  bool ReductionDirections(int k);
+  bool ReducedQuarticAt(const Vec& u, const Vec& x, int k, SolverSummary* s, ReducedQuartic* q);
+  StepResult BacktrackAlongCurve(const Vec& u, Vec* x, double s_star, double e0);
+
+  // Solve's steps. SnapAndStop finishes a snap inside this update (DESIGN.md #4) and
+  // leaves |E_x| in *r. CheckNewtonStep computes the Newton step at x and judges it: a
+  // factorisation failure, too long (a snap), refused (it raises E near a fold), or taken
+  // (*trial_gradient: g_trial_ holds E_x at the trial state xs_).
+  enum class NewtonCheck { kTake, kRefused, kSnap, kFailed };
+  void SnapAndStop(const Vec& u, Vec* x, SolverSummary* s, double* r);
+  NewtonCheck CheckNewtonStep(const Vec& u, const Vec& x, double lambda0, SolverSummary* s, bool* trial_gradient);
+  // Takes the Newton step and updates |E_x| in *r; true when it did not halve |E_x|.
+  bool NewtonIteration(const Vec& u, Vec* x, bool trial_gradient, double* r, SolverSummary* s);
+  // A reduction step (or a globalised one where it fails) from x; false when the
+  // iteration loop ends (a snap finished, or no descent step).
+  bool ReductionIteration(const Vec& u, Vec* x, LinearSolverStatus st, int* reduction_stalls, double* r,
+                          SolverSummary* s);
 
   std::vector<int> col_k_rows_, col_k_pos_, row_k_pos_;
   Vec delta_, vt_, w_, rhs_, gp_, gm_, xs_, g_trial_;

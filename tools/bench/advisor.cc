@@ -72,6 +72,51 @@ int SelectCheapest(const std::vector<AdviceCandidate>& c, double te, double tr) 
   return best;
 }
 
+namespace {
+
+// Every configuration (method x cutoff x budget) timed on the scene sc (model size n,
+// 0 for a scene that is not a chain), with its force error against the reference trace.
+std::vector<AdviceCandidate> TimeCandidates(const Scene& sc, int n, const std::vector<Vec>& path,
+                                            const AdvisorOptions& o, const std::vector<SweepRow>& ref,
+                                            double scale) {
+  std::vector<AdviceCandidate> here;
+  for (const std::string& m : o.methods)
+    for (double cutoff : o.cutoffs)
+      for (int budget : o.budgets) {
+        const TimedSweep t = TimeSweep(WithSolver(sc, m, cutoff, budget), path, o.repetitions, o.min_time_s);
+        AdviceCandidate cand;
+        cand.n = n;
+        cand.method = m;
+        cand.cutoff = cutoff;
+        cand.budget = budget;
+        cand.rate_hz = t.rate_hz.median;
+        cand.force_error = RelativeRmsForceError(t.rows, ref, scale);
+        cand.spurious_reversals = Compare(t.rows, ref).spurious_reversals;
+        here.push_back(cand);
+      }
+  return here;
+}
+
+// Why no configuration was chosen after the whole ladder.
+std::string NoChoiceMessage(const Advice& a, bool chain, const std::vector<int>& ladder) {
+  std::ostringstream msg;
+  msg << "no configuration meets both targets: ";
+  if (chain) {
+    const ModelErrorRow* best = nullptr;
+    for (const auto& m : a.model_errors)
+      if (!best || m.force_error < best->force_error) best = &m;
+    msg << "along the ladder (up to n = " << ladder.back() << ") the smallest model error is "
+        << Sci(best ? best->force_error : 0.0) << " (n = " << (best ? best->n : 0) << ")";
+    if (!a.candidates.empty()) msg << "; where the model was fine enough, no fast configuration was accurate enough";
+    msg << ", target " << Sci(a.target_force_error);
+  } else {
+    msg << "no fast enough configuration reaches a force error of " << Sci(a.target_force_error);
+  }
+  return msg.str();
+}
+
+}  // namespace
+
 Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progress) {
   Advice a;
   a.target_force_error = o.target_force_error > 0 ? o.target_force_error : scene.target_force_error;
@@ -113,21 +158,7 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
       if (progress) *progress << "advise: n=" << n << ": model error " << Sci(e) << '\n' << std::flush;
       if (e > a.target_force_error) continue;
     }
-    std::vector<AdviceCandidate> here;
-    for (const std::string& m : o.methods)
-      for (double cutoff : o.cutoffs)
-        for (int budget : o.budgets) {
-          const TimedSweep t = TimeSweep(WithSolver(sc, m, cutoff, budget), path, o.repetitions, o.min_time_s);
-          AdviceCandidate cand;
-          cand.n = chain ? n : 0;
-          cand.method = m;
-          cand.cutoff = cutoff;
-          cand.budget = budget;
-          cand.rate_hz = t.rate_hz.median;
-          cand.force_error = RelativeRmsForceError(t.rows, ref, scale);
-          cand.spurious_reversals = Compare(t.rows, ref).spurious_reversals;
-          here.push_back(cand);
-        }
+    const std::vector<AdviceCandidate> here = TimeCandidates(sc, chain ? n : 0, path, o, ref, scale);
     a.candidates.insert(a.candidates.end(), here.begin(), here.end());
     const int best = SelectCheapest(here, a.target_force_error, a.target_rate_hz);
     if (progress)
@@ -159,20 +190,7 @@ Advice Advise(const Scene& scene, const AdvisorOptions& o, std::ostream* progres
     }
     // Fast enough but every fast configuration is too inaccurate: a finer model may help.
   }
-  std::ostringstream msg;
-  msg << "no configuration meets both targets: ";
-  if (chain) {
-    const ModelErrorRow* best = nullptr;
-    for (const auto& m : a.model_errors)
-      if (!best || m.force_error < best->force_error) best = &m;
-    msg << "along the ladder (up to n = " << ladder.back() << ") the smallest model error is "
-        << Sci(best ? best->force_error : 0.0) << " (n = " << (best ? best->n : 0) << ")";
-    if (!a.candidates.empty()) msg << "; where the model was fine enough, no fast configuration was accurate enough";
-    msg << ", target " << Sci(a.target_force_error);
-  } else {
-    msg << "no fast enough configuration reaches a force error of " << Sci(a.target_force_error);
-  }
-  a.message = msg.str();
+  a.message = NoChoiceMessage(a, chain, ladder);
   return a;
 }
 

@@ -122,6 +122,50 @@ double Microseconds(std::chrono::steady_clock::time_point a, std::chrono::steady
   return std::chrono::duration<double, std::micro>(b - a).count();
 }
 
+// The Ceres options of a setting name (lm-* / dogleg-* with a linear solver suffix), a
+// gradient-norm stop only (the caller adds the callback); false for an unknown name.
+bool SetCeresOptions(const std::string& name, int max_iterations, ceres::Solver::Options* options) {
+  options->minimizer_type = ceres::TRUST_REGION;
+  // The settings: lm-* Levenberg-Marquardt, dogleg-* Powell's dogleg; *-dense-qr,
+  // *-dense-cholesky dense QR / normal Cholesky (Ceres' advice for small problems),
+  // *-sparse-cholmod / *-sparse-eigen sparse normal Cholesky through SuiteSparse or
+  // Eigen (Ceres' advice for large sparse ones), *-cgnr Ceres' iterative solver.
+  auto ends_with = [&](const std::string& tail) {
+    return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  if (name.rfind("lm-", 0) == 0) {
+    options->trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  } else if (name.rfind("dogleg-", 0) == 0) {
+    options->trust_region_strategy_type = ceres::DOGLEG;
+  } else {
+    return false;
+  }
+  if (ends_with("-dense-qr")) {
+    options->linear_solver_type = ceres::DENSE_QR;
+  } else if (ends_with("-dense-cholesky")) {
+    options->linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  } else if (ends_with("-sparse-cholmod")) {
+    options->linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    options->sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  } else if (ends_with("-cgnr")) {
+    options->linear_solver_type = ceres::CGNR;
+    options->preconditioner_type = ceres::JACOBI;
+  } else if (ends_with("-sparse-eigen")) {
+    options->linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    options->sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
+  } else {
+    return false;
+  }
+  options->max_num_iterations = max_iterations;
+  // Only the gradient-norm callback stops a converging solve.
+  options->function_tolerance = 0.0;
+  options->parameter_tolerance = 0.0;
+  options->gradient_tolerance = 0.0;
+  options->num_threads = 1;
+  options->logging_type = ceres::SILENT;
+  return true;
+}
+
 }  // namespace
 
 bool CeresBuilt() { return true; }
@@ -154,47 +198,11 @@ CeresPathResult RunCeresPath(const Scene& scene, const std::vector<Vec>& control
   const double snap_distance = 0.1 * ChainSegmentLength(scene.params);
   CeresThread thread(scene.params);
   ceres::Solver::Options options;
-  options.minimizer_type = ceres::TRUST_REGION;
-  // The settings: lm-* Levenberg-Marquardt, dogleg-* Powell's dogleg; *-dense-qr,
-  // *-dense-cholesky dense QR / normal Cholesky (Ceres' advice for small problems),
-  // *-sparse-cholmod / *-sparse-eigen sparse normal Cholesky through SuiteSparse or
-  // Eigen (Ceres' advice for large sparse ones), *-cgnr Ceres' iterative solver.
   const std::string& name = setting.solver;
-  auto ends_with = [&](const std::string& tail) {
-    return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
-  };
-  if (name.rfind("lm-", 0) == 0) {
-    options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  } else if (name.rfind("dogleg-", 0) == 0) {
-    options.trust_region_strategy_type = ceres::DOGLEG;
-  } else {
+  if (!SetCeresOptions(name, setting.max_iterations, &options)) {
     result.note = "unknown Ceres setting '" + name + "'";
     return result;
   }
-  if (ends_with("-dense-qr")) {
-    options.linear_solver_type = ceres::DENSE_QR;
-  } else if (ends_with("-dense-cholesky")) {
-    options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  } else if (ends_with("-sparse-cholmod")) {
-    options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
-  } else if (ends_with("-cgnr")) {
-    options.linear_solver_type = ceres::CGNR;
-    options.preconditioner_type = ceres::JACOBI;
-  } else if (ends_with("-sparse-eigen")) {
-    options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
-  } else {
-    result.note = "unknown Ceres setting '" + name + "'";
-    return result;
-  }
-  options.max_num_iterations = setting.max_iterations;
-  // Only the gradient-norm callback stops a converging solve.
-  options.function_tolerance = 0.0;
-  options.parameter_tolerance = 0.0;
-  options.gradient_tolerance = 0.0;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
   GradientNormStop stop(setting.cutoff);
   options.callbacks.push_back(&stop);
   std::string why;

@@ -43,14 +43,15 @@ bool RunGnuplot(const std::string& dir, const std::string& name, const std::stri
   return true;
 }
 
+// Adds a note. Out of line: once inlined into the Plot* functions, GCC 12 misreads the
+// copy of a long literal into the vector's new string as out of bounds (-Warray-bounds).
+[[gnu::noinline]] void AddNote(PlotOutcome* out, const std::string& note) { out->notes.push_back(note); }
+
 // A data file of the output directory, by its fixed name.
 std::string Csv(const std::string& name) { return "'" + name + "'"; }
 
-}  // namespace
-
-PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
-  PlotOutcome out;
-  const std::string ch = SessionLabel(r.session());
+// force.png: |F| and its components over time, snaps marked.
+void PlotForce(const std::string& dir, const SessionReview& r, const std::string& ch, PlotOutcome* out) {
   if (r.HasForce()) {
     std::string body = "set title 'Force on the grasp (" + ch + "_FORCE_MODEL f0); snaps marked'\n"
                        "set xlabel 'time [s]'\nset ylabel 'force [N]'\n"
@@ -67,11 +68,14 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
               " skip 1 using 1:2 with impulses lw 2 lc rgb 'red' title 'snap', "
               "'' skip 1 using 1:2 with points pt 7 ps 1.5 lc rgb 'red' notitle";
     }
-    RunGnuplot(dir, "force", body + "\n", &out);
+    RunGnuplot(dir, "force", body + "\n", out);
   } else {
-    out.notes.push_back("force.png not drawn: no " + ch + "_FORCE_MODEL messages");
+    AddNote(out, "force.png not drawn: no " + ch + "_FORCE_MODEL messages");
   }
+}
 
+// knot.png: the knot determinant and the active self-contacts over time.
+void PlotKnot(const std::string& dir, const SessionReview& r, const std::string& ch, PlotOutcome* out) {
   if (r.HasKnot()) {
     RunGnuplot(dir, "knot",
                "set multiplot layout 2,1 title 'Knot type and self-contacts (" + ch +
@@ -82,11 +86,14 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
                    "title '|Delta(-1)|'\nset ylabel 'active contacts'\n"
                    "set ytics autofreq\nplot '' skip 1 using 1:4 with steps lw 2 lc rgb 'red' "
                    "title 'contacts'\nunset multiplot\n",
-               &out);
+               out);
   } else {
-    out.notes.push_back("knot.png not drawn: no knot type or contacts in the solver status");
+    AddNote(out, "knot.png not drawn: no knot type or contacts in the solver status");
   }
+}
 
+// solver.png: iterations, residual and method (or solve time) over time.
+void PlotSolver(const std::string& dir, const SessionReview& r, const std::string& ch, PlotOutcome* out) {
   if (r.HasSolve() || r.HasSolverStatus()) {
     std::string body = "set multiplot layout 3,1 title 'Solver (" + ch + ")'\nset xlabel 'time [s]'\n";
     if (r.HasSolve()) {
@@ -109,11 +116,14 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
               " skip 1 using 1:4 with points pt 7 ps 0.3 title 'solve time'\n";
     }
     body += "unset multiplot\n";
-    RunGnuplot(dir, "solver", body, &out);
+    RunGnuplot(dir, "solver", body, out);
   } else {
-    out.notes.push_back("solver.png not drawn: no force models or solver status");
+    AddNote(out, "solver.png not drawn: no force models or solver status");
   }
+}
 
+// device.png and latency_hist.png: tick lateness, model age and the latency histograms.
+void PlotDevice(const std::string& dir, const SessionReview& r, const std::string& ch, PlotOutcome* out) {
   if (r.HasDevice()) {
     const std::string body =
         "set multiplot layout 2,1 title 'Device (" + ch + "_DEVICE_STATUS)'\nset xlabel 'time [s]'\n"
@@ -122,7 +132,7 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
         "'' skip 1 using 1:5 with lines title 'max'\n"
         "set ylabel 'model age [ms]'\nplot '' skip 1 using 1:6 with lines title 'model age'\n"
         "unset multiplot\n";
-    RunGnuplot(dir, "device", body, &out);
+    RunGnuplot(dir, "device", body, out);
     // Histograms of the per-window statistics the device publishes (~2 Hz windows).
     const std::string hist =
         "set multiplot layout 1,2 title 'Latency histograms (" + ch + ")'\n"
@@ -140,7 +150,7 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
              : "set xlabel 'round trip'\nunset key\nset label 1 'no pose/model pairs in the log' at graph 0.5, graph 0.5 center\n"
                "plot [0:1][0:1] NaN notitle\n") +
         "unset multiplot\n";
-    RunGnuplot(dir, "latency_hist", hist, &out);
+    RunGnuplot(dir, "latency_hist", hist, out);
   } else if (r.HasRoundTrip()) {
     const std::string hist =
         "stats " + Csv("round_trip.csv") + " skip 1 using 2 nooutput\n"
@@ -148,12 +158,23 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
         "set title 'Round trip, pose -> model as logged (" + ch + ")'\n"
         "set xlabel 'round trip [us]'\nset ylabel 'models'\n"
         "plot " + Csv("round_trip.csv") + " skip 1 using (bin($2,w)):(1.0) smooth freq with boxes title 'round trip'\n";
-    RunGnuplot(dir, "latency_hist", hist, &out);
-    out.notes.push_back("device.png not drawn: no " + ch + "_DEVICE_STATUS messages");
+    RunGnuplot(dir, "latency_hist", hist, out);
+    AddNote(out, "device.png not drawn: no " + ch + "_DEVICE_STATUS messages");
   } else {
-    out.notes.push_back("device.png and latency_hist.png not drawn: no device status and no "
-                        "pose/model pairs");
+    AddNote(out, "device.png and latency_hist.png not drawn: no device status and no "
+                 "pose/model pairs");
   }
+}
+
+}  // namespace
+
+PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
+  PlotOutcome out;
+  const std::string ch = SessionLabel(r.session());
+  PlotForce(dir, r, ch, &out);
+  PlotKnot(dir, r, ch, &out);
+  PlotSolver(dir, r, ch, &out);
+  PlotDevice(dir, r, ch, &out);
   return out;
 }
 

@@ -252,17 +252,7 @@ std::vector<std::string> SessionReview::WriteCsv(const std::string& dir) const {
   return written;
 }
 
-std::string SessionReview::Summary(const std::string& log_path, const LogReadStats& read,
-                                   const std::vector<std::string>& plots,
-                                   const std::vector<std::string>& notes) const {
-  std::ostringstream s;
-  s << "snapthread session report\n";
-  s << "log: " << log_path << " (" << read.file_bytes << " bytes)\n";
-  s << "session: " << (session_.empty() ? "(none found)" : session_) << "\n";
-  s << "read: " << (read.Partial() ? "PARTIAL" : "COMPLETE") << ", " << read.events
-    << " events, " << read.skipped_bytes << " bytes unreadable\n";
-  s << "duration_s: " << Fmt("%.3f", last_s_) << "\n\n";
-
+void SessionReview::SummaryChannels(std::ostream& s) const {
   s << "channels (messages, rate, rejected, sequence numbers):\n";
   for (const auto& [name, c] : channels_) {
     const double span = c.last_s - c.first_s;
@@ -296,7 +286,9 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
     }
   }
   if (!any_gap) s << "(none)\n";
+}
 
+void SessionReview::SummaryForce(std::ostream& s) const {
   s << "\nforce:\n";
   if (force_.empty()) {
     s << "no force models in the log\n";
@@ -318,7 +310,9 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
       << first_answered_pose_ << ".." << last_answered_pose_ << ", skipped_poses "
       << span - answered_poses_ << ", device_seq_regressions " << device_seq_regressions_ << "\n";
   }
+}
 
+void SessionReview::SummarySolver(std::ostream& s) const {
   s << "\nsolver:\n";
   if (!solve_.empty()) {
     std::vector<double> it, res, us;
@@ -342,7 +336,9 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
       << "\n";
   }
   if (solve_.empty() && status_.empty()) s << "no solver messages in the log\n";
+}
 
+void SessionReview::SummaryKnot(std::ostream& s) const {
   s << "\nknot:\n";
   if (!HasKnot()) {
     s << "no knot type or contacts in the solver status\n";
@@ -366,7 +362,9 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
     s << "\nknot_last: " << (knot_.back().knot.empty() ? "-" : Shown(knot_.back().knot))
       << "; contacts max " << max_contacts << " last " << knot_.back().contacts << "\n";
   }
+}
 
+void SessionReview::SummaryDevice(std::ostream& s) const {
   s << "\ndevice:\n";
   if (device_.empty()) {
     s << "no device status in the log\n";
@@ -396,6 +394,24 @@ std::string SessionReview::Summary(const std::string& log_path, const LogReadSta
       << Fmt("%.0f", l.p99) << " max " << Fmt("%.0f", l.max) << "; server_us p50 "
       << Fmt("%.0f", sv.p50) << " p99 " << Fmt("%.0f", sv.p99) << "\n";
   }
+}
+
+std::string SessionReview::Summary(const std::string& log_path, const LogReadStats& read,
+                                   const std::vector<std::string>& plots,
+                                   const std::vector<std::string>& notes) const {
+  std::ostringstream s;
+  s << "snapthread session report\n";
+  s << "log: " << log_path << " (" << read.file_bytes << " bytes)\n";
+  s << "session: " << (session_.empty() ? "(none found)" : session_) << "\n";
+  s << "read: " << (read.Partial() ? "PARTIAL" : "COMPLETE") << ", " << read.events
+    << " events, " << read.skipped_bytes << " bytes unreadable\n";
+  s << "duration_s: " << Fmt("%.3f", last_s_) << "\n\n";
+
+  SummaryChannels(s);
+  SummaryForce(s);
+  SummarySolver(s);
+  SummaryKnot(s);
+  SummaryDevice(s);
 
   s << "\nplots:";
   for (const auto& p : plots) s << " " << p;

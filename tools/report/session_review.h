@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,14 @@ class SessionReview {
   const std::string& session() const { return session_; }
 
  private:
+  // Summary()'s sections, in its order: channels and sequence gaps; force, snaps and
+  // latest-wins; solver; knot; device and round trip.
+  void SummaryChannels(std::ostream& s) const;
+  void SummaryForce(std::ostream& s) const;
+  void SummarySolver(std::ostream& s) const;
+  void SummaryKnot(std::ostream& s) const;
+  void SummaryDevice(std::ostream& s) const;
+
   double TimeS(int64_t utime) const { return (utime - t0_us_) * 1e-6; }
 
   std::string session_;

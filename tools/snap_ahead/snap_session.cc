@@ -42,6 +42,41 @@ class Wire final : public device::DeviceTransport {
   std::vector<std::vector<uint8_t>> models;
 };
 
+// The server's half of one update: the newest pose (taken off the wire) to controls, the
+// tracker's update (resumed on the far branch first when the device switched there), and
+// the force model back on the wire.
+void ServeNewestPose(const Scene& scene, const Eigen::Vector3d& rest, EquilibriumTracker* tracker,
+                     server::FoldBoundary* fold, int64_t* model_seq, Wire* wire) {
+  const device_state_t pose = *wire->newest;
+  wire->newest.reset();
+  const Eigen::Vector3d p(pose.position[0], pose.position[1], pose.position[2]);
+  const Eigen::Vector4d q(pose.orientation[0], pose.orientation[1], pose.orientation[2],
+                          pose.orientation[3]);
+  const Vec u = messages::PoseToControls(scene.device, scene.grasp_layout, p, q, rest);
+  Vec x_after, u_after;
+  if (fold && fold->TakeSwitch(pose.snap_fold_id, &x_after, &u_after)) tracker->Resume(x_after, u_after);
+  const TrackResult& r = tracker->Update(u);
+  if (fold) {
+    fold->AfterUpdate(*tracker, u, q);
+    fold->WaitForSearch();
+  }
+  server::ForceModelInputs in;
+  in.mapping = &scene.device;
+  in.model = &tracker->model();
+  in.u = u;
+  in.position_m = p;
+  in.result = &r;
+  in.layout = &scene.grasp_layout;
+  in.device_seq = pose.seq;
+  in.device_utime = pose.utime;
+  in.seq = (*model_seq)++;
+  force_model_t msg = server::BuildForceModel(in);
+  if (fold) fold->Fill(&msg);
+  std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  wire->models.push_back(std::move(bytes));
+}
+
 }  // namespace
 
 SessionResult RunSession(const Scene& scene, const SessionOptions& options) {
@@ -96,34 +131,7 @@ SessionResult RunSession(const Scene& scene, const SessionOptions& options) {
     client.Service(g_now_us);  // publishes this tick's pose
     if (wire.newest && static_cast<double>(g_now_us) >= next_solve_us) {
       next_solve_us += period_us;
-      const device_state_t pose = *wire.newest;
-      wire.newest.reset();
-      const Eigen::Vector3d p(pose.position[0], pose.position[1], pose.position[2]);
-      const Eigen::Vector4d q(pose.orientation[0], pose.orientation[1], pose.orientation[2],
-                              pose.orientation[3]);
-      const Vec u = messages::PoseToControls(scene.device, scene.grasp_layout, p, q, rest);
-      Vec x_after, u_after;
-      if (fold && fold->TakeSwitch(pose.snap_fold_id, &x_after, &u_after)) tracker->Resume(x_after, u_after);
-      const TrackResult& r = tracker->Update(u);
-      if (fold) {
-        fold->AfterUpdate(*tracker, u, q);
-        fold->WaitForSearch();
-      }
-      server::ForceModelInputs in;
-      in.mapping = &scene.device;
-      in.model = &tracker->model();
-      in.u = u;
-      in.position_m = p;
-      in.result = &r;
-      in.layout = &scene.grasp_layout;
-      in.device_seq = pose.seq;
-      in.device_utime = pose.utime;
-      in.seq = model_seq++;
-      force_model_t msg = server::BuildForceModel(in);
-      if (fold) fold->Fill(&msg);
-      std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
-      msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-      wire.models.push_back(std::move(bytes));
+      ServeNewestPose(scene, rest, tracker.get(), fold.get(), &model_seq, &wire);
       ++out.models;
     }
     client.Receive(0);  // rendered from the next tick on
