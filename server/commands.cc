@@ -4,6 +4,7 @@
 // Commands come from the network: LOAD_SCENE takes a scene *name* from
 // --scene-dir (scene_dir.h) and loads it on a loader thread with a time limit, so the
 // solve thread keeps serving the current scene; SET_METHOD is limited to --allow-methods.
+#include <algorithm>
 #include <chrono>
 #include <exception>
 #include <memory>
@@ -12,6 +13,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "messages/validate.h"
+#include "realtime/clock.h"
 #include "scene_dir.h"
 #include "solve_loop.h"
 #include "snapthread/force_model_t.hpp"
@@ -51,7 +54,7 @@ void SolveLoop::ApplyCommand(const command_t& command) {
                   "' is still in progress";
         break;
       }
-      StartSceneLoad(command.argument);
+      StartSceneLoad(command);
       return;  // reported when the load ends (PollSceneLoad)
     }
     case command_t::SET_METHOD:
@@ -61,7 +64,7 @@ void SolveLoop::ApplyCommand(const command_t& command) {
       ok = false;
       message = "unknown command " + std::to_string(command.command);
   }
-  FinishCommand(command.command, ok, message, rejected);
+  FinishCommand({command.command, command.auth_seq}, ok, message, rejected);
 }
 
 bool SolveLoop::SetMethod(const std::string& method, std::string* message, bool* rejected) {
@@ -95,8 +98,10 @@ bool SolveLoop::SetMethod(const std::string& method, std::string* message, bool*
   return true;
 }
 
-void SolveLoop::StartSceneLoad(const std::string& name) {
+void SolveLoop::StartSceneLoad(const command_t& command) {
+  const std::string& name = command.argument;
   load_name_ = name;
+  load_command_ = {command.command, command.auth_seq};
   const std::string dir = params_.scene_dir;
   const auto limit = std::chrono::duration_cast<BackgroundJob<Session>::Clock::duration>(
       std::chrono::duration<double>(params_.load_timeout_s));
@@ -125,7 +130,7 @@ bool SolveLoop::PollSceneLoad() {
       return false;
     case BackgroundJob<Session>::State::kDone:
       session_ = std::move(next);
-      FinishCommand(command_t::LOAD_SCENE, true,
+      FinishCommand(load_command_, true,
                     "LOAD_SCENE: now scene '" + session_->scene.name + "' (" + load_name_ + ")");
       return true;
     case BackgroundJob<Session>::State::kFailed: {
@@ -136,12 +141,12 @@ bool SolveLoop::PollSceneLoad() {
         policy = true;
       } catch (...) {
       }
-      FinishCommand(command_t::LOAD_SCENE, false,
+      FinishCommand(load_command_, false,
                     "LOAD_SCENE refused, " + keeping + ": " + failure.message, policy);
       return true;
     }
     case BackgroundJob<Session>::State::kTimedOut:
-      FinishCommand(command_t::LOAD_SCENE, false,
+      FinishCommand(load_command_, false,
                     "LOAD_SCENE '" + load_name_ + "' abandoned after " +
                         std::to_string(params_.load_timeout_s) + " s (--load-timeout), " + keeping,
                     true);
@@ -150,13 +155,14 @@ bool SolveLoop::PollSceneLoad() {
   return false;
 }
 
-void SolveLoop::FinishCommand(int8_t command, bool ok, const std::string& message, bool rejected) {
+void SolveLoop::FinishCommand(const CommandId& command, bool ok, const std::string& message,
+                              bool rejected) {
   // The message first, then the counters: a caller that waits on a counter reads the
   // message of that command.
   SetInfo(&message);
   if (ok) {
     // A new start: the shape's snap count is "since the session (re)started".
-    if (command != command_t::SET_METHOD) {
+    if (command.command != command_t::SET_METHOD) {
       snaps_since_reset_ = 0;
       last_status_ = force_model_t::STATUS_REGULAR;
       last_force_n_ = {0.0, 0.0, 0.0};
@@ -168,6 +174,21 @@ void SolveLoop::FinishCommand(int8_t command, bool ok, const std::string& messag
     if (rejected) counters_->rejected_messages.fetch_add(1);
     counters_->commands_refused.fetch_add(1);
   }
+  PublishReply(command, ok, message);
+}
+
+void SolveLoop::PublishReply(const CommandId& command, bool ok, const std::string& message) {
+  if (publisher_ == nullptr) return;  // not running: nobody waits for an answer
+  command_reply_t reply;
+  reply.utime = realtime::RealtimeMicros();
+  reply.seq = ++reply_seq_;
+  reply.command_auth_seq = command.auth_seq;
+  reply.command = command.command;
+  reply.ok = ok ? 1 : 0;
+  // The server's own text, cut to what a reply may carry (a scene error can be long).
+  reply.message = message.substr(0, messages::kMaxCommandReplyBytes);
+  std::replace(reply.message.begin(), reply.message.end(), '\0', '?');  // LCM strings end at a NUL
+  publisher_->CommandReply(&reply);
 }
 
 }  // namespace snapthread::server

@@ -42,6 +42,10 @@ bool LcmServerTransport::PublishSolverStatus(const solver_status_t& msg) {
   return lcm_->publish(channels_.solver_status, &msg) == 0;
 }
 
+bool LcmServerTransport::PublishCommandReply(const command_reply_t& msg) {
+  return lcm_->publish(channels_.command_reply, &msg) == 0;
+}
+
 int LcmServerTransport::Receive(int wait_ms, InboundSink* sink) {
   sink_ = sink;
   const int rc = lcm_->handleTimeout(wait_ms);

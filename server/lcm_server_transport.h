@@ -28,6 +28,7 @@ class LcmServerTransport final : public ServerTransport {
   bool PublishForceModel(const force_model_t& msg) override;
   bool PublishShape(const thread_shape_t& msg) override;
   bool PublishSolverStatus(const solver_status_t& msg) override;
+  bool PublishCommandReply(const command_reply_t& msg) override;
   // One handleTimeout(wait_ms): at most one datagram per call.
   int Receive(int wait_ms, InboundSink* sink) override;
   std::string Describe() const override { return url_; }

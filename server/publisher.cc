@@ -43,4 +43,10 @@ bool Publisher::SolverStatus(solver_status_t* msg) {
               &counters_->statuses_published);
 }
 
+bool Publisher::CommandReply(command_reply_t* msg) {
+  return Send(msg, channels_.command_reply,
+              [this](const command_reply_t& m) { return transport_->PublishCommandReply(m); },
+              nullptr);
+}
+
 }  // namespace snapthread::server

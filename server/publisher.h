@@ -31,6 +31,7 @@ class Publisher {
   bool ForceModel(force_model_t* msg);
   bool Shape(thread_shape_t* msg);
   bool SolverStatus(solver_status_t* msg);
+  bool CommandReply(command_reply_t* msg);
 
  private:
   // Signs msg for channel and hands it to `publish` (a call of the transport); false (and

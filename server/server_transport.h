@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "snapthread/command_reply_t.hpp"
 #include "snapthread/force_model_t.hpp"
 #include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
@@ -42,12 +43,14 @@ class ServerTransport {
  public:
   virtual ~ServerTransport() = default;
 
-  // Publish on <SESSION>_FORCE_MODEL / _SHAPE / _SOLVER_STATUS (messages/channels.h).
+  // Publish on <SESSION>_FORCE_MODEL / _SHAPE / _SOLVER_STATUS / _COMMAND_REPLY
+  // (messages/channels.h).
   // False when the transport refused (counted by the caller, never fatal). Never throw.
   // Called from the solve thread only.
   virtual bool PublishForceModel(const force_model_t& msg) = 0;
   virtual bool PublishShape(const thread_shape_t& msg) = 0;
   virtual bool PublishSolverStatus(const solver_status_t& msg) = 0;
+  virtual bool PublishCommandReply(const command_reply_t& msg) = 0;
 
   // Hands what arrived to sink, waiting at most wait_ms for it. Returns how many
   // messages it handed over, or -1 when the transport failed (the caller backs off).

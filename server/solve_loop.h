@@ -41,6 +41,12 @@ struct ServerTestHooks {
   std::function<void()> before_checkpoint_write;
 };
 
+// Which command a reply answers: its code and its sender's auth_seq.
+struct CommandId {
+  int8_t command = 0;
+  int64_t auth_seq = 0;
+};
+
 class SolveLoop {
  public:
   // Loads the start scene (SceneError), prepares --state-dir (CheckpointIoError) and
@@ -79,11 +85,13 @@ class SolveLoop {
   bool SetMethod(const std::string& method, std::string* message, bool* rejected);
   // LOAD_SCENE off the solve thread: starts the loader; Run polls it and swaps the
   // session in when it is ready (true when the session changed or a load ended).
-  void StartSceneLoad(const std::string& name);
+  void StartSceneLoad(const command_t& command);
   bool PollSceneLoad();
-  // Logs and counts the outcome of a command; `rejected` also counts a policy refusal in
-  // rejected_messages.
-  void FinishCommand(int8_t command, bool ok, const std::string& message, bool rejected = false);
+  // Logs and counts the outcome of `command` (its code and auth_seq) and answers it on
+  // COMMAND_REPLY; `rejected` also counts a policy refusal in rejected_messages.
+  void FinishCommand(const CommandId& command, bool ok, const std::string& message,
+                     bool rejected = false);
+  void PublishReply(const CommandId& command, bool ok, const std::string& message);
 
   ServerParams params_;
   messages::Channels channels_;
@@ -96,12 +104,13 @@ class SolveLoop {
   std::string method_override_;  // "" = the scene's
   BackgroundJob<Session> load_;   // the LOAD_SCENE in progress, if any
   std::string load_name_;         // its argument
+  CommandId load_command_;        // answered when the load ends
   KnotWatch knot_watch_;          // the shape's knot type, a few times a second
   std::unique_ptr<SessionCheckpoints> checkpoints_;  // null without --state-dir
   bool resumed_ = false;          // this start resumed a checkpoint
 
   // What the shape and status report.
-  int64_t model_seq_ = 0, shape_seq_ = 0, status_seq_ = 0;
+  int64_t model_seq_ = 0, shape_seq_ = 0, status_seq_ = 0, reply_seq_ = 0;
   int64_t snaps_since_reset_ = 0;
   int8_t last_status_ = 0;
   std::array<double, 3> last_force_n_{0.0, 0.0, 0.0};

@@ -19,6 +19,8 @@ namespace snapthread::app {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;
+// A program that waits for a peer's answer (snapthread-ctl) and got none in time.
+inline constexpr int kExitNoReply = 3;
 // For the programs above whose bad arguments exit 1.
 inline constexpr int kExitUsageAsFailure = kExitFailure;
 

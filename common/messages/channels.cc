@@ -62,6 +62,7 @@ Channels::Channels(const std::string& session_name) : session(session_name) {
   solver_status = session + "_SOLVER_STATUS";
   device_status = session + "_DEVICE_STATUS";
   command = session + "_COMMAND";
+  command_reply = session + "_COMMAND_REPLY";
 }
 
 }  // namespace snapthread::messages

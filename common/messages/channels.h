@@ -22,10 +22,11 @@ struct Channels {
   std::string solver_status;  // <SESSION>_SOLVER_STATUS  solver_status_t
   std::string device_status;  // <SESSION>_DEVICE_STATUS  device_status_t
   std::string command;        // <SESSION>_COMMAND        command_t
+  std::string command_reply;  // <SESSION>_COMMAND_REPLY  command_reply_t
 };
 
 // LCM refuses channel names longer than 63 bytes (at publish time, sending nothing);
-// the longest suffix, "_SOLVER_STATUS" / "_DEVICE_STATUS", takes 14 of them.
+// the longest suffixes, "_SOLVER_STATUS", "_DEVICE_STATUS" and "_COMMAND_REPLY", take 14 of them.
 inline constexpr size_t kMaxSessionNameLength = 63 - 14;
 
 // True when `session` matches [A-Za-z0-9_]+ and has at most kMaxSessionNameLength

@@ -232,12 +232,32 @@ const Field<C> kCommand[] = {
     Member<&C::mac>("mac"),
 };
 
+// A reply's message is short text for a terminal (the operator's console prints it).
+bool ReplyMessageLength(const command_reply_t& msg, std::string* why) {
+  if (msg.message.size() <= static_cast<size_t>(kMaxCommandReplyBytes)) return true;
+  return Fail(why, "message longer than " + std::to_string(kMaxCommandReplyBytes) + " bytes");
+}
+
+using R = command_reply_t;
+const Field<R> kCommandReply[] = {
+    Member<&R::utime>("utime"),
+    Member<&R::seq>("seq"),
+    Member<&R::command_auth_seq>("command_auth_seq"),
+    Member<&R::command>("command", C::RESET, C::SET_METHOD),
+    Member<&R::ok>("ok", 0, 1),
+    With(Member<&R::message>("message"), &ReplyMessageLength),
+    Member<&R::epoch>("epoch"),  // authentication (docs/security.md)
+    Member<&R::auth_seq>("auth_seq"),
+    Member<&R::mac>("mac"),
+};
+
 std::span<const Field<D>> TableOf(const D*) { return kDeviceState; }
 std::span<const Field<F>> TableOf(const F*) { return kForceModel; }
 std::span<const Field<S>> TableOf(const S*) { return kThreadShape; }
 std::span<const Field<V>> TableOf(const V*) { return kSolverStatus; }
 std::span<const Field<T>> TableOf(const T*) { return kDeviceStatus; }
 std::span<const Field<C>> TableOf(const C*) { return kCommand; }
+std::span<const Field<R>> TableOf(const R*) { return kCommandReply; }
 
 template <class M>
 bool ValidateByTable(const M& msg, std::string* why) {
@@ -256,6 +276,7 @@ template bool PreDecodeCheck<thread_shape_t>(const void*, int, std::string*);
 template bool PreDecodeCheck<solver_status_t>(const void*, int, std::string*);
 template bool PreDecodeCheck<device_status_t>(const void*, int, std::string*);
 template bool PreDecodeCheck<command_t>(const void*, int, std::string*);
+template bool PreDecodeCheck<command_reply_t>(const void*, int, std::string*);
 
 bool Validate(const device_state_t& msg, std::string* why) { return ValidateByTable(msg, why); }
 bool Validate(const force_model_t& msg, std::string* why) { return ValidateByTable(msg, why); }
@@ -263,5 +284,6 @@ bool Validate(const thread_shape_t& msg, std::string* why) { return ValidateByTa
 bool Validate(const solver_status_t& msg, std::string* why) { return ValidateByTable(msg, why); }
 bool Validate(const device_status_t& msg, std::string* why) { return ValidateByTable(msg, why); }
 bool Validate(const command_t& msg, std::string* why) { return ValidateByTable(msg, why); }
+bool Validate(const command_reply_t& msg, std::string* why) { return ValidateByTable(msg, why); }
 
 }  // namespace snapthread::messages

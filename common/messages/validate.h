@@ -10,6 +10,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "messages/field_table.h"
+#include "snapthread/command_reply_t.hpp"
 #include "snapthread/command_t.hpp"
 #include "snapthread/device_state_t.hpp"
 #include "snapthread/device_status_t.hpp"
@@ -27,6 +28,8 @@ inline constexpr double kMinQuaternionNorm = 0.5;
 inline constexpr double kMaxQuaternionNorm = 2.0;
 // Most grasps a scene may name (thread_shape_t.grasps rows).
 inline constexpr int kMaxGrasps = 16;
+// Longest reason a command reply carries (the server cuts a longer one).
+inline constexpr int kMaxCommandReplyBytes = 1024;
 
 // Each returns true when the message is usable; otherwise false with the reason in
 // *why (if why is non-null). Never throws. The rules are the message's field table
@@ -37,11 +40,12 @@ bool Validate(const thread_shape_t& msg, std::string* why);
 bool Validate(const solver_status_t& msg, std::string* why);
 bool Validate(const device_status_t& msg, std::string* why);
 bool Validate(const command_t& msg, std::string* why);
+bool Validate(const command_reply_t& msg, std::string* why);
 
 // Checks an encoded buffer before handing it to the generated decoder: every string
 // length and array count of T against the bytes there, and that T's fields fill the
 // buffer exactly (field_table.h: CheckWire).
-// Defined for the six message types above.
+// Defined for the seven message types above.
 template <class T>
 bool PreDecodeCheck(const void* data, int size, std::string* why);
 

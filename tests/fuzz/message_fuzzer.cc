@@ -38,13 +38,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   const uint8_t* body = data + 1;
   const size_t n = size - 1;
-  switch (data[0] % 6) {
+  switch (data[0] % 7) {
     case 0: Check<device_state_t>(body, n); break;
     case 1: Check<force_model_t>(body, n); break;
     case 2: Check<thread_shape_t>(body, n); break;
     case 3: Check<solver_status_t>(body, n); break;
     case 4: Check<device_status_t>(body, n); break;
-    default: Check<command_t>(body, n); break;
+    case 5: Check<command_t>(body, n); break;
+    default: Check<command_reply_t>(body, n); break;
   }
   return 0;
 }

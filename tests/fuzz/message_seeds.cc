@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
                   Write(dir, 2, "thread_shape", Sample<thread_shape_t>()) &&
                   Write(dir, 3, "solver_status", Sample<solver_status_t>()) &&
                   Write(dir, 4, "device_status", Sample<device_status_t>()) &&
-                  Write(dir, 5, "command", Sample<command_t>());
+                  Write(dir, 5, "command", Sample<command_t>()) &&
+                  Write(dir, 6, "command_reply", Sample<command_reply_t>());
   return ok ? 0 : 1;
 }

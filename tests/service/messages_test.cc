@@ -49,6 +49,7 @@ TEST(TransportChannelsTest, NamesArePrefixedBySession) {
   EXPECT_EQ(c.solver_status, "LAB_2_SOLVER_STATUS");
   EXPECT_EQ(c.device_status, "LAB_2_DEVICE_STATUS");
   EXPECT_EQ(c.command, "LAB_2_COMMAND");
+  EXPECT_EQ(c.command_reply, "LAB_2_COMMAND_REPLY");
   EXPECT_EQ(Channels().device_state, "SNAPTHREAD_DEVICE_STATE");
 }
 
@@ -145,6 +146,7 @@ TEST(TransportRoundTripTest, ThreadShape) {
 TEST(TransportRoundTripTest, SolverStatus) { RoundTrip(Sample<solver_status_t>()); }
 TEST(TransportRoundTripTest, DeviceStatus) { RoundTrip(Sample<device_status_t>()); }
 TEST(TransportRoundTripTest, Command) { RoundTrip(Sample<command_t>()); }
+TEST(TransportRoundTripTest, CommandReply) { RoundTrip(Sample<command_reply_t>()); }
 
 TEST(TransportRoundTripTest, ForceModelFieldsSurvive) {
   // One explicit field-by-field check so that an encoding comparison bug cannot hide one.
@@ -174,6 +176,7 @@ TEST(TransportValidateTest, AcceptsSamples) {
   EXPECT_TRUE(Validate(Sample<solver_status_t>(), &why)) << why;
   EXPECT_TRUE(Validate(Sample<device_status_t>(), &why)) << why;
   EXPECT_TRUE(Validate(Sample<command_t>(), &why)) << why;
+  EXPECT_TRUE(Validate(Sample<command_reply_t>(), &why)) << why;
 }
 
 TEST(TransportValidateTest, RejectsNonFiniteDeviceState) {
@@ -271,6 +274,25 @@ TEST(TransportValidateTest, StatusesAndCommands) {
   EXPECT_FALSE(Validate(c, nullptr));
 }
 
+TEST(TransportValidateTest, CommandReplies) {
+  auto r = Sample<command_reply_t>();
+  std::string why;
+  EXPECT_TRUE(Validate(r, &why)) << why;
+  r.ok = 2;  // ok is 0 or 1
+  EXPECT_FALSE(Validate(r, &why));
+  EXPECT_NE(why.find("ok"), std::string::npos) << why;
+  r.ok = 0;
+  r.command = 0;  // answers one of command_t's commands
+  EXPECT_FALSE(Validate(r, nullptr));
+  r.command = command_t::RESET;
+  EXPECT_TRUE(Validate(r, nullptr));
+  r.message.assign(kMaxCommandReplyBytes, 'x');
+  EXPECT_TRUE(Validate(r, nullptr));
+  r.message += 'x';  // a reply is short text for a terminal
+  EXPECT_FALSE(Validate(r, &why));
+  EXPECT_NE(why.find("message"), std::string::npos) << why;
+}
+
 // ---- DecodeAndValidate against malformed buffers ------------------------------------------
 
 template <class T>
@@ -301,6 +323,7 @@ TEST(TransportDecodeTest, TruncatedOversizedAndWrongTypeRejected) {
   ExpectTruncationsRejected(Sample<solver_status_t>());
   ExpectTruncationsRejected(Sample<device_status_t>());
   ExpectTruncationsRejected(Sample<command_t>());
+  ExpectTruncationsRejected(Sample<command_reply_t>());
 }
 
 TEST(TransportDecodeTest, HugeShapeCountIsRefusedBeforeAllocation) {
@@ -389,6 +412,7 @@ TEST(TransportDecodeTest, FuzzEveryType) {
   Fuzz(Sample<solver_status_t>(), 4, &accepted);
   Fuzz(Sample<device_status_t>(), 5, &accepted);
   Fuzz(Sample<command_t>(), 6, &accepted);
+  Fuzz(Sample<command_reply_t>(), 7, &accepted);
   // Flipping bytes of doubles often still gives a valid message: the fuzz reaches Validate.
   EXPECT_GT(accepted, 0);
 }

@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "arrival_log.h"
 #include "environment.h"
 #include "messages/pose_mapping.h"
+#include "messages/validate.h"
 #include "scene/scene.h"
 #include "scene_dir.h"
 #include "server.h"
@@ -68,8 +70,9 @@ class CommandsTest : public ::testing::Test {
     params.log_level = "off";
     params.key_path = key_file_.path();
     server_ = std::make_unique<Server>(params, &transport_, std::move(hooks));
-    transport_.AddListener([this](testing::Outbound channel, const std::vector<uint8_t>&) {
+    transport_.AddListener([this](testing::Outbound channel, const std::vector<uint8_t>& bytes) {
       if (channel == testing::Outbound::kForceModel) arrivals_.Mark();
+      if (channel == testing::Outbound::kCommandReply) KeepReply(bytes);
     });
     server_->Start();
     const Scene scene = LoadScene(params.scene_path);
@@ -102,11 +105,42 @@ class CommandsTest : public ::testing::Test {
   size_t Models() { return arrivals_.count(); }
   double MaxGapSince(size_t from) { return arrivals_.MaxGapSince(from); }
 
-  void Command(int8_t command, const std::string& argument) {
+  // Sends a command signed with `key` (the session's by default); returns its auth_seq.
+  int64_t Command(int8_t command, const std::string& argument,
+                  const auth::SessionKey* key = nullptr) {
     command_t c = MakeCommand(command, argument);
-    ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
-                           key_file_.key()));
+    const int64_t seq = auth_seq_.Next();
+    EXPECT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), seq,
+                           key != nullptr ? *key : key_file_.key()));
     transport_.DeliverCommand(test_support::Encode(c));
+    return seq;
+  }
+  // A reply as a console checks it: it decodes, validates and its MAC verifies.
+  void KeepReply(const std::vector<uint8_t>& bytes) {
+    command_reply_t reply;
+    std::string why;
+    const bool valid =
+        messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &reply, &why) &&
+        auth::VerifyEncoded(bytes.data(), bytes.size(), server_->channels().command_reply,
+                            key_file_.key());
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (valid) {
+      replies_.push_back(reply);
+    } else {
+      ++invalid_replies_;
+    }
+  }
+  // The reply answering auth_seq `seq`, waited for.
+  std::optional<command_reply_t> ReplyTo(int64_t seq, double timeout_s = kWaitS) {
+    std::optional<command_reply_t> found;
+    test_support::WaitUntil([&] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (const auto& r : replies_) {
+        if (r.command_auth_seq == seq) found = r;
+      }
+      return found.has_value();
+    }, timeout_s, 0.002);
+    return found;
   }
   bool WaitRefused(int64_t n) {
     return test_support::WaitUntil([&] { return server_->Stats().commands_refused >= n; }, kWaitS,
@@ -126,8 +160,44 @@ class CommandsTest : public ::testing::Test {
   std::thread poser_;
   std::atomic<bool> stop_poses_{false};
   std::mutex mutex_;
+  std::vector<command_reply_t> replies_;  // under mutex_
+  int invalid_replies_ = 0;               // under mutex_
   test_support::ArrivalLog arrivals_;
 };
+
+TEST_F(CommandsTest, EveryAuthenticatedCommandIsAnsweredAndNoOtherOne) {
+  ASSERT_NO_FATAL_FAILURE(StartServer());
+  const int64_t method = Command(command_t::SET_METHOD, "newton");
+  const int64_t bogus = Command(command_t::SET_METHOD, "bogus");
+  const int64_t outside = Command(command_t::LOAD_SCENE, "../zeeman");
+  const int64_t load = Command(command_t::LOAD_SCENE, "zeeman");  // answered when loaded
+  const int64_t missing = Command(command_t::LOAD_SCENE, "nothere");
+
+  const auto expect = [&](int64_t seq, int8_t command, bool ok, const std::string& text) {
+    const std::optional<command_reply_t> r = ReplyTo(seq);
+    ASSERT_TRUE(r.has_value()) << "no reply to " << text;
+    EXPECT_EQ(r->command, command) << text;
+    EXPECT_EQ(r->ok, ok ? 1 : 0) << r->message;
+    EXPECT_EQ(r->epoch, server_->epoch());
+    EXPECT_NE(r->message.find(text), std::string::npos) << r->message;
+  };
+  expect(method, command_t::SET_METHOD, true, "now newton");
+  expect(bogus, command_t::SET_METHOD, false, "unknown method 'bogus'");
+  expect(outside, command_t::LOAD_SCENE, false, "keeping scene 'curve2d_snap'");
+  expect(load, command_t::LOAD_SCENE, true, "now scene 'zeeman'");
+  expect(missing, command_t::LOAD_SCENE, false, "nothere");
+  // After the load: the RESET goes back to the start of the new scene.
+  auth::SessionKey other = auth::SessionKey::Generate();
+  const int64_t forged = Command(command_t::RESET, "", &other);
+  const int64_t reset = Command(command_t::RESET, "");
+  expect(reset, command_t::RESET, true, "start of scene 'zeeman'");
+  // A sender without the key learns nothing: its command is refused and not answered.
+  EXPECT_FALSE(ReplyTo(forged, 0.5).has_value());
+  std::lock_guard<std::mutex> lock(mutex_);
+  EXPECT_EQ(replies_.size(), 6u);
+  EXPECT_EQ(invalid_replies_, 0);
+  for (size_t i = 1; i < replies_.size(); ++i) EXPECT_GT(replies_[i].seq, replies_[i - 1].seq);
+}
 
 TEST_F(CommandsTest, EveryWayOutOfTheSceneDirIsRefusedAndCounted) {
   // The directory's traps: symlinks out (a file, a device), a FIFO, a 2 MiB file, a

@@ -21,7 +21,7 @@
 namespace snapthread::server::testing {
 
 // What the server publishes on.
-enum class Outbound { kForceModel, kShape, kSolverStatus };
+enum class Outbound { kForceModel, kShape, kSolverStatus, kCommandReply };
 
 class MemoryServerTransport final : public ServerTransport {
  public:
@@ -43,6 +43,9 @@ class MemoryServerTransport final : public ServerTransport {
   bool PublishShape(const thread_shape_t& msg) override { return Send(Outbound::kShape, msg); }
   bool PublishSolverStatus(const solver_status_t& msg) override {
     return Send(Outbound::kSolverStatus, msg);
+  }
+  bool PublishCommandReply(const command_reply_t& msg) override {
+    return Send(Outbound::kCommandReply, msg);
   }
 
   int Receive(int wait_ms, InboundSink* sink) override {

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "snapthread/command_reply_t.hpp"
 #include "snapthread/command_t.hpp"
 #include "snapthread/device_state_t.hpp"
 #include "snapthread/device_status_t.hpp"
@@ -86,6 +87,12 @@ inline device_status_t Sample(const device_status_t*) {
 inline command_t Sample(const command_t*) {
   return {.utime = 13, .command = command_t::LOAD_SCENE, .argument = "scenes/zeeman.yaml",
           .epoch = 0, .auth_seq = 0, .mac = {}};
+}
+
+inline command_reply_t Sample(const command_reply_t*) {
+  return {.utime = 14, .seq = 3, .command_auth_seq = 1700000000000000001, .command = command_t::LOAD_SCENE,
+          .ok = 1, .message = "LOAD_SCENE: now scene 'zeeman' (zeeman)", .epoch = 0, .auth_seq = 0,
+          .mac = {}};
 }
 
 template <class Msg>

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "snapthread/command_reply_t.hpp"
 #include "snapthread/device_state_t.hpp"
 #include "snapthread/device_status_t.hpp"
 #include "snapthread/force_model_t.hpp"
@@ -70,6 +71,15 @@ std::string WriteReferenceLog(const std::string& dir) {
       log.Write("RPT_SOLVER_STATUS", t + 20, ReportSolverStatus(k, t, "test"));
     }
     if (k % 40 == 0) log.Write("RPT_DEVICE_STATUS", t + 30, ReportDeviceStatus(k, "test"));
+    if (k % 100 == 0) {  // the server's answers to two commands
+      command_reply_t reply{};
+      reply.utime = t;
+      reply.seq = k / 100;
+      reply.command = 1;  // command_t.RESET
+      reply.ok = 1;
+      reply.message = "RESET: back to the start of scene 'test'";
+      log.Write("RPT_COMMAND_REPLY", t + 40, reply);
+    }
   }
   log.WriteRaw("OTHER_CHANNEL", kT0 + (kModels + 1) * 1000, {1, 2, 3});
   return path;
@@ -126,6 +136,10 @@ TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
   EXPECT_NE(Line(summary, "channel RPT_SHAPE ").find("messages 20 "), std::string::npos);
   EXPECT_NE(Line(summary, "channel RPT_SOLVER_STATUS ").find("messages 20 "), std::string::npos);
   EXPECT_NE(Line(summary, "channel OTHER_CHANNEL ").find("messages 1 "), std::string::npos);
+  EXPECT_NE(Line(summary, "channel RPT_COMMAND_REPLY ").find("type command_reply_t messages 2 "),
+            std::string::npos) << summary;
+  EXPECT_NE(Line(summary, "channel RPT_COMMAND_REPLY ").find("rejected 0 seq 1..2 missing 0"),
+            std::string::npos) << summary;
   EXPECT_NE(summary.find("max_force_n: 2.0000"), std::string::npos) << summary;
   // Models answer poses 1..200 except the 4 dropped; the late repeat answers an older pose.
   EXPECT_NE(summary.find("latest_wins: models answer 196 poses of seq 1..200, skipped_poses 4, "
@@ -276,8 +290,8 @@ TEST(ReportTest, ListsAtMostAThousandChannels) {
   ASSERT_TRUE(r.exited);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string summary = ReadFile(dir + "/out/summary.txt");
-  // The session's 5 channels and OTHER_CHANNEL come first; 994 flood channels fill the table.
-  EXPECT_NE(summary.find("channels beyond the first 1000: 506 messages (506 bytes), not listed"),
+  // The session's 6 channels and OTHER_CHANNEL come first; 993 flood channels fill the table.
+  EXPECT_NE(summary.find("channels beyond the first 1000: 507 messages (507 bytes), not listed"),
             std::string::npos) << summary.substr(0, 2000);
   EXPECT_NE(summary.find("session: RPT\n"), std::string::npos);
 }

@@ -13,7 +13,8 @@ namespace snapthread::report {
 namespace {
 
 constexpr const char* kSuffixes[] = {"_DEVICE_STATE", "_FORCE_MODEL",   "_SHAPE",
-                                     "_SOLVER_STATUS", "_DEVICE_STATUS", "_COMMAND"};
+                                     "_SOLVER_STATUS", "_DEVICE_STATUS", "_COMMAND",
+                                     "_COMMAND_REPLY"};
 constexpr size_t kMaxRememberedPoses = 20000;
 
 // Text from the log (channel names, method and knot strings) as it may appear in the
@@ -29,6 +30,7 @@ std::string TypeOf(const std::string& channel, const std::string& session) {
   if (rest == "_SOLVER_STATUS") return "solver_status_t";
   if (rest == "_DEVICE_STATUS") return "device_status_t";
   if (rest == "_COMMAND") return "command_t";
+  if (rest == "_COMMAND_REPLY") return "command_reply_t";
   return "";
 }
 
@@ -162,6 +164,11 @@ void SessionReview::Add(const lcm::LogEvent& e) {
   } else if (c.type == "command_t") {
     command_t m;
     Decode(e, &m, &c);
+  } else if (c.type == "command_reply_t") {
+    command_reply_t m;
+    if (!Decode(e, &m, &c)) return;
+    c.has_seq = true;
+    c.seq.Add(m.seq);
   }
 }
 
