@@ -72,4 +72,17 @@ std::optional<auth::SessionKey> LoadSessionKey(const CommonFlags& flags, std::st
   }
 }
 
+std::optional<auth::KeySet> LoadKeySet(const CommonFlags& flags, auth::Role needed,
+                                       std::string_view program, auth::KeyLocation* where) {
+  try {
+    const auth::KeyLocation location = auth::ResolveKeyPath(flags.key_path);
+    std::optional<auth::KeySet> keys(auth::LoadKeySet(location.path, needed, program));
+    if (where != nullptr) *where = location;
+    return keys;
+  } catch (const std::exception& e) {
+    Fail(program, kExitFailure, std::string("--key: ") + e.what());
+    return std::nullopt;
+  }
+}
+
 }  // namespace snapthread::app

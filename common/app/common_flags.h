@@ -10,6 +10,8 @@
 #include <CLI/CLI.hpp>
 
 #include "auth/key_file.h"
+#include "auth/key_set.h"
+#include "auth/role.h"
 #include "auth/session_key.h"
 #include "messages/channels.h"
 #include "messages/lcm_url.h"
@@ -65,5 +67,12 @@ std::string LcmUrl(const CommonFlags& flags, int receive_buffer_bytes = messages
 // given, receives the file used.
 std::optional<auth::SessionKey> LoadSessionKey(const CommonFlags& flags, std::string_view program,
                                                auth::KeyLocation* where = nullptr);
+
+// What --key names for a program playing `needed` (auth/key_set.h: the root key, or a
+// credential of that role), or nullopt after printing "<program>: --key: <which file, why
+// and the fix>" (a credential of another role names the role needed). `where`, if given,
+// receives the file used.
+std::optional<auth::KeySet> LoadKeySet(const CommonFlags& flags, auth::Role needed,
+                                       std::string_view program, auth::KeyLocation* where = nullptr);
 
 }  // namespace snapthread::app

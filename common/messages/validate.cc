@@ -86,7 +86,7 @@ bool CountedRowsAgree(const thread_shape_t& msg, std::string* why) {
 
 // ---- one table per message type: its fields in .lcm order (lcmtypes/*.lcm) -----------------
 // Every double must be finite and every string at most kMaxStringBytes (Member's default);
-// the ranges below are the rest. The authentication fields (epoch, auth_seq, mac) are
+// the ranges below are the rest. The authentication trailer (epoch ... mac) is
 // checked by the receiver's auth layer (common/auth), not here.
 
 using D = device_state_t;
@@ -101,6 +101,12 @@ const Field<D> kDeviceState[] = {
     Member<&D::snap_fold_id>("snap_fold_id"),
     Member<&D::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&D::auth_seq>("auth_seq"),
+    Member<&D::sender_role>("sender_role", 0, 3),
+    Member<&D::sender_name>("sender_name"),
+    Member<&D::key_expires>("key_expires"),
+    Member<&D::key_id>("key_id"),
+    Member<&D::signature>("signature"),
+    Member<&D::signature2>("signature2"),
     Member<&D::mac>("mac"),
 };
 
@@ -137,6 +143,12 @@ const Field<F> kForceModel[] = {
     Member<&F::post_torque0>("post_torque0"),
     Member<&F::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&F::auth_seq>("auth_seq"),
+    Member<&F::sender_role>("sender_role", 0, 3),
+    Member<&F::sender_name>("sender_name"),
+    Member<&F::key_expires>("key_expires"),
+    Member<&F::key_id>("key_id"),
+    Member<&F::signature>("signature"),
+    Member<&F::signature2>("signature2"),
     Member<&F::mac>("mac"),
 };
 
@@ -164,6 +176,12 @@ const Field<S> kThreadShape[] = {
     Member<&S::knot>("knot"),
     Member<&S::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&S::auth_seq>("auth_seq"),
+    Member<&S::sender_role>("sender_role", 0, 3),
+    Member<&S::sender_name>("sender_name"),
+    Member<&S::key_expires>("key_expires"),
+    Member<&S::key_id>("key_id"),
+    Member<&S::signature>("signature"),
+    Member<&S::signature2>("signature2"),
     Member<&S::mac>("mac"),
 };
 
@@ -189,8 +207,15 @@ const Field<V> kSolverStatus[] = {
     Member<&V::knot_determinant>("knot_determinant", 0, kInt32Max),
     Member<&V::contacts>("contacts", 0, kInt32Max),
     Member<&V::max_update_hz>("max_update_hz"),
+    Member<&V::refusals>("refusals"),
     Member<&V::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&V::auth_seq>("auth_seq"),
+    Member<&V::sender_role>("sender_role", 0, 3),
+    Member<&V::sender_name>("sender_name"),
+    Member<&V::key_expires>("key_expires"),
+    Member<&V::key_id>("key_id"),
+    Member<&V::signature>("signature"),
+    Member<&V::signature2>("signature2"),
     Member<&V::mac>("mac"),
 };
 
@@ -217,8 +242,16 @@ const Field<T> kDeviceStatus[] = {
     Member<&T::snaps_felt>("snaps_felt"),
     Member<&T::grasp>("grasp"),
     Member<&T::snap_ahead_switches>("snap_ahead_switches"),
+    Member<&T::device_public_key>("device_public_key"),
+    Member<&T::device_certificate>("device_certificate"),
     Member<&T::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&T::auth_seq>("auth_seq"),
+    Member<&T::sender_role>("sender_role", 0, 3),
+    Member<&T::sender_name>("sender_name"),
+    Member<&T::key_expires>("key_expires"),
+    Member<&T::key_id>("key_id"),
+    Member<&T::signature>("signature"),
+    Member<&T::signature2>("signature2"),
     Member<&T::mac>("mac"),
 };
 
@@ -229,6 +262,12 @@ const Field<C> kCommand[] = {
     Member<&C::argument>("argument"),
     Member<&C::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&C::auth_seq>("auth_seq"),
+    Member<&C::sender_role>("sender_role", 0, 3),
+    Member<&C::sender_name>("sender_name"),
+    Member<&C::key_expires>("key_expires"),
+    Member<&C::key_id>("key_id"),
+    Member<&C::signature>("signature"),
+    Member<&C::signature2>("signature2"),
     Member<&C::mac>("mac"),
 };
 
@@ -248,6 +287,12 @@ const Field<R> kCommandReply[] = {
     With(Member<&R::message>("message"), &ReplyMessageLength),
     Member<&R::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&R::auth_seq>("auth_seq"),
+    Member<&R::sender_role>("sender_role", 0, 3),
+    Member<&R::sender_name>("sender_name"),
+    Member<&R::key_expires>("key_expires"),
+    Member<&R::key_id>("key_id"),
+    Member<&R::signature>("signature"),
+    Member<&R::signature2>("signature2"),
     Member<&R::mac>("mac"),
 };
 

@@ -31,7 +31,8 @@ namespace snapthread::test_support {
 inline device_state_t ReportPose(int k, const std::string& device_id) {
   return {.utime = k * 1000, .seq = k, .device_id = device_id, .position = {},
           .orientation = {1.0, 0.0, 0.0, 0.0}, .buttons = 1, .grasp = "", .snap_fold_id = 0,
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 // The answer to pose `seq`, its server times from t0_us: |F| grows to 2.0 N at seq 200.
@@ -45,7 +46,8 @@ inline force_model_t ReportModel(int seq, int64_t t0_us) {
           .has_wrench = 0, .q0 = {}, .K6 = {}, .grasp = "", .has_fold = 0, .fold_id = 0,
           .fold_point = {}, .fold_normal = {}, .fold_curvature = 0.0, .post_u0 = {}, .post_f0 = {},
           .post_K = {}, .fold_q = {}, .fold_normal_r = {}, .post_torque0 = {},
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 // Steps k = 10, 20, ...: a two-node curve2d shape published at t_us.
@@ -55,7 +57,8 @@ inline thread_shape_t ReportShape(int k, int64_t t_us, const std::string& scene)
           .force = {}, .force_newtons = {}, .status = force_model_t::STATUS_REGULAR,
           .snaps = k > 100 ? 1 : 0, .num_frames = 0, .frames = {}, .grasp_names = "",
           .num_grasps = 0, .grasps = {}, .num_contacts = 0, .contacts = {}, .knot = "",
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 // Steps k = 10, 20, ...: Newton until step 100, the higher-order solver after it.
@@ -66,8 +69,9 @@ inline solver_status_t ReportSolverStatus(int k, int64_t t_us, const std::string
           .update_rate_hz = 1000.0, .solve_us_p50 = 200.0, .solve_us_p99 = 300.0, .updates = k,
           .snaps = 0, .dropped_poses = 0, .rejected_messages = 0,
           .knot = k < 150 ? "unknot" : "trefoil", .knot_determinant = k < 150 ? 1 : 3,
-          .contacts = k < 100 ? 0 : k < 150 ? 2 : 4, .max_update_hz = 0.0,
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .contacts = k < 100 ? 0 : k < 150 ? 2 : 4, .max_update_hz = 0.0, .refusals = "",
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 // Steps k = 40, 80, ...: lateness growing, force clamps 0 .. 4 over the five statuses.
@@ -78,7 +82,9 @@ inline device_status_t ReportDeviceStatus(int k, const std::string& device_id) {
           .round_trip_us_p99 = 900.0, .force_norm_n = 0.01 * k, .ticks = k, .models_received = 0,
           .models_rejected = 0, .force_clamps = k / 40 - 1, .stiffness_clamps = 0,
           .slew_limits = 0, .fades = 0, .snaps_felt = 0, .grasp = "", .snap_ahead_switches = 0,
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .device_public_key = {}, .device_certificate = {},
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 // A plot with real content: plot-sized, many colours and a good share of ink.

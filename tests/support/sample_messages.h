@@ -19,13 +19,14 @@ namespace snapthread::test_support {
 
 // Designated initializers name every field: with -Wextra (missing-field-initializers) a
 // field added to a type fails the build here until its sample sets it. The samples are
-// unsigned (epoch, auth_seq and mac zero).
+// unsigned (the authentication trailer zero).
 
 inline device_state_t Sample(const device_state_t*) {
   return {.utime = 123456789, .seq = 42, .device_id = "virtual-hand",
           .position = {0.01, -0.02, 0.03}, .orientation = {1.0, 0.0, 0.0, 0.0}, .buttons = 1,
           .grasp = "", .snap_fold_id = 3,
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 inline force_model_t Sample(const force_model_t*) {
@@ -43,7 +44,8 @@ inline force_model_t Sample(const force_model_t*) {
           .post_f0 = {0.5, 0.0, 0.0}, .post_K = {{-100.0, 0, 0}, {0, -100.0, 0}, {0, 0, -100.0}},
           .fold_q = {0.9950041652780258, 0.0, 0.0, 0.09983341664682815}, .fold_normal_r = {0.0, 0.0, 0.8},
           .post_torque0 = {0.0, -0.001, 0.002},
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 // A shape of `nodes` nodes along a line.
@@ -58,7 +60,8 @@ inline thread_shape_t SampleShape(int nodes) {
           .frames = {{0.0, 1.0, 0.0, 0.25}}, .grasp_names = "left,right", .num_grasps = 2,
           .grasps = {{0.0, 0.0, 0.0, -1.0, 0.0, 0.0}, {1.0 * nodes, 0.0, 0.0, 1.0, 0.0, 0.0}},
           .num_contacts = 1, .contacts = {{1.0, 0.5, 0.0, 1.0, 0.5, 0.1}}, .knot = "unknot",
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 inline thread_shape_t Sample(const thread_shape_t*) { return SampleShape(12); }
@@ -69,8 +72,9 @@ inline solver_status_t Sample(const solver_status_t*) {
           .status = force_model_t::STATUS_REGULAR, .update_rate_hz = 950.0,
           .solve_us_p50 = 40.0, .solve_us_p99 = 120.0, .updates = 1000, .snaps = 2,
           .dropped_poses = 5, .rejected_messages = 1, .knot = "trefoil",
-          .knot_determinant = 3, .contacts = 2, .max_update_hz = 100.0,
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .knot_determinant = 3, .contacts = 2, .max_update_hz = 100.0, .refusals = "device/bad-mac=1",
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 inline device_status_t Sample(const device_status_t*) {
@@ -80,19 +84,21 @@ inline device_status_t Sample(const device_status_t*) {
           .force_norm_n = 0.7, .ticks = 10000, .models_received = 9000, .models_rejected = 1,
           .force_clamps = 2, .stiffness_clamps = 3, .slew_limits = 4, .fades = 5,
           .snaps_felt = 6, .grasp = "",
-          .snap_ahead_switches = 1,
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .snap_ahead_switches = 1, .device_public_key = {}, .device_certificate = {},
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 inline command_t Sample(const command_t*) {
   return {.utime = 13, .command = command_t::LOAD_SCENE, .argument = "scenes/zeeman.yaml",
-          .epoch = 0, .auth_seq = 0, .mac = {}};
+          .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 inline command_reply_t Sample(const command_reply_t*) {
   return {.utime = 14, .seq = 3, .command_auth_seq = 1700000000000000001, .command = command_t::LOAD_SCENE,
-          .ok = 1, .message = "LOAD_SCENE: now scene 'zeeman' (zeeman)", .epoch = 0, .auth_seq = 0,
-          .mac = {}};
+          .ok = 1, .message = "LOAD_SCENE: now scene 'zeeman' (zeeman)", .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
+          .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
 
 template <class Msg>
