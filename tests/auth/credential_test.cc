@@ -116,41 +116,40 @@ TEST_F(CredentialFileTest, ObserverAndOperatorRoundTrip) {
 }
 
 TEST_F(CredentialFileTest, TamperedExpiryOrNameGivesAKeyTheServerDoesNotDerive) {
-  // An operator's file carries no certificate: an edited later expiry or another name
-  // still parses (the holder has the secret), but the server re-derives the key from the
-  // claim and it differs.
-  const std::string op_path = Path("alice.cred");
-  WriteCredentialFile(op_path, IssueCredential(root_, Role::kOperator, "alice", 1798761600), false);
-  const std::string op_text = ReadText(op_path);
-  for (const auto& [from, to] : {std::pair<std::string, std::string>{"expires 1798761600", "expires 1898761600"},
-                                 {"expires 1798761600", "expires never"},
-                                 {"name alice", "name bob"}}) {
-    std::string edited = op_text;
-    edited.replace(edited.find(from), from.size(), to);
-    const Credential c = LoadCredential(WriteText("edited.cred", edited));
-    EXPECT_NE(KeyBytes(*c.secret), KeyBytes(DeriveOperatorKey(root_, c.name, c.expires_unix_s))) << to;
-    EXPECT_NE(c.key_id, SecretKeyId("operator", DeriveOperatorKey(root_, c.name, c.expires_unix_s))) << to;
-  }
-  // A device's file is refused outright: its certificate binds the name and the expiry.
-  const std::string path = Path("left.cred");
-  WriteCredentialFile(path, IssueCredential(root_, Role::kDevice, "left", 1798761600), false);
-  const std::string text = ReadText(path);
-  for (const auto& [from, to] : {std::pair<std::string, std::string>{"expires 1798761600", "expires 1898761600"},
-                                 {"expires 1798761600", "expires never"},
-                                 {"name left", "name right"}}) {
-    std::string edited = text;
-    edited.replace(edited.find(from), from.size(), to);
-    const std::string file = WriteText("edited.cred", edited);
-    const std::string error = LoadError(file);
-    EXPECT_NE(error.find("credential " + file + " line 10: 'certificate' does not verify"), std::string::npos)
-        << to << ": " << error;
-    // The key the holder has is still not the one the server derives for the claim.
-    const Credential issued = IssueCredential(root_, Role::kDevice, "left", 1798761600);
-    const Credential claimed = IssueCredential(root_, Role::kDevice, to == "name right" ? "right" : "left",
-                                               to == "expires 1898761600" ? 1898761600
-                                               : to == "expires never"    ? kNeverExpires
-                                                                          : 1798761600);
-    EXPECT_NE(KeyBytes(*issued.secret), KeyBytes(*claimed.secret)) << to;
+  // A later expiry, never, or another name written into the file: the key the holder has
+  // is never the one the server re-derives for that claim. An operator's file still parses
+  // (it carries no certificate); a device's is refused at load, its certificate binding
+  // the name and the expiry.
+  struct Edit {
+    std::string from, to, name;
+    int64_t expires;
+  };
+  for (const Role role : {Role::kOperator, Role::kDevice}) {
+    const std::string own = role == Role::kDevice ? "left" : "alice";
+    const std::string path = Path(own + ".cred");
+    WriteCredentialFile(path, IssueCredential(root_, role, own, 1798761600), false);
+    const std::string text = ReadText(path);
+    const std::string held = KeyBytes(DeriveRoleKey(root_, role, own, 1798761600));
+    for (const Edit& e : {Edit{"expires 1798761600", "expires 1898761600", own, 1898761600},
+                          Edit{"expires 1798761600", "expires never", own, kNeverExpires},
+                          Edit{"name " + own, "name right", "right", 1798761600}}) {
+      std::string edited = text;
+      edited.replace(edited.find(e.from), e.from.size(), e.to);
+      const std::string file = WriteText("edited.cred", edited);
+      const std::string claimed = KeyBytes(DeriveRoleKey(root_, role, e.name, e.expires));
+      EXPECT_NE(held, claimed) << e.to;
+      if (role == Role::kDevice) {
+        const std::string error = LoadError(file);
+        EXPECT_NE(error.find("credential " + file + " line 10: 'certificate' does not verify"), std::string::npos)
+            << e.to << ": " << error;
+        continue;
+      }
+      const Credential c = LoadCredential(file);
+      EXPECT_EQ(c.name, e.name);
+      EXPECT_EQ(c.expires_unix_s, e.expires);
+      EXPECT_EQ(KeyBytes(*c.secret), held) << e.to;
+      EXPECT_NE(c.key_id, SecretKeyId("operator", DeriveOperatorKey(root_, c.name, c.expires_unix_s))) << e.to;
+    }
   }
 }
 
