@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   snapthread::app::CommonFlagSet key_only;
   key_only.session = false;
   key_only.lcm_url = false;
+  key_only.key_note = "; on the server host the root key FILE, beside FILE.previous and FILE.revoked";
   snapthread::app::AddCommonFlags(&app, &common, key_only);
   KeygenOptions o;
   app.add_flag("--force", o.force, "replace an existing root key (copy it to every machine) or credential file");
@@ -42,6 +43,14 @@ int main(int argc, char** argv) {
   app.add_option("--revoke-key-id", o.revoke_key_id, "revoke the credential of this key id (16 hex) in FILE.revoked");
   app.add_flag("--list-revoked", o.list_revoked, "print the entries of FILE.revoked");
   app.add_option("--show", o.show, "print a credential's role, name, expiry and ids (no secrets)");
+  app.footer(
+      "Examples (on the server host):\n"
+      "  snapthread-keygen --role device --device left --expires-in 30d --out left.cred\n"
+      "  snapthread-keygen --role operator --name alice --out alice.cred\n"
+      "  snapthread-keygen --role observer --out observer.cred\n"
+      "  snapthread-keygen --rotate          then re-issue, kill -HUP the server, copy, kill -HUP the rest\n"
+      "  snapthread-keygen --revoke left     then kill -HUP the server\n"
+      "docs/security.md, \"Issuing, rotating, revoking\", says what each writes and prints.");
   const auto run = [&]() -> int {
     for (const char* flag : {"--key", "--force", "--id", "--host", "--role", "--device", "--name", "--expires",
                              "--expires-in", "--out", "--rotate", "--revoke", "--revoke-key-id", "--list-revoked",
