@@ -6,14 +6,17 @@
 #include <charconv>
 #include <string>
 
+#include "auth/device_certificate.h"
 #include "auth/role_keys.h"
 
 namespace snapthread::auth {
 namespace {
 
-enum Field { kRole, kName, kExpires, kRootId, kKeyId, kServerPublicKey, kReadKey, kSecret, kFieldCount };
+enum Field {
+  kRole, kName, kExpires, kRootId, kKeyId, kServerPublicKey, kReadKey, kSecret, kCertificate, kFieldCount
+};
 constexpr std::array<std::string_view, kFieldCount> kFieldNames = {
-    "role", "name", "expires", "root_id", "key_id", "server_public_key", "read_key", "secret"};
+    "role", "name", "expires", "root_id", "key_id", "server_public_key", "read_key", "secret", "certificate"};
 
 constexpr std::string_view kHeader = "snapthread-credential ";
 // More than the longest text FormatCredential makes (about 400 bytes).
@@ -44,6 +47,7 @@ class Parser {
   int64_t ParseExpiry() const;
   void ParseBytes(Field field, uint8_t* out, std::size_t size) const;
   SessionKey ParseKey(Field field) const;
+  void CheckCertificate(Credential* c) const;
 
   std::string_view text_;
   const std::string& source_;
@@ -120,7 +124,7 @@ void Parser::CheckFieldsOfRole(Role role) const {
   const std::string role_word(RoleToString(role));
   for (int f = 0; f < kFieldCount; ++f) {
     const bool only_named = f == kName || f == kSecret;
-    const bool wanted = !only_named || RoleIsNamed(role);
+    const bool wanted = f == kCertificate ? role == Role::kDevice : !only_named || RoleIsNamed(role);
     const Line& line = fields_[static_cast<std::size_t>(f)];
     const std::string word(kFieldNames[static_cast<std::size_t>(f)]);
     if (wanted && line.number == 0) Fail(0, "no '" + word + "' line (a " + role_word + " credential needs one)");
@@ -160,6 +164,22 @@ SessionKey Parser::ParseKey(Field field) const {
   return key;
 }
 
+// A device's certificate must be the server's (server_public_key) for this name, expiry
+// and the signing key of this secret: an edited name or expiry, or a credential pieced
+// together from two roots, shows here.
+void Parser::CheckCertificate(Credential* c) const {
+  DeviceCertificateBytes certificate{};
+  ParseBytes(kCertificate, certificate.data(), certificate.size());
+  const PublicKey device_public_key = DeriveDeviceSigner(*c->secret).public_key();
+  if (!VerifyDeviceCertificate(c->server_public_key, c->name, c->expires_unix_s, device_public_key,
+                               certificate.data())) {
+    Fail(fields_[kCertificate].number,
+         "'certificate' does not verify with server_public_key for this name, expiry and secret "
+         "(edited, or issued from another root key)");
+  }
+  c->certificate = certificate;
+}
+
 Credential Parser::Parse() {
   SplitLines();
   Credential c;
@@ -182,6 +202,7 @@ Credential Parser::Parse() {
   if (SecretKeyId(KeyIdLabel(c.role), identified) != c.key_id) {
     Fail(fields_[kKeyId].number, "'key_id' does not match the key of this credential");
   }
+  if (c.role == Role::kDevice) CheckCertificate(&c);
   return c;
 }
 
@@ -216,6 +237,10 @@ Credential IssueCredential(const SessionKey& root, Role role, std::string_view n
   if (RoleIsNamed(role)) {
     c.secret.emplace(DeriveRoleKey(root, role, name, expires_unix_s));
     c.key_id = SecretKeyId(KeyIdLabel(role), *c.secret);
+    if (role == Role::kDevice) {
+      c.certificate = DeviceCertificate(DeriveServerSigner(root), name, expires_unix_s,
+                                        DeriveDeviceSigner(*c.secret).public_key());
+    }
   } else {
     c.key_id = SecretKeyId(KeyIdLabel(role), *c.read_key);
   }
@@ -246,6 +271,7 @@ std::string FormatCredential(const Credential& c) {
   hex_line("server_public_key", c.server_public_key.data(), c.server_public_key.size());
   if (c.read_key) hex_line("read_key", c.read_key->data(), SessionKey::kBytes);
   if (c.secret) hex_line("secret", c.secret->data(), SessionKey::kBytes);
+  if (c.certificate) hex_line("certificate", c.certificate->data(), c.certificate->size());
   return text;
 }
 

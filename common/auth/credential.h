@@ -11,20 +11,24 @@
 //   server_public_key <64 hex>       verifies what the server signs
 //   read_key <64 hex>                opens what the server seals
 //   secret <64 hex>                  devices and operators only: the MAC key
+//   certificate <128 hex>            devices only: the server's DeviceCertificate of the
+//                                    device's signing key (auth/device_certificate.h)
 //
 // One "word value" a line, single spaces, "\n" endings, each line once, in any order after
 // the first. Parsing is strict: an unknown, repeated or missing line, a line of another
-// role, bad hex, a wrong length, an invalid name or expiry, or a key id that does not
-// match the key is refused with a CredentialError naming the file, the line and the fix.
+// role, bad hex, a wrong length, an invalid name or expiry, a key id that does not match
+// the key, or a device certificate that server_public_key does not verify is refused with a CredentialError naming the file, the line and the fix.
 // The server takes no credential: it holds the root key file itself.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
+#include "auth/device_certificate.h"
 #include "auth/key_id.h"
 #include "auth/role.h"
 #include "auth/session_key.h"
@@ -48,12 +52,15 @@ struct Credential {
   PublicKey server_public_key{};
   std::optional<SessionKey> read_key;     // every credential
   std::optional<SessionKey> secret;       // devices and operators: the MAC key
+  // Devices: DeviceCertificate(server signer, name, expiry, DeriveDeviceSigner(*secret)
+  // .public_key()), which the device publishes with its statuses for observers.
+  std::optional<DeviceCertificateBytes> certificate;
 
   bool ExpiredAt(int64_t now_unix_s) const { return IsExpired(expires_unix_s, now_unix_s); }
 };
 
-// A credential for `role` from the root key. Devices and operators need a valid name,
-// observers none; `expires_unix_s` is kNeverExpires or a positive time. Throws
+// A credential for `role` from the root key (a device's with its certificate). Devices
+// and operators need a valid name, observers none; `expires_unix_s` is kNeverExpires or a positive time. Throws
 // CredentialError (a server credential, a bad name, a negative expiry).
 Credential IssueCredential(const SessionKey& root, Role role, std::string_view name,
                            int64_t expires_unix_s);

@@ -1,6 +1,5 @@
 #include "auth/device_certificate.h"
 
-#include <cstddef>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -8,48 +7,51 @@
 #include "auth/role.h"
 
 namespace snapthread::auth {
-
 namespace {
 
-constexpr std::string_view kDomain = "snapthread-device-cert-v1";
-constexpr std::size_t kMaxBytes = kDomain.size() + kMaxRoleNameBytes + 1 + 8 + kPublicKeyBytes;
+constexpr std::string_view kLabel = "snapthread-device-cert-v1";
+// label || name || '\0' || le64(expiry) || public key, for the longest valid name.
+constexpr std::size_t kMaxSignedBytes = kLabel.size() + kMaxRoleNameBytes + 1 + 8 + kPublicKeyBytes;
 
-// The signed bytes into `out` (kMaxBytes); their length, 0 for an invalid name.
-std::size_t Encode(std::string_view name, int64_t expires_unix_s, const PublicKey& device_public_key,
-                   uint8_t* out) noexcept {
-  if (!IsValidRoleName(name)) return 0;
-  uint8_t* p = out;
-  std::memcpy(p, kDomain.data(), kDomain.size());
-  p += kDomain.size();
-  std::memcpy(p, name.data(), name.size());
-  p += name.size();
-  *p++ = 0;
-  const auto e = static_cast<uint64_t>(expires_unix_s);
-  for (int i = 0; i < 8; ++i) *p++ = static_cast<uint8_t>(e >> (8 * i));
-  std::memcpy(p, device_public_key.data(), kPublicKeyBytes);
-  p += kPublicKeyBytes;
-  return static_cast<std::size_t>(p - out);
+// The signed bytes into `out` (kMaxSignedBytes); their length, or 0 for an invalid name
+// or a negative expiry.
+std::size_t SignedBytes(std::string_view name, int64_t expires_unix_s, const PublicKey& device_public_key,
+                        uint8_t out[kMaxSignedBytes]) noexcept {
+  if (!IsValidRoleName(name) || expires_unix_s < 0) return 0;
+  std::size_t at = 0;
+  std::memcpy(out + at, kLabel.data(), kLabel.size());
+  at += kLabel.size();
+  std::memcpy(out + at, name.data(), name.size());
+  at += name.size();
+  out[at++] = 0;
+  for (int i = 0; i < 8; ++i) out[at++] = static_cast<uint8_t>(static_cast<uint64_t>(expires_unix_s) >> (8 * i));
+  std::memcpy(out + at, device_public_key.data(), device_public_key.size());
+  return at + device_public_key.size();
 }
 
 }  // namespace
 
-Certificate DeviceCertificate(const Signer& server, std::string_view name, int64_t expires_unix_s,
-                              const PublicKey& device_public_key) {
-  uint8_t bytes[kMaxBytes];
-  const std::size_t n = Encode(name, expires_unix_s, device_public_key, bytes);
-  if (n == 0) throw std::invalid_argument("'" + std::string(name) + "' is not a valid device name");
-  Certificate cert{};
-  server.Sign(bytes, n, cert.data());
-  return cert;
+DeviceCertificateBytes DeviceCertificate(const Signer& server, std::string_view name, int64_t expires_unix_s,
+                                         const PublicKey& device_public_key) {
+  uint8_t bytes[kMaxSignedBytes];
+  const std::size_t size = SignedBytes(name, expires_unix_s, device_public_key, bytes);
+  if (size == 0) {
+    throw std::invalid_argument("no device certificate for name '" + std::string(name) + "' and expiry " +
+                                std::to_string(expires_unix_s) +
+                                " (a name is 1 to 32 of A-Z a-z 0-9 _ -, an expiry 0 or positive)");
+  }
+  DeviceCertificateBytes certificate{};
+  server.Sign(bytes, size, certificate.data());
+  return certificate;
 }
 
-bool VerifyDeviceCertificate(const PublicKey& server_public_key, std::string_view name,
-                             int64_t expires_unix_s, const PublicKey& device_public_key,
-                             const uint8_t certificate[kSignatureBytes]) noexcept {
-  uint8_t bytes[kMaxBytes];
-  const std::size_t n = Encode(name, expires_unix_s, device_public_key, bytes);
-  if (n == 0) return false;
-  return SignatureVerifier(server_public_key).Verify(bytes, n, certificate);
+bool VerifyDeviceCertificate(const PublicKey& server_public_key, std::string_view name, int64_t expires_unix_s,
+                             const PublicKey& device_public_key,
+                             const uint8_t certificate[kDeviceCertificateBytes]) noexcept {
+  uint8_t bytes[kMaxSignedBytes];
+  const std::size_t size = SignedBytes(name, expires_unix_s, device_public_key, bytes);
+  if (size == 0) return false;
+  return SignatureVerifier(server_public_key).Verify(bytes, size, certificate);
 }
 
 }  // namespace snapthread::auth

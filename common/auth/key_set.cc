@@ -43,7 +43,7 @@ KeySet KeySet::FromCredential(Credential credential) {
   if (k.role_ == Role::kDevice) {
     if (!k.credential_->secret) throw CredentialError("a device credential without its secret");
     k.device_signer_.emplace(DeriveDeviceSigner(*k.credential_->secret));
-    // MERGE-KEYGEN: if (k.credential_->certificate) k.certificate_ = *k.credential_->certificate;
+    if (k.credential_->certificate) k.certificate_ = *k.credential_->certificate;
   }
   k.BuildTaggers();
   return k;

@@ -58,7 +58,7 @@ class KeySet {
   const Tagger* device_status_tagger() const { return device_signer_ ? &status_tagger_ : nullptr; }
   // The device's public key and the server's certificate of it (devices only).
   const PublicKey* device_public_key() const { return device_signer_ ? &device_signer_->public_key() : nullptr; }
-  const Certificate* device_certificate() const { return certificate_ ? &*certificate_ : nullptr; }
+  const DeviceCertificateBytes* device_certificate() const { return certificate_ ? &*certificate_ : nullptr; }
 
  private:
   KeySet() = default;
@@ -69,7 +69,7 @@ class KeySet {
   std::optional<Credential> credential_;
   std::optional<Signer> server_signer_;  // root holders
   std::optional<Signer> device_signer_;  // devices
-  std::optional<Certificate> certificate_;
+  std::optional<DeviceCertificateBytes> certificate_;
   PublicKey server_public_key_{};
   std::optional<SessionKey> read_key_;
   Tagger tagger_;

@@ -1,6 +1,9 @@
 #include "auth/revocation_list.h"
 
-#include <vector>
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <string>
 
 #include "auth/private_file.h"
 
@@ -43,6 +46,24 @@ bool operator<(const NameKey& a, const std::pair<Role, std::string>& b) {
   return a.role != b.first ? a.role < b.first : a.name < std::string_view(b.second);
 }
 
+// The whole text of the list under the private file rules.
+std::string ReadListText(const PrivateFileNaming& file) {
+  std::string text;
+  try {
+    const OpenedPrivateFile opened = OpenPrivateFile(file);
+    if (opened.size > static_cast<off_t>(kMaxRevocationListBytes)) {
+      throw RevocationListError(file.named + " holds " + std::to_string(opened.size) +
+                                " bytes, more than " + std::to_string(kMaxRevocationListBytes) +
+                                ". Fix: " + kFix);
+    }
+    text.resize(static_cast<std::size_t>(opened.size));
+    ReadExactly(opened, file, reinterpret_cast<uint8_t*>(text.data()), text.size());
+  } catch (const PrivateFileError& e) {
+    throw RevocationListError(e.what());
+  }
+  return text;
+}
+
 }  // namespace
 
 RevocationList RevocationList::Parse(std::string_view text, const std::string& source) {
@@ -78,21 +99,32 @@ RevocationList RevocationList::Parse(std::string_view text, const std::string& s
 }
 
 RevocationList RevocationList::Load(const std::string& path) {
+  const std::string text = ReadListText(ListNaming(path));
+  return Parse(text, path);
+}
+
+RevocationList RevocationList::Append(const std::string& path, std::string_view lines) {
+  if (lines.empty() || lines.back() != '\n') {
+    throw RevocationListError("entries appended to " + path + " must be whole lines ending in a newline");
+  }
+  Parse(lines, "(new entries for " + path + ")");
   const PrivateFileNaming file = ListNaming(path);
-  std::vector<uint8_t> text;
+  std::string text;
+  struct stat st {};
+  if (lstat(path.c_str(), &st) == 0 || errno != ENOENT) {
+    text = ReadListText(file);  // refused as Load refuses it
+    Parse(text, path);
+    if (!text.empty() && text.back() != '\n') text += '\n';
+  }
+  text.append(lines);
   try {
-    const OpenedPrivateFile opened = OpenPrivateFile(file);
-    if (opened.size > static_cast<off_t>(kMaxRevocationListBytes)) {
-      throw RevocationListError(file.named + " holds " + std::to_string(opened.size) +
-                                " bytes, more than " + std::to_string(kMaxRevocationListBytes) +
-                                ". Fix: " + kFix);
-    }
-    text.resize(static_cast<std::size_t>(opened.size));
-    ReadExactly(opened, file, text.data(), text.size());
+    const bool written =
+        WritePrivateFile(file, reinterpret_cast<const uint8_t*>(text.data()), text.size(), true);
+    (void)written;  // always, with overwrite
   } catch (const PrivateFileError& e) {
     throw RevocationListError(e.what());
   }
-  return Parse(std::string_view(reinterpret_cast<const char*>(text.data()), text.size()), path);
+  return Load(path);
 }
 
 bool RevocationList::IsRevoked(Role role, std::string_view name, const KeyId& key_id) const noexcept {

@@ -38,12 +38,21 @@ class RevocationList {
   static RevocationList Parse(std::string_view text, const std::string& source);
   // Reads `path` under the private file rules (at most kMaxRevocationListBytes).
   static RevocationList Load(const std::string& path);
+  // Appends `lines` (whole lines of the format above, each ending in "\n") to the list at
+  // `path`, creating it (mode 0600, parents 0700) when missing, and returns the new list.
+  // The file is replaced atomically, so a server reloading meanwhile reads the old or the
+  // new list whole. Refuses (RevocationListError, nothing written) an existing list that
+  // does not load and lines that do not parse.
+  static RevocationList Append(const std::string& path, std::string_view lines);
 
   // Whether a credential of `role` named `name` with key id `key_id` is revoked: by its
   // name (devices and operators) or by its key id. Allocates nothing.
   bool IsRevoked(Role role, std::string_view name, const KeyId& key_id) const noexcept;
 
   std::size_t size() const { return names_.size() + key_ids_.size(); }
+  // The revoked (role, name) pairs and key ids, in order (for listing them).
+  const std::set<std::pair<Role, std::string>, std::less<>>& names() const { return names_; }
+  const std::set<KeyId>& key_ids() const { return key_ids_; }
 
  private:
   std::set<std::pair<Role, std::string>, std::less<>> names_;

@@ -14,6 +14,7 @@
 
 #include "auth/credential.h"
 #include "auth/credential_file.h"
+#include "auth/device_certificate.h"
 #include "auth/role_keys.h"
 
 namespace snapthread::auth {
@@ -77,6 +78,11 @@ TEST_F(CredentialFileTest, DeviceCredentialRoundTrip) {
   EXPECT_EQ(loaded.server_public_key, DeriveServerPublicKey(root_));
   EXPECT_EQ(KeyBytes(*loaded.secret), KeyBytes(DeriveDeviceKey(root_, "left", 1798761600)));
   EXPECT_EQ(KeyBytes(*loaded.read_key), KeyBytes(DeriveReadKey(root_)));
+  ASSERT_TRUE(loaded.certificate.has_value());
+  EXPECT_EQ(*loaded.certificate, *issued.certificate);
+  EXPECT_TRUE(VerifyDeviceCertificate(DeriveServerPublicKey(root_), "left", 1798761600,
+                                      DeriveDeviceSigner(DeriveDeviceKey(root_, "left", 1798761600)).public_key(),
+                                      loaded.certificate->data()));
   EXPECT_TRUE(loaded.ExpiredAt(1798761600));
   EXPECT_FALSE(loaded.ExpiredAt(1798761599));
   EXPECT_EQ(ReadText(path).rfind("snapthread-credential 1\nrole device\nname left\nexpires 1798761600\n", 0), 0u);
@@ -100,26 +106,50 @@ TEST_F(CredentialFileTest, ObserverAndOperatorRoundTrip) {
   EXPECT_FALSE(o.secret.has_value());
   EXPECT_EQ(ReadText(obs).find("secret"), std::string::npos);
   EXPECT_EQ(ReadText(obs).find("name"), std::string::npos);
+  EXPECT_FALSE(o.certificate.has_value());
+  EXPECT_EQ(ReadText(obs).find("certificate"), std::string::npos);
   const std::string op = Path("alice.cred");
   WriteCredentialFile(op, IssueCredential(root_, Role::kOperator, "alice", 0), false);
   EXPECT_EQ(KeyBytes(*LoadCredential(op).secret), KeyBytes(DeriveOperatorKey(root_, "alice", 0)));
+  EXPECT_FALSE(LoadCredential(op).certificate.has_value());
+  EXPECT_EQ(ReadText(op).find("certificate"), std::string::npos);
 }
 
 TEST_F(CredentialFileTest, TamperedExpiryOrNameGivesAKeyTheServerDoesNotDerive) {
-  const std::string path = Path("left.cred");
-  WriteCredentialFile(path, IssueCredential(root_, Role::kDevice, "left", 1798761600), false);
-  std::string text = ReadText(path);
-  // A later expiry, or the other grasp's name: the file still parses (the holder has the
-  // secret), but the server re-derives the key from the claim and it differs.
-  for (const auto& [from, to] : {std::pair<std::string, std::string>{"expires 1798761600", "expires 1898761600"},
-                                 {"expires 1798761600", "expires never"},
-                                 {"name left", "name right"}}) {
-    std::string edited = text;
-    edited.replace(edited.find(from), from.size(), to);
-    const std::string file = WriteText("edited.cred", edited);
-    const Credential c = LoadCredential(file);
-    EXPECT_NE(KeyBytes(*c.secret), KeyBytes(DeriveDeviceKey(root_, c.name, c.expires_unix_s))) << to;
-    EXPECT_NE(c.key_id, SecretKeyId("device", DeriveDeviceKey(root_, c.name, c.expires_unix_s))) << to;
+  // A later expiry, never, or another name written into the file: the key the holder has
+  // is never the one the server re-derives for that claim. An operator's file still parses
+  // (it carries no certificate); a device's is refused at load, its certificate binding
+  // the name and the expiry.
+  struct Edit {
+    std::string from, to, name;
+    int64_t expires;
+  };
+  for (const Role role : {Role::kOperator, Role::kDevice}) {
+    const std::string own = role == Role::kDevice ? "left" : "alice";
+    const std::string path = Path(own + ".cred");
+    WriteCredentialFile(path, IssueCredential(root_, role, own, 1798761600), false);
+    const std::string text = ReadText(path);
+    const std::string held = KeyBytes(DeriveRoleKey(root_, role, own, 1798761600));
+    for (const Edit& e : {Edit{"expires 1798761600", "expires 1898761600", own, 1898761600},
+                          Edit{"expires 1798761600", "expires never", own, kNeverExpires},
+                          Edit{"name " + own, "name right", "right", 1798761600}}) {
+      std::string edited = text;
+      edited.replace(edited.find(e.from), e.from.size(), e.to);
+      const std::string file = WriteText("edited.cred", edited);
+      const std::string claimed = KeyBytes(DeriveRoleKey(root_, role, e.name, e.expires));
+      EXPECT_NE(held, claimed) << e.to;
+      if (role == Role::kDevice) {
+        const std::string error = LoadError(file);
+        EXPECT_NE(error.find("credential " + file + " line 10: 'certificate' does not verify"), std::string::npos)
+            << e.to << ": " << error;
+        continue;
+      }
+      const Credential c = LoadCredential(file);
+      EXPECT_EQ(c.name, e.name);
+      EXPECT_EQ(c.expires_unix_s, e.expires);
+      EXPECT_EQ(KeyBytes(*c.secret), held) << e.to;
+      EXPECT_NE(c.key_id, SecretKeyId("operator", DeriveOperatorKey(root_, c.name, c.expires_unix_s))) << e.to;
+    }
   }
 }
 
@@ -147,14 +177,21 @@ TEST_F(CredentialFileTest, EveryMalformedFileIsRefusedWithFileLineAndFix) {
   WriteCredentialFile(good_path, IssueCredential(root_, Role::kDevice, "left", 1798761600), false);
   const std::string good = ReadText(good_path);
   // Lines: 1 header, 2 role, 3 name, 4 expires, 5 root_id, 6 key_id, 7 server_public_key,
-  // 8 read_key, 9 secret.
+  // 8 read_key, 9 secret, 10 certificate.
   const std::string secret_hex = good.substr(good.find("secret ") + 7, 64);
+  const std::string cert_hex = good.substr(good.find("certificate ") + 12, 128);
+  const std::string other_root_cert = [] {
+    const std::string t = FormatCredential(IssueCredential(SessionKey::Generate(), Role::kDevice, "left", 1798761600));
+    return t.substr(t.find("certificate ") + 12, 128);
+  }();
+  // One hex digit of the certificate changed.
+  const std::string flipped_cert = cert_hex.substr(0, 40) + (cert_hex[40] == '0' ? '1' : '0') + cert_hex.substr(41);
   const std::vector<Malformed> cases = {
       {"empty", [](std::string) { return std::string(); }, "", "empty"},
       {"not a credential", [](std::string) { return std::string("\x01\x02garbage"); }, "line 1", "does not start with"},
       {"other version", [](std::string t) { return Replace(t, "credential 1", "credential 2"); }, "line 1", "format version '2'"},
-      {"unknown line", [](std::string t) { return t + "colour blue\n"; }, "line 10", "unknown line 'colour'"},
-      {"duplicate", [](std::string t) { return t + "name left\n"; }, "line 10", "a second 'name' line (the first is line 3)"},
+      {"unknown line", [](std::string t) { return t + "colour blue\n"; }, "line 11", "unknown line 'colour'"},
+      {"duplicate", [](std::string t) { return t + "name left\n"; }, "line 11", "a second 'name' line (the first is line 3)"},
       {"missing secret", [](std::string t) { return DropLine(t, "secret"); }, "", "no 'secret' line"},
       {"missing expires", [](std::string t) { return DropLine(t, "expires"); }, "", "no 'expires' line"},
       {"missing name", [](std::string t) { return DropLine(t, "name"); }, "", "no 'name' line"},
@@ -175,6 +212,11 @@ TEST_F(CredentialFileTest, EveryMalformedFileIsRefusedWithFileLineAndFix) {
       {"edited secret", [&](std::string t) { return Replace(t, secret_hex, std::string(64, '0')); }, "line 6", "does not match the key"},
       {"crlf", [](std::string t) { return Replace(t, "name left\n", "name left\r\n"); }, "line 3", "carriage return"},
       {"empty line", [](std::string t) { return Replace(t, "name left\n", "name left\n\n"); }, "line 4", "an empty line"},
+      {"missing certificate", [](std::string t) { return DropLine(t, "certificate"); }, "", "no 'certificate' line (a device credential needs one)"},
+      {"short certificate", [&](std::string t) { return Replace(t, cert_hex, cert_hex.substr(2)); }, "line 10", "128 hex digits (126 characters"},
+      {"edited certificate", [&](std::string t) { return Replace(t, cert_hex, flipped_cert); }, "line 10", "'certificate' does not verify"},
+      {"certificate of another root", [&](std::string t) { return Replace(t, cert_hex, other_root_cert); }, "line 10", "'certificate' does not verify"},
+      {"operator with certificate", [](std::string t) { return Replace(t, "role device", "role operator"); }, "line 10", "an operator credential has no 'certificate' line"},
       {"observer with secret", [](std::string t) { return Replace(DropLine(t, "name"), "role device", "role observer"); }, "line 8", "an observer credential has no 'secret' line"},
   };
   for (const Malformed& m : cases) {
