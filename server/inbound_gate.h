@@ -49,7 +49,7 @@ class InboundGate final : public InboundSink {
 
  private:
   // Counts a refusal (rejected_messages, the role/reason table) and logs it rate-limited.
-  void Refuse(const std::string& channel, int8_t claimed_role, std::string_view name, Refusal refusal);
+  void Refuse(const std::string& channel, int8_t claimed_role, std::string_view name, RefusalReason refusal);
   // The key of a message claimed by `role` (whose sender_role must be `role`) if its
   // MAC verifies under it; else refuses it and returns nullptr.
   template <class Msg>

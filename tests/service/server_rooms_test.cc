@@ -63,7 +63,7 @@ class GateTest : public ::testing::Test {
   ServerInbox::Taken Take() {
     return inbox_.Wait(ServerInbox::Clock::now());
   }
-  int64_t Refused(auth::Role role, Refusal refusal) const {
+  int64_t Refused(auth::Role role, RefusalReason refusal) const {
     return counters_.refusals.Get(static_cast<int8_t>(role), refusal);
   }
 
@@ -134,12 +134,12 @@ TEST_F(GateTest, OnlyTheGraspsOwnDeviceMovesIt) {
   give(other_root.tagger(), "right");
   EXPECT_EQ(counters_.poses_received.load(), 0);
   EXPECT_TRUE(Take().poses.empty());
-  EXPECT_EQ(Refused(auth::Role::kOperator, Refusal::kWrongRole), 1);
-  EXPECT_EQ(Refused(auth::Role::kObserver, Refusal::kWrongRole), 1);
-  EXPECT_EQ(Refused(auth::Role::kServer, Refusal::kWrongRole), 1);
-  EXPECT_EQ(Refused(auth::Role::kDevice, Refusal::kWrongGrasp), 1);
-  EXPECT_EQ(Refused(auth::Role::kDevice, Refusal::kUnknownKey), 2);
-  EXPECT_EQ(Refused(auth::Role::kDevice, Refusal::kExpired), 1);
+  EXPECT_EQ(Refused(auth::Role::kOperator, RefusalReason::kWrongRole), 1);
+  EXPECT_EQ(Refused(auth::Role::kObserver, RefusalReason::kWrongRole), 1);
+  EXPECT_EQ(Refused(auth::Role::kServer, RefusalReason::kWrongRole), 1);
+  EXPECT_EQ(Refused(auth::Role::kDevice, RefusalReason::kWrongGrasp), 1);
+  EXPECT_EQ(Refused(auth::Role::kDevice, RefusalReason::kUnknownKey), 2);
+  EXPECT_EQ(Refused(auth::Role::kDevice, RefusalReason::kExpired), 1);
   EXPECT_EQ(counters_.rejected_messages.load(), 7);
   EXPECT_EQ(counters_.refusals.Total(), 7);
   // The genuine "right" device is unaffected.
@@ -155,7 +155,7 @@ TEST_F(GateTest, RevocationActsFromTheNextMessage) {
   keys_.Reload(UnixSeconds());
   GiveDeviceState(Pose(hand_.tagger(), 2, 2));
   EXPECT_EQ(counters_.poses_received.load(), 1);
-  EXPECT_EQ(Refused(auth::Role::kDevice, Refusal::kRevoked), 1);
+  EXPECT_EQ(Refused(auth::Role::kDevice, RefusalReason::kRevoked), 1);
   // Another device goes on. A broken list keeps the old one (logged naming the file).
   const auth::KeySet left = testing::DeviceKeys(root_, "left");
   GiveDeviceState(Pose(left.tagger(), 3, 1, "left"));
@@ -166,7 +166,7 @@ TEST_F(GateTest, RevocationActsFromTheNextMessage) {
   }
   keys_.Reload(UnixSeconds());
   GiveDeviceState(Pose(hand_.tagger(), 4, 3));
-  EXPECT_EQ(Refused(auth::Role::kDevice, Refusal::kRevoked), 2);
+  EXPECT_EQ(Refused(auth::Role::kDevice, RefusalReason::kRevoked), 2);
   EXPECT_EQ(keys_.reloads(), 2);
 }
 
@@ -190,8 +190,8 @@ TEST_F(GateTest, ThePreviousRootIsAcceptedOnlyDuringItsGrace) {
   GiveDeviceState(Pose(new_hand.tagger(), 3, 3));
   GiveDeviceState(Pose(hand_.tagger(), 4, 4));  // two roots back: unknown
   EXPECT_EQ(counters_.poses_received.load(), 2);
-  EXPECT_EQ(Refused(auth::Role::kDevice, Refusal::kGraceOver), 1);
-  EXPECT_EQ(Refused(auth::Role::kDevice, Refusal::kUnknownKey), 1);
+  EXPECT_EQ(Refused(auth::Role::kDevice, RefusalReason::kGraceOver), 1);
+  EXPECT_EQ(Refused(auth::Role::kDevice, RefusalReason::kUnknownKey), 1);
 }
 
 TEST_F(GateTest, AtMostKMaxSendersAreTracked) {
@@ -207,7 +207,7 @@ TEST_F(GateTest, AtMostKMaxSendersAreTracked) {
   const auth::KeySet extra = testing::DeviceKeys(root_, "one-too-many");
   GiveDeviceState(Pose(extra.tagger(), 1, 1, "one-too-many"));
   EXPECT_EQ(counters_.rejected_messages.load(), 1);
-  EXPECT_EQ(Refused(auth::Role::kDevice, Refusal::kTooMany), 1);
+  EXPECT_EQ(Refused(auth::Role::kDevice, RefusalReason::kTooMany), 1);
   // A known device goes on; a forged pose of a new name never takes a slot.
   GiveDeviceState(Pose(devices[0].tagger(), 2, 2, "d0"));
   EXPECT_EQ(counters_.poses_received.load(), static_cast<int64_t>(InboundGate::kMaxSenders) + 1);
