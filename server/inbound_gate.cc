@@ -49,7 +49,7 @@ void InboundGate::OnCommand(const void* data, size_t size) {
 }
 
 void InboundGate::Refuse(const std::string& channel, int8_t claimed_role, std::string_view name,
-                         RefusalReason refusal) {
+                         RefusalReason refusal, std::string_view detail) {
   counters_->refusals.Count(claimed_role, refusal);
   const int64_t total = counters_->rejected_messages.fetch_add(1) + 1;
   if (ShouldLog(&counters_->last_reject_log_us)) {
@@ -57,8 +57,9 @@ void InboundGate::Refuse(const std::string& channel, int8_t claimed_role, std::s
         claimed_role >= 0 && claimed_role <= static_cast<int8_t>(auth::Role::kOperator)
             ? auth::RoleToString(static_cast<auth::Role>(claimed_role))
             : std::string_view("unknown");
-    spdlog::warn("server: refused a message on {} from {} '{}': {} ({} refused since start: {})", channel,
-                 role, name, RefusalName(refusal), total, counters_->refusals.Format());
+    spdlog::warn("server: refused a message on {} from {} '{}': {}{}{} ({} refused since start: {})", channel,
+                 role, name, RefusalName(refusal), detail.empty() ? "" : ": ", detail, total,
+                 counters_->refusals.Format());
   }
 }
 
@@ -87,7 +88,7 @@ void InboundGate::AdmitDeviceState(const void* data, size_t size) {
   ReceivedPose sample;
   std::string why;
   if (!Decode(data, size, &sample.state, &why)) {
-    Refuse(channel, kUnknownRole, why, RefusalReason::kMalformed);
+    Refuse(channel, kUnknownRole, "", RefusalReason::kMalformed, why);
     return;
   }
   const device_state_t& s = sample.state;
@@ -121,7 +122,7 @@ void InboundGate::AdmitCommand(const void* data, size_t size) {
   command_t command;
   std::string why;
   if (!Decode(data, size, &command, &why)) {
-    Refuse(channel, kUnknownRole, why, RefusalReason::kMalformed);
+    Refuse(channel, kUnknownRole, "", RefusalReason::kMalformed, why);
     return;
   }
   if (Authenticate(data, size, command, channel, auth::Role::kOperator) == nullptr) return;
