@@ -170,5 +170,35 @@ TEST_F(ServerRolesTest, ARevokedDeviceIsRefusedFromItsNextPose) {
   EXPECT_EQ(server_->Stats().updates, 1);
 }
 
+// Issue 25: holders of each other credential try to move the hand: 0 of their poses are
+// answered, and the solver status reports each refusal under the claimed role and reason.
+TEST_F(ServerRolesTest, NoOtherCredentialMovesTheHand) {
+  StartServer("curve2d_snap.yaml");
+  const auth::SessionKey& root = key_file_.key();
+  const auth::KeySet ops = testing::OperatorKeys(root);
+  const auth::KeySet observer = auth::KeySet::ForRole(root, auth::Role::kObserver);
+  const auth::KeySet left = testing::DeviceKeys(root, "left");
+  const auth::KeySet expired = testing::DeviceKeys(root, "hand", UnixSeconds() - 1);
+  const auth::KeySet stranger = testing::DeviceKeys(auth::SessionKey::Generate(), "hand");
+  int64_t seq = 0;
+  for (const auth::KeySet* forger : {&ops, &observer, &left, &expired, &stranger}) {
+    ++seq;
+    PublishAs(*forger, MakePose(seq, Eigen::Vector3d(0.001 * static_cast<double>(seq), 0.0, 0.0)));
+  }
+  device_state_t for_right = MakePose(++seq, Eigen::Vector3d::Zero());
+  for_right.grasp = "right";
+  PublishAs(left, for_right);
+  const std::string expected =
+      "device/unknown-key=1 device/expired=1 device/wrong-grasp=2 observer/wrong-role=1 operator/wrong-role=1";
+  EXPECT_TRUE(probe_->WaitStatus(0, [&](const solver_status_t& s) { return s.refusals == expected; }))
+      << server_->Stats().refusals;
+  EXPECT_EQ(server_->Stats().updates, 0);
+  EXPECT_TRUE(probe_->models().empty());
+  // The genuine device is answered.
+  Publish(MakePose(++seq, Eigen::Vector3d::Zero()));
+  force_model_t m;
+  EXPECT_TRUE(probe_->WaitModel(seq, &m));
+}
+
 }  // namespace
 }  // namespace snapthread::server
