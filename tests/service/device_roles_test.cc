@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "allocation_counter.h"
 #include "auth/device_certificate.h"
 #include "auth/freshness_filter.h"
 #include "auth/key_set.h"
@@ -222,6 +223,48 @@ TEST(DeviceRolesTest, AfterAReloadThePreviousKeyIsAcceptedForItsGraceOnly) {
   rig.server.MacWith(auth::KeySet::ForRole(new_root, auth::Role::kDevice, "hand"));
   rig.Run(300);
   EXPECT_GT(rig.rx().received(), at_end_of_grace + 250);
+}
+
+// The io thread's tags (a pose at up to 1 kHz, a status) and the receive thread's MAC
+// check allocate nothing once warm, with the key swapped by a reload in between.
+TEST(DeviceRolesTest, TaggingAndCheckingAllocateNothingInSteadyState) {
+  const auth::SessionKey root = auth::SessionKey::Generate();
+  DeviceKeys keys(auth::KeySet::ForRole(root, auth::Role::kDevice, "hand"), kGraceUs);
+  const messages::Channels channels(messages::kDefaultSession);
+  device_state_t pose{};
+  pose.device_id = "virtual-hand";
+  device_status_t st{};
+  st.device_id = "virtual-hand";
+  force_model_t model{};
+  const auth::Tagger model_tagger = ForceModelTagger(keys.current());
+  ASSERT_TRUE(auth::Sign(&model, channels.force_model, 7, 1, model_tagger));
+  const std::vector<uint8_t> model_bytes = Encoded(model);
+  std::string error;
+  long allocations = 0;
+  for (int round = 0; round < 2; ++round) {
+    // Warm-up of each size (the per-thread buffer), then counted.
+    ASSERT_TRUE(auth::Sign(&pose, channels.device_state, 7, 1, keys.current().tagger()));
+    ASSERT_TRUE(auth::Sign(&st, channels.device_status, 7, 2, *keys.current().device_status_tagger()));
+    test_support::AllocationCounter counter;
+    for (int64_t i = 0; i < 1000; ++i) {
+      pose.seq = i;
+      if (!auth::Sign(&pose, channels.device_state, 7, 10 + i, keys.current().tagger())) ADD_FAILURE();
+      const auth::KeySet* k = keys.ForKeyId(model.key_id, 0);
+      if (k == nullptr ||
+          !auth::VerifyMac(model_bytes.data(), model_bytes.size(), channels.force_model, *k->mac_key())) {
+        ADD_FAILURE();
+      }
+    }
+    if (!auth::Sign(&st, channels.device_status, 7, 5000, *keys.current().device_status_tagger())) ADD_FAILURE();
+    allocations += counter.mallocs();
+    counter.Stop();
+    // A reload between the rounds: the previous key still checks the model.
+    if (round == 0) {
+      ASSERT_TRUE(keys.Replace(auth::KeySet::ForRole(auth::SessionKey::Generate(), auth::Role::kDevice, "hand"), 0,
+                               &error));
+    }
+  }
+  EXPECT_EQ(allocations, 0);
 }
 
 TEST(DeviceRolesTest, AReloadOfAnotherDevicesCredentialIsRefused) {
