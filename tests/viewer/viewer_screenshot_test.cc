@@ -19,6 +19,9 @@
 #include "snapthread/device_state_t.hpp"
 #include "scene/scene.h"
 #include "orbit_camera.h"
+#include "auth/credential.h"
+#include "auth/credential_file.h"
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "snapthread/solver_status_t.hpp"
@@ -74,15 +77,26 @@ thread_shape_t ArcShape(int64_t seq, int8_t status = 0) {
   return s;
 }
 
-// Publishes the arc every 20 ms (plus malformed packets when asked) until stopped, signed
-// like the server's (a per-test key in SNAPTHREAD_KEY_FILE for the viewer, an epoch
-// announced in a signed solver status before each shape).
+// A credential of `role` issued from `root`, written to `dir`; its path.
+std::string WriteCredential(const std::string& dir, const auth::SessionKey& root, auth::Role role,
+                            const std::string& name = "") {
+  const std::string path = dir + "/" + std::string(auth::RoleToString(role)) + ".cred";
+  auth::WriteCredentialFile(path, auth::IssueCredential(root, role, name, auth::kNeverExpires), true);
+  return path;
+}
+
+// Publishes the arc every 20 ms (plus malformed packets, or forged shapes, when asked)
+// until stopped, signed as the server (the root key of a per-test key file in
+// SNAPTHREAD_KEY_FILE, an epoch announced in a signed solver status before each shape).
+// The forged shapes (a straight line across the window: drawn, it would show) are MACed
+// with a device key of the session, or signed by another session's server.
 class ShapePublisher {
  public:
   // `decorate` adds to each shape (grasps, contacts) before it is signed.
   ShapePublisher(const std::string& session, bool with_garbage, int8_t status = 0,
-                 std::function<void(thread_shape_t*)> decorate = {})
-      : channel_(messages::Channels(session).shape),
+                 std::function<void(thread_shape_t*)> decorate = {}, bool with_forged = false)
+      : forged_(with_forged),
+        channel_(messages::Channels(session).shape),
         status_channel_(messages::Channels(session).solver_status),
         garbage_(with_garbage),
         status_(status),
@@ -98,7 +112,9 @@ class ShapePublisher {
     if (thread_.joinable()) thread_.join();
   }
   int64_t garbage_sent() const { return garbage_sent_; }
+  int64_t forged_sent() const { return forged_sent_; }
   int64_t epoch() const { return epoch_; }
+  const auth::SessionKey& root() const { return key_file_.key(); }
 
  private:
   void Loop() {
@@ -111,16 +127,32 @@ class ShapePublisher {
       st.scene = "test-arc";
       st.method = "newton";
       st.status = status_;
-      if (auth::Sign(&st, status_channel_, epoch_, auth_seq_.Next(), key_file_.key())) {
+      if (auth::Sign(&st, status_channel_, epoch_, auth_seq_.Next(), server_.tagger())) {
         lcm_.publish(status_channel_, &st);
       }
       thread_shape_t s = ArcShape(++seq, status_);
       if (decorate_) decorate_(&s);
-      if (auth::Sign(&s, channel_, epoch_, auth_seq_.Next(), key_file_.key())) {
+      if (auth::Sign(&s, channel_, epoch_, auth_seq_.Next(), server_.tagger())) {
         lcm_.publish(channel_, &s);
       }
+      if (forged_) PublishForged(seq);
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
+  }
+
+  // A straight line from the window's lower left to its lower right, tagged by `tagger`
+  // with the session's epoch and a fresh sequence: only its tag is wrong.
+  void PublishForgedShape(int64_t seq, const auth::Tagger& tagger) {
+    thread_shape_t line = ArcShape(seq);
+    for (int i = 0; i < kNodes; ++i) line.positions[i] = {-1.0 + 2.0 * i / (kNodes - 1), -0.5, 0.0};
+    if (auth::Sign(&line, channel_, epoch_, auth_seq_.Next(), tagger)) {
+      lcm_.publish(channel_, &line);
+      forged_sent_++;
+    }
+  }
+  void PublishForged(int64_t seq) {
+    PublishForgedShape(seq, device_.tagger());
+    PublishForgedShape(seq, other_server_.tagger());
   }
 
   void PublishGarbage(int64_t seq, std::mt19937* rng) {
@@ -162,6 +194,11 @@ class ShapePublisher {
   }
 
   const SessionKeyFile key_file_;
+  const auth::KeySet server_ =
+      auth::KeySet::FromRoot(auth::SessionKey::FromBytes(key_file_.key().data(), auth::SessionKey::kBytes));
+  const auth::KeySet device_ = auth::KeySet::ForRole(key_file_.key(), auth::Role::kDevice, "hand");
+  const auth::KeySet other_server_ = auth::KeySet::FromRoot(auth::SessionKey::Generate());
+  const bool forged_;
   const int64_t epoch_ = auth::NewEpoch();
   auth::AuthSequence auth_seq_;
   lcm::LCM lcm_{kLoopbackUrl};
@@ -172,6 +209,7 @@ class ShapePublisher {
   std::function<void(thread_shape_t*)> decorate_;
   std::atomic<bool> running_{true};
   std::atomic<int64_t> garbage_sent_{0};
+  std::atomic<int64_t> forged_sent_{0};
   std::thread thread_;
 };
 
@@ -180,18 +218,21 @@ struct ViewerRun {
   std::string png;
 };
 
+// `key`: the --key given ("" = SNAPTHREAD_KEY_FILE's root key).
 ViewerRun RunViewerScreenshot(const std::string& session, const std::string& dir,
-                              int after_shapes, double timeout_s) {
+                              int after_shapes, double timeout_s, const std::string& key = "") {
   ViewerRun run;
   run.png = dir + "/shot.png";
   const VirtualDisplay display(dir);
   EXPECT_TRUE(display.ready()) << "Xvfb did not start: " << display.error();
   if (!display.ready()) return run;
-  const std::vector<std::string> argv = display.On({
+  std::vector<std::string> args = {
       BinDir() + "/snapthread-viewer", "--session", session, "--lcm-url", kLoopbackUrl,
       "--screenshot", run.png, "--after-shapes", std::to_string(after_shapes), "--timeout-s",
       std::to_string(timeout_s), "--width", std::to_string(kWidth), "--height",
-      std::to_string(kHeight)});
+      std::to_string(kHeight)};
+  if (!key.empty()) args.insert(args.end(), {"--key", key});
+  const std::vector<std::string> argv = display.On(args);
   ChildProcess viewer(argv, OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
   EXPECT_TRUE(viewer.started()) << "cannot start snapthread-viewer";
   if (viewer.started()) run.result = viewer.Finish(timeout_s + 40.0);
@@ -279,13 +320,15 @@ void ExpectArcDrawn(const Image& img) {
   EXPECT_TRUE(IsBackground(img.At(int(centre.x()), int(centre.y()))));
 }
 
+// The viewer on an observer credential shows the live thread.
 TEST(ViewerScreenshotTest, ShowsTheThreadAlongTheProjectedArc) {
   const std::string session = UniqueSession("VIEWARC");
   const std::string dir = FreshTempDir("viewer-arc");
   ShapePublisher publisher(session, /*with_garbage=*/false);
+  const std::string observer = WriteCredential(dir, publisher.root(), auth::Role::kObserver);
   ASSERT_TRUE(publisher.Start()) << "LCM publisher failed on " << kLoopbackUrl
                                  << " (no multicast route? see deploy/multicast-route.sh)";
-  const ViewerRun run = RunViewerScreenshot(session, dir, 5, 30.0);
+  const ViewerRun run = RunViewerScreenshot(session, dir, 5, 30.0, observer);
   publisher.Stop();
   ASSERT_TRUE(run.result.exited) << "viewer did not exit; stderr:\n" << run.result.err;
   ASSERT_EQ(run.result.exit_code, 0) << run.result.out << run.result.err;
@@ -294,6 +337,54 @@ TEST(ViewerScreenshotTest, ShowsTheThreadAlongTheProjectedArc) {
   std::string error;
   ASSERT_TRUE(ReadPng(run.png, &img, &error)) << error;
   ExpectArcDrawn(img);
+}
+
+// Shapes MACed with a device key of the session, or signed by another session's server,
+// arrive between the genuine ones: the viewer on an observer credential draws only the
+// arc (a forged line drawn would show below it), and --print-rates counts the forged.
+TEST(ViewerScreenshotTest, RefusesAndCountsShapesTheServerDidNotSign) {
+  const std::string session = UniqueSession("VIEWFORGE");
+  const std::string dir = FreshTempDir("viewer-forge");
+  ShapePublisher publisher(session, /*with_garbage=*/false, 0, {}, /*with_forged=*/true);
+  const std::string observer = WriteCredential(dir, publisher.root(), auth::Role::kObserver);
+  ASSERT_TRUE(publisher.Start());
+  const ViewerRun run = RunViewerScreenshot(session, dir, 20, 30.0, observer);
+  ASSERT_TRUE(run.result.exited) << run.result.err;
+  ASSERT_EQ(run.result.exit_code, 0) << run.result.out << run.result.err;
+  Image img;
+  std::string error;
+  ASSERT_TRUE(ReadPng(run.png, &img, &error)) << error;
+  ExpectArcDrawn(img);
+  ChildProcess rates({BinDir() + "/snapthread-viewer", "--print-rates", "--session", session, "--lcm-url",
+                      kLoopbackUrl, "--key", observer, "--duration-s", "3"},
+                     OutputFiles(dir + "/rates_out.txt", dir + "/rates_err.txt", true));
+  ASSERT_TRUE(rates.started());
+  const ProcessResult r = rates.Finish(20.0);
+  publisher.Stop();
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << r.out << r.err;
+  const size_t at = r.out.find("REJECTED ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  // 3 s at 50 Hz, two forged shapes each time (loopback UDP may drop a few).
+  EXPECT_GE(std::stoll(r.out.substr(at + 9)), 150) << r.out;
+  EXPECT_NE(r.err.find("refused SHAPE"), std::string::npos) << r.err;
+}
+
+// A device's or an operator's credential is no observer's: the viewer refuses to start,
+// naming the observer role.
+TEST(ViewerScreenshotTest, RefusesAnotherRolesCredential) {
+  const std::string dir = FreshTempDir("viewer-role");
+  const auth::SessionKey root = auth::SessionKey::Generate();
+  for (const auth::Role role : {auth::Role::kDevice, auth::Role::kOperator}) {
+    const std::string cred = WriteCredential(dir, root, role, "hand");
+    ChildProcess viewer({BinDir() + "/snapthread-viewer", "--print-rates", "--session", "VIEWROLE", "--lcm-url",
+                         kLoopbackUrl, "--key", cred, "--duration-s", "1"},
+                        OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
+    ASSERT_TRUE(viewer.started());
+    const ProcessResult r = viewer.Finish(20.0);
+    ASSERT_TRUE(r.exited) << r.err;
+    EXPECT_NE(r.exit_code, 0) << r.out << r.err;
+    EXPECT_NE(r.err.find("observer"), std::string::npos) << r.err;
+  }
 }
 
 TEST(ViewerScreenshotTest, MalformedShapePacketsAreDroppedAndCounted) {
@@ -424,7 +515,11 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
   const std::string session = UniqueSession("VIEWREPLAY");
   const std::string dir = FreshTempDir("viewer-replay");
   const std::string log_path = dir + "/session.lcmlog";
-  const SessionKeyFile key_file;  // the logged session's key, for the viewer too
+  const SessionKeyFile key_file;  // the logged session's root key
+  const auth::KeySet server =
+      auth::KeySet::FromRoot(auth::SessionKey::FromBytes(key_file.key().data(), auth::SessionKey::kBytes));
+  // Reviewed with an observer credential of that session.
+  const std::string observer = WriteCredential(dir, key_file.key(), auth::Role::kObserver);
   {
     lcm::LogFile log(log_path, "w");
     ASSERT_TRUE(log.good());
@@ -437,7 +532,7 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
       st.scene = "test-arc";
       st.method = "newton";
       ASSERT_TRUE(auth::Sign(&st, messages::Channels(session).solver_status, epoch,
-                             auth_seq.Next(), key_file.key()));
+                             auth_seq.Next(), server.tagger()));
       std::vector<uint8_t> status_buf(st.getEncodedSize());
       st.encode(status_buf.data(), 0, int(status_buf.size()));
       lcm::LogEvent se;
@@ -447,7 +542,7 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
       se.data = status_buf.data();
       ASSERT_EQ(log.writeEvent(&se), 0);
       thread_shape_t s = ArcShape(k);
-      ASSERT_TRUE(auth::Sign(&s, channel, epoch, auth_seq.Next(), key_file.key()));
+      ASSERT_TRUE(auth::Sign(&s, channel, epoch, auth_seq.Next(), server.tagger()));
       std::vector<uint8_t> buf(s.getEncodedSize());
       s.encode(buf.data(), 0, int(buf.size()));
       lcm::LogEvent e;
@@ -465,7 +560,7 @@ TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
   const std::vector<std::string> viewer_argv = display.On({
       BinDir() + "/snapthread-viewer", "--session", session, "--lcm-url", kLoopbackUrl,
       "--screenshot", dir + "/shot.png", "--after-shapes", "10", "--timeout-s", "30",
-      "--width", std::to_string(kWidth), "--height", std::to_string(kHeight)});
+      "--width", std::to_string(kWidth), "--height", std::to_string(kHeight), "--key", observer});
   ChildProcess viewer(viewer_argv, OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
   ASSERT_TRUE(viewer.started());
   const bool listening = WaitUntil(
@@ -535,6 +630,9 @@ TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
 
   ShapePublisher publisher(session, /*with_garbage=*/false);
   ASSERT_TRUE(publisher.Start());
+  const std::string driven_name =
+      scene.grasps.size() == 1 && !scene.grasps.front().name.empty() ? scene.grasps.front().name : "hand";
+  const auth::KeySet driven = auth::KeySet::ForRole(publisher.root(), auth::Role::kDevice, driven_name);
   PoseCollector collector(session);
   const std::string viewer = BinDir() + "/snapthread-viewer";
   const std::string title = "snapthread-viewer: " + session;
@@ -564,9 +662,18 @@ TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
   for (const auto& p : poses) {
     EXPECT_EQ(p.buttons, 1);  // published only while the button is held
     EXPECT_EQ(p.device_id, "viewer-mouse");
-    // Signed with the epoch the viewer learned from the publisher's signed status.
+    // Tagged as the device of the scene's grasp (the root key's viewer acts as it), with
+    // the epoch the viewer learned from the publisher's signed status.
     EXPECT_EQ(p.epoch, publisher.epoch());
     EXPECT_GT(p.auth_seq, 0);
+    EXPECT_EQ(p.sender_role, static_cast<int8_t>(auth::Role::kDevice));
+    EXPECT_EQ(p.sender_name, driven_name);
+    device_state_t copy = p;
+    std::vector<uint8_t> bytes(copy.getEncodedSize());
+    copy.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    EXPECT_TRUE(auth::VerifyMac(bytes.data(), bytes.size(), messages::Channels(session).device_state,
+                                *driven.mac_key()))
+        << "the pose carries the MAC of the grasp's device key";
   }
   // The pose while held at the target: the model point under the cursor, in device metres
   // (one pixel is ~0.007 model units = 0.14 mm here).
