@@ -3,46 +3,31 @@
 // counts shapes it did not sign, refuses another role's credential, and in grasp mode
 // drives as a device.
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <mutex>
-#include <cmath>
-#include <cstring>
-#include <functional>
-#include <random>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "messages/pose_mapping.h"
-#include "grasp_publisher.h"
-#include "hud_layout.h"
-#include "marker_colors.h"
-#include "snapthread/device_state_t.hpp"
-#include "scene/scene.h"
-#include "orbit_camera.h"
-#include "auth/credential.h"
-#include "auth/credential_file.h"
+#include "arc_session.h"
 #include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
-#include "snapthread/solver_status_t.hpp"
-#include "snapthread/thread_shape_t.hpp"
 #include "messages/channels.h"
+#include "messages/pose_mapping.h"
 #include "messages/subscribe.h"
-#include "spline.h"
-#include "png_image.h"
-#include "test_support.h"
-#include "arc_session.h"
+#include "scene/scene.h"
+#include "snapthread/device_state_t.hpp"
 
 namespace snapthread::viewer_test {
 namespace {
 
-using namespace test_support;  // the shared fixtures (tests/support)
-
-using viewer::CatmullRomCurve;
+using namespace test_support;  // ChildProcess, VirtualDisplay, UniqueSession, ...
 using viewer::OrbitCamera;
-using viewer::Point3;
 
 // Shapes MACed with a device key of the session, or signed by another session's server,
 // arrive between the genuine ones: the viewer on an observer credential draws only the
