@@ -8,6 +8,7 @@
 
 #include "app/command_line.h"
 #include "app/exit_codes.h"
+#include "auth/sealed_message.h"
 
 namespace snapthread::app {
 
@@ -31,9 +32,17 @@ void AddCommonFlags(CLI::App* app, CommonFlags* flags, const CommonFlagSet& set)
   }
   if (set.key) {
     app->add_option("--key", flags->key_path,
-                    "session key file (default: $" + std::string(auth::kKeyFileEnv) +
+                    "the root key file (server host) or this program's role credential (default: $" + std::string(auth::kKeyFileEnv) +
                         ", else $XDG_CONFIG_HOME/snapthread/session.key or ~/.config/snapthread/session.key)" +
                         set.key_note);
+  }
+  if (set.encrypt) {
+    if (const char* e = std::getenv("SNAPTHREAD_ENCRYPT"); e != nullptr && std::string_view(e) == "1") {
+      flags->encrypt = true;
+    }
+    app->add_flag("--encrypt", flags->encrypt,
+                  "seal what this program publishes under the session's read key (default: "
+                  "$SNAPTHREAD_ENCRYPT=1; docs/security.md, \"Sealed payloads\")");
   }
   if (set.log_level) {
     app->add_option("--log-level", flags->log_level, "trace | debug | info | warn | error | critical | off")
@@ -77,6 +86,7 @@ std::optional<auth::KeySet> LoadKeySet(const CommonFlags& flags, auth::Role need
   try {
     const auth::KeyLocation location = auth::ResolveKeyPath(flags.key_path);
     std::optional<auth::KeySet> keys(auth::LoadKeySet(location.path, needed, program));
+    auth::SetSealing(keys->read_key(), nullptr, flags.encrypt);
     if (where != nullptr) *where = location;
     return keys;
   } catch (const std::exception& e) {

@@ -24,6 +24,7 @@ struct CommonFlags {
   std::string lcm_url;    // as given; "" = $LCM_DEFAULT_URL, else kDefaultLcmUrl (LcmUrl())
   std::string key_path;   // as given; "" = $SNAPTHREAD_KEY_FILE, else the XDG default
   std::string log_level = "info";  // spdlog's level names
+  bool encrypt = false;   // --encrypt (or $SNAPTHREAD_ENCRYPT=1): seal what this program publishes
   // The --session default came from $SNAPTHREAD_SESSION (AddCommonFlags set it).
   bool session_from_environment = false;
 };
@@ -34,6 +35,8 @@ struct CommonFlagSet {
   bool lcm_url = true;
   bool key = true;
   bool log_level = false;
+  // --encrypt: programs that publish (server, device, ctl, a viewer driving a grasp).
+  bool encrypt = false;
   // A non-empty $SNAPTHREAD_SESSION is the default --session (the observers: viewer, web).
   bool session_from_environment = false;
   // The --lcm-url option's names: snapthread-logger adds lcm-logger's "-l".
@@ -71,7 +74,9 @@ std::optional<auth::SessionKey> LoadSessionKey(const CommonFlags& flags, std::st
 // What --key names for a program playing `needed` (auth/key_set.h: the root key, or a
 // credential of that role), or nullopt after printing "<program>: --key: <which file, why
 // and the fix>" (a credential of another role names the role needed). `where`, if given,
-// receives the file used.
+// receives the file used. On success the process opens sealed messages with the keys'
+// read key from now on, and seals what it publishes with --encrypt
+// (auth/sealed_message.h).
 std::optional<auth::KeySet> LoadKeySet(const CommonFlags& flags, auth::Role needed,
                                        std::string_view program, auth::KeyLocation* where = nullptr);
 

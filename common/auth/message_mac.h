@@ -116,8 +116,7 @@ template <class Msg>
 // KeySet's taggers.
 inline Tagger RootMacTagger(const SessionKey& root) {
   Tagger t;
-  t.mac_key = &root;
-  t.key_id = RootKeyId(root);
+  t.mac_key = &root;  // key_id stays zero: nothing resolves it (and RootKeyId allocates)
   return t;
 }
 

@@ -15,7 +15,8 @@
 // Usage (server/lcm_server_transport.cc):
 //   sub = messages::Subscribe<&LcmServerTransport::HandleDeviceState>(lcm, channel, this);
 // the handler is (const lcm::ReceiveBuffer*, const std::string& channel) or, typed,
-// (const lcm::ReceiveBuffer*, const std::string& channel, const Msg*). Unsubscribe with
+// (const lcm::ReceiveBuffer*, const std::string& channel, const Msg*) (typed: liblcm decodes,
+// so a sealed message never reaches it; snapthread's receivers are untyped). Unsubscribe with
 // lcm.unsubscribe(sub) as before.
 #pragma once
 
@@ -23,9 +24,26 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/sealed_message.h"
+
 namespace snapthread::messages {
 
 namespace subscribe_detail {
+
+// A sealed_t envelope (auth/sealed_message.h) opened with the process's read key stands
+// in for the message it holds, so every handler sees the message as if sent in clear. An
+// envelope that does not open is passed on as it came: its type fingerprint is none the
+// handler decodes, so the handler refuses and counts it as malformed.
+inline const lcm::ReceiveBuffer* Unsealed(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
+                                          lcm::ReceiveBuffer* opened) {
+  if (!auth::IsSealed(rbuf->data, rbuf->data_size)) return rbuf;
+  const auto plain = auth::OpenSealed(rbuf->data, rbuf->data_size, channel);
+  if (!plain) return rbuf;
+  opened->data = const_cast<uint8_t*>(plain->data);
+  opened->data_size = static_cast<uint32_t>(plain->size);
+  opened->recv_utime = rbuf->recv_utime;
+  return opened;
+}
 
 template <auto Method>
 struct MemberHandler;
@@ -37,7 +55,8 @@ struct MemberHandler<Method> {
     return lcm->subscribeFunction(channel, &Call, self);
   }
   static void Call(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Class* self) {
-    (self->*Method)(rbuf, channel);
+    lcm::ReceiveBuffer opened{};
+    (self->*Method)(Unsealed(rbuf, channel, &opened), channel);
   }
 };
 
