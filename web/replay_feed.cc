@@ -9,6 +9,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/sealed_message.h"
 #include "json_writer.h"
 #include "message_json.h"
 #include "messages/validate.h"
@@ -34,14 +35,15 @@ bool Classify(const std::string& channel, FeedKind* kind, std::string* session) 
 }
 
 template <class Msg>
-bool Decode(const lcm::LogEvent& e, Msg* msg) {
-  return messages::DecodeAndValidate(e.data, e.datalen, msg, nullptr);
+bool Decode(auth::ByteView bytes, Msg* msg) {
+  return bytes.data != nullptr &&
+         messages::DecodeAndValidate(bytes.data, static_cast<int>(bytes.size), msg, nullptr);
 }
 
-// Whether the decoded message of `e` is genuine (observer_check.h).
+// Whether the decoded message `bytes` on `channel` is genuine (observer_check.h).
 template <class Msg>
-bool Genuine(const lcm::LogEvent& e, const Msg& msg, const auth::PublicKey& server_key) {
-  return viewer::CheckObserved(e.data, static_cast<std::size_t>(e.datalen), e.channel, msg, server_key) ==
+bool Genuine(auth::ByteView bytes, const std::string& channel, const Msg& msg, const auth::PublicKey& server_key) {
+  return viewer::CheckObserved(bytes.data, bytes.size, channel, msg, server_key) ==
          viewer::ObserverVerdict::kAccepted;
 }
 
@@ -60,8 +62,8 @@ std::string FirstShapeSession(const std::string& path) {
 }  // namespace
 
 ReplayFeed::ReplayFeed(const std::string& path, const std::string& session,
-                       const auth::PublicKey& server_key, PublishFn publish)
-    : publish_(std::move(publish)), session_(session), server_key_(server_key) {
+                       const auth::PublicKey& server_key, const auth::SessionKey* read_key, PublishFn publish)
+    : publish_(std::move(publish)), session_(session), server_key_(server_key), read_key_(read_key) {
   if (session_.empty()) session_ = FirstShapeSession(path);
   lcm::LogFile log(path, "r");
   if (!log.good()) throw std::runtime_error("cannot read the log file " + path);
@@ -90,13 +92,22 @@ ReplayFeed::ReplayFeed(const std::string& path, const std::string& session,
   }
 }
 
+auth::ByteView ReplayFeed::Plain(const lcm::LogEvent& e) const {
+  const auto size = static_cast<std::size_t>(e.datalen);
+  if (!auth::IsSealed(e.data, size)) return {static_cast<const uint8_t*>(e.data), size};
+  if (read_key_ == nullptr) return {nullptr, 0};
+  return auth::OpenSealedWith(*read_key_, e.data, size, e.channel).value_or(auth::ByteView{nullptr, 0});
+}
+
 std::string ReplayFeed::Vet(const lcm::LogEvent& e, FeedKind kind, int64_t t_us, bool* skip) {
+  // The opened bytes live in this thread's buffer until the next OpenSealedWith: used here only.
+  const auth::ByteView bytes = Plain(e);
   const auto vet = [&](auto* m) -> bool {
-    if (!Decode(e, m)) {
+    if (!Decode(bytes, m)) {
       counts_.malformed++;
       return false;
     }
-    if (!Genuine(e, *m, server_key_)) {
+    if (!Genuine(bytes, e.channel, *m, server_key_)) {
       counts_.auth_rejected++;
       return false;
     }
@@ -111,7 +122,7 @@ std::string ReplayFeed::Vet(const lcm::LogEvent& e, FeedKind kind, int64_t t_us,
   }
   if (kind == FeedKind::kForceModel) {
     // Models the server did not sign are the device's, not the observers'.
-    *skip = viewer::SignaturesAbsent(e.data, static_cast<std::size_t>(e.datalen)) ||
+    *skip = (bytes.data != nullptr && viewer::SignaturesAbsent(bytes.data, bytes.size)) ||
             1e-6 * t_us - last_force_s_ < kForceModelMinIntervalS;
     force_model_t m;
     if (*skip || !vet(&m)) return "";

@@ -72,7 +72,8 @@ void OpenFeeds(asio::io_context& io, const WebOptions& o, Feeds* f) {
   const auth::PublicKey& server_key = f->keys->server_public_key();
   if (!o.log_path.empty()) {
     // The hub is set below, once it exists: the feed publishes to it.
-    f->replay = std::make_unique<ReplayFeed>(o.log_path, o.common.session, server_key, publish);
+    f->replay = std::make_unique<ReplayFeed>(o.log_path, o.common.session, server_key,
+                                             &f->keys->read_key(), publish);
     f->hub = std::make_shared<Hub>(io, "replay", f->replay->session(), [f] { return f->replay->counts(); });
     f->hub->SetCommandHandler([f](const std::string& c) { return f->replay->Command(c); });
     const ReplayPosition p = f->replay->position();

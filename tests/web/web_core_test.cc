@@ -16,6 +16,7 @@
 #include "auth/credential.h"
 #include "auth/key_set.h"
 #include "auth/message_mac.h"
+#include "auth/sealed_message.h"
 #include "client_pacer.h"
 #include "json_writer.h"
 #include "message_json.h"
@@ -182,17 +183,20 @@ std::vector<uint8_t> Signed(Msg msg, const std::string& channel, int64_t seq, co
 
 // A log of `shapes` shapes of session S 10 ms apart signed by keys.server, with a status,
 // a shape of another session, a malformed shape, a shape signed by another session's
-// server and a force model the server did not sign mixed in.
-std::string WriteLog(const std::string& dir, int shapes, const LogKeys& keys) {
+// server and a force model the server did not sign mixed in. `sealed`: every message as
+// the sealed_t envelope a session run with --encrypt publishes (and the logger records).
+std::string WriteLog(const std::string& dir, int shapes, const LogKeys& keys, bool sealed = false) {
   const std::string path = dir + "/session.lcmlog";
   lcm::LogFile log(path, "w");
+  if (sealed) auth::SetSealing(keys.server.read_key(), nullptr, true);
   auto write = [&](const std::string& channel, const std::vector<uint8_t>& bytes, int64_t t_us) {
+    const auth::ByteView out = auth::SealForChannel(auth::ByteView{bytes.data(), bytes.size()}, channel);
     lcm::LogEvent e;
     e.eventnum = 0;
     e.timestamp = 1'000'000 + t_us;
     e.channel = channel;
-    e.datalen = static_cast<int32_t>(bytes.size());
-    e.data = const_cast<uint8_t*>(bytes.data());
+    e.datalen = static_cast<int32_t>(out.size);
+    e.data = const_cast<uint8_t*>(out.data);
     log.writeEvent(&e);
   };
   write("S_SOLVER_STATUS", Signed(test_support::Sample<solver_status_t>(), "S_SOLVER_STATUS", 1, keys.server), 0);
@@ -208,6 +212,7 @@ std::string WriteLog(const std::string& dir, int shapes, const LogKeys& keys) {
       write("S_FORCE_MODEL", test_support::Encode(test_support::Sample<force_model_t>()), 10'000 * i + 4);
     }
   }
+  auth::ClearSealing();
   return path;
 }
 
@@ -234,7 +239,7 @@ TEST(ReplayFeed, PlaysTheSessionToItsLastShapeAndSeeksBack) {
   const LogKeys keys;
   const std::string path = WriteLog(dir.path(), 20, keys);
   Received received;
-  ReplayFeed replay(path, "", keys.observer.server_public_key(),
+  ReplayFeed replay(path, "", keys.observer.server_public_key(), &keys.observer.read_key(),
                     [&](FeedKind k, Text t) { received.Add(k, std::move(t)); });
   EXPECT_EQ(replay.session(), "S");
   EXPECT_EQ(replay.counts().malformed, 1);
@@ -272,8 +277,9 @@ TEST(ReplayFeed, RefusesALogWithoutShapes) {
   const LogKeys keys;
   const auth::PublicKey& server = keys.observer.server_public_key();
   const std::string path = WriteLog(dir.path(), 0, keys);
-  EXPECT_THROW(ReplayFeed(path, "", server, [](FeedKind, Text) {}), std::runtime_error);
-  EXPECT_THROW(ReplayFeed(dir.path() + "/missing.lcmlog", "", server, [](FeedKind, Text) {}), std::runtime_error);
+  EXPECT_THROW(ReplayFeed(path, "", server, nullptr, [](FeedKind, Text) {}), std::runtime_error);
+  EXPECT_THROW(ReplayFeed(dir.path() + "/missing.lcmlog", "", server, nullptr, [](FeedKind, Text) {}),
+               std::runtime_error);
 }
 
 // An observer credential of another session finds no genuine shape in the log: refused,
@@ -284,11 +290,35 @@ TEST(ReplayFeed, RefusesALogOfAnotherSessionsServer) {
   const LogKeys other;
   const std::string path = WriteLog(dir.path(), 5, keys);
   try {
-    ReplayFeed replay(path, "", other.observer.server_public_key(), [](FeedKind, Text) {});
+    ReplayFeed replay(path, "", other.observer.server_public_key(), &other.observer.read_key(),
+                      [](FeedKind, Text) {});
     ADD_FAILURE() << "a log of another server was replayed";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("refused"), std::string::npos) << e.what();
   }
+}
+
+// A log of a session run with --encrypt (sealed_t envelopes) reviewed with an observer
+// credential: opened with its read key, checked and played as a clear one; without the
+// read key nothing opens.
+TEST(ReplayFeed, OpensASealedLogWithTheObserversReadKey) {
+  test_support::ScopedTempDir dir("web-replay-sealed");
+  const LogKeys keys;
+  const std::string path = WriteLog(dir.path(), 10, keys, /*sealed=*/true);
+  {
+    lcm::LogFile log(path, "r");
+    const lcm::LogEvent* first = log.readNextEvent();
+    ASSERT_NE(first, nullptr);
+    EXPECT_TRUE(auth::IsSealed(first->data, static_cast<std::size_t>(first->datalen))) << "the log is sealed";
+  }
+  ReplayFeed replay(path, "", keys.observer.server_public_key(), &keys.observer.read_key(), [](FeedKind, Text) {});
+  EXPECT_EQ(replay.session(), "S");
+  EXPECT_EQ(replay.counts().received[Index(FeedKind::kShape)], 10);
+  EXPECT_EQ(replay.counts().received[Index(FeedKind::kSolverStatus)], 1);
+  EXPECT_EQ(replay.counts().auth_rejected, 1) << "the shape signed by another server";
+  EXPECT_EQ(replay.position().last_seq, 109);
+  EXPECT_THROW(ReplayFeed(path, "", keys.observer.server_public_key(), nullptr, [](FeedKind, Text) {}),
+               std::runtime_error);
 }
 
 }  // namespace
