@@ -5,6 +5,7 @@
 #include "auth/message_mac.h"
 #include "snapthread/device_state_t.hpp"
 #include "messages/channels.h"
+#include "messages/publish.h"
 #include "messages/pose_mapping.h"
 #include "realtime/clock.h"
 #include "messages/validate.h"
@@ -35,7 +36,8 @@ bool GraspPublisher::Publish(const Eigen::Vector3d& model_position, bool held) {
       !auth::Sign(&msg, channel_, epoch_ ? epoch_() : 0, auth_seq_.Next(), *tagger_)) {
     return false;
   }
-  return lcm_->publish(channel_, &msg) == 0;
+  // In clear, or sealed when the viewer runs with --encrypt.
+  return messages::Publish(lcm_, channel_, msg) == 0;
 }
 
 }  // namespace snapthread::viewer

@@ -18,6 +18,7 @@ void AddViewerFlags(CLI::App* app, snapthread::viewer::ViewerOptions* o) {
   common.session_from_environment = true;
   common.key_note = "; an observer credential (snapthread-keygen --role observer) or the root key; "
                     "--grasp-mode needs a device credential";
+  common.encrypt = true;  // what --grasp-mode publishes
   snapthread::app::AddCommonFlags(app, &o->common, common);
   app->add_option("--width", o->width, "window width, pixels")->capture_default_str()
       ->check(CLI::Range(64, 8192));
