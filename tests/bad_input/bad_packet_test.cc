@@ -250,9 +250,10 @@ TEST(BadPacketTest, ALiveServerRefusesAndCountsEveryBadPoseAndCommand) {
       {"pose NaN position", ch.device_state, [&] { return pose(nan_pose, epoch); }, "position"},
       {"pose zero quaternion", ch.device_state, [&] { return pose(zero_quaternion, epoch); }, "quaternion"},
       {"pose device_id 2 GB", ch.device_state, [&] { return HugeLength(pose(good, epoch), 24); }, "device_id"},
-      {"pose bad MAC", ch.device_state, [&] { return BadMac(pose(good, epoch)); }, "bad MAC"},
-      {"pose unsigned", ch.device_state, [&] { return Encode(good); }, "bad MAC"},
-      {"pose wrong epoch", ch.device_state, [&] { return pose(good, epoch ^ 0x5A5A); }, "foreign epoch"},
+      {"pose bad MAC", ch.device_state, [&] { return BadMac(pose(good, epoch)); }, "bad-mac"},
+      // No tag at all: the trailer's defaults claim the server's role, which sends no pose.
+      {"pose unsigned", ch.device_state, [&] { return Encode(good); }, "wrong-role"},
+      {"pose wrong epoch", ch.device_state, [&] { return pose(good, epoch ^ 0x5A5A); }, "foreign-epoch"},
       {"pose replayed", ch.device_state,
        [&] {
          replayed = pose(good, epoch);
@@ -260,12 +261,12 @@ TEST(BadPacketTest, ALiveServerRefusesAndCountsEveryBadPoseAndCommand) {
          std::this_thread::sleep_for(std::chrono::milliseconds(100));
          return replayed;
        },
-       "replayed"},
+       "replay"},
       {"command truncated", ch.command, [&] { return Truncated(command(kLoad, "zeeman", epoch)); }, "truncated"},
       {"command wrong fingerprint", ch.command, [&] { return WrongFingerprint(command(kLoad, "zeeman", epoch)); },
        "fingerprint"},
-      {"command bad MAC", ch.command, [&] { return BadMac(command(kLoad, "zeeman", epoch)); }, "bad MAC"},
-      {"command wrong epoch", ch.command, [&] { return command(kLoad, "zeeman", epoch + 1); }, "foreign epoch"},
+      {"command bad MAC", ch.command, [&] { return BadMac(command(kLoad, "zeeman", epoch)); }, "bad-mac"},
+      {"command wrong epoch", ch.command, [&] { return command(kLoad, "zeeman", epoch + 1); }, "foreign-epoch"},
       {"LOAD_SCENE /etc/passwd", ch.command, [&] { return command(kLoad, "/etc/passwd", epoch); },
        "path separator"},
       {"LOAD_SCENE /dev/zero", ch.command, [&] { return command(kLoad, "/dev/zero", epoch); }, "path separator"},

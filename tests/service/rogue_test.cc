@@ -163,7 +163,7 @@ TEST(RogueTest, NoKeyNoForceNoCommandsAndTheGenuineSessionStillWorks) {
   // 1. A genuine session, logged; its epoch (what the rogue replays) noted.
   int64_t logged_epoch = 0;
   {
-    Watcher recorded(session, &key_file.key());
+    Watcher recorded(session, key_file.key());
     ASSERT_TRUE(recorded.good());
     ChildProcess logger({SNAPTHREAD_LCM_LOGGER, "-q", "-c", session + "_.*",
                          std::string("--lcm-url=") + kUrl, "-f", log},
