@@ -35,12 +35,14 @@
 #include "auth/pose_echo_window.h"
 #include "auth/session_key.h"
 #include "auth/signature.h"
+#include "auth_gate_fuzzer.h"
 #include "messages/validate.h"
 #include "sample_messages.h"
 
 namespace {
 
 using namespace snapthread;
+using namespace snapthread::fuzz_gate;
 using auth::Reason;
 
 // ---------------------------------------------------------------- input
@@ -69,56 +71,6 @@ class Script {
   const uint8_t* end_;
 };
 
-// Operation codes (the first byte of each step, modulo kOpCount).
-enum Op : uint8_t {
-  kGenuine = 0,      // sign a message with the test key, offer it
-  kFlipped,          // sign, flip one byte, offer it
-  kWrongChannel,     // signed for another channel
-  kWrongKey,         // signed with another key
-  kReplay,           // offer an already admitted buffer again
-  kRaw,              // arbitrary bytes as a packet
-  kSetEpoch,         // the receiver's epoch changes
-  kRecordPose,       // the device sends a pose (PoseEchoWindow)
-  kForceModel,       // a signed force model through AdmitForceModel
-  kLogLine,          // TakeLogLine
-  kServerSigned,     // a status or reply signed by the server (or claiming another role), maybe flipped
-  kOpCount
-};
-
-// ---------------------------------------------------------------- keys and channels
-
-constexpr uint8_t kTestKey[32] = {0x73, 0x6e, 0x61, 0x70, 0x74, 0x68, 0x72, 0x65, 0x61, 0x64, 0x2d,
-                                  0x66, 0x75, 0x7a, 0x7a, 0x2d, 0x6b, 0x65, 0x79, 0x2d, 0x30, 0x31,
-                                  0x02, 0x03, 0x05, 0x07, 0x0b, 0x0d, 0x11, 0x13, 0x17, 0x1d};
-constexpr uint8_t kOtherKey[32] = {0x01};
-constexpr char kChannel[] = "FUZZ_GATE";
-constexpr char kOtherChannel[] = "FUZZ_GATE2";
-
-const auth::SessionKey& Key() {
-  static const auth::SessionKey key = (auth::InitSodium(), auth::SessionKey::FromBytes(kTestKey, 32));
-  return key;
-}
-const auth::SessionKey& OtherKey() {
-  static const auth::SessionKey key = (auth::InitSodium(), auth::SessionKey::FromBytes(kOtherKey, 32));
-  return key;
-}
-// The server's signing key (a fixed seed: the test key's bytes).
-const auth::Signer& ServerSigner() {
-  static const auth::Signer signer = (auth::InitSodium(), auth::Signer::FromSeed(kTestKey));
-  return signer;
-}
-
-// A device "hand" MACing with `key` (the test key, or another for kWrongKey).
-auth::Tagger MacTagger(const auth::SessionKey& key) {
-  auth::Tagger t;
-  t.role = auth::Role::kDevice;
-  t.name = "hand";
-  t.mac_key = &key;
-  return t;
-}
-
-// A few epochs, so scripts hit equal ones often; 0 is "none".
-constexpr int64_t kEpochs[] = {0x1111, 0x2222, 0, -5, INT64_MIN, INT64_MAX};
 
 [[noreturn]] void Fail(const char* what) {
   std::fprintf(stderr, "auth_gate_fuzzer: invariant broken: %s\n", what);
@@ -230,27 +182,6 @@ Msg Fill(Script& in) {
   return m;
 }
 
-struct Signed {
-  std::vector<uint8_t> bytes;
-  int64_t epoch = 0, seq = 0;
-};
-
-template <class Msg>
-bool SignInto(Msg* m, const char* channel, const auth::Tagger& tagger, int64_t epoch, int64_t seq, Signed* out) {
-  if (!auth::Sign(m, channel, epoch, seq, tagger)) return false;
-  out->bytes = test_support::Encode(*m);
-  out->epoch = epoch;
-  out->seq = seq;
-  return true;
-}
-template <class Msg>
-bool SignInto(Msg* m, const char* channel, const auth::SessionKey& key, int64_t epoch, int64_t seq, Signed* out) {
-  if (!auth::Sign(m, channel, epoch, seq, MacTagger(key))) return false;
-  out->bytes = test_support::Encode(*m);
-  out->epoch = epoch;
-  out->seq = seq;
-  return true;
-}
 
 // Counts the gate's decision in the model; an admitted buffer is remembered for replays.
 template <class Msg>
@@ -521,138 +452,6 @@ void Step(Script& in, State& st) {
     }
     default: break;
   }
-}
-
-// ---------------------------------------------------------------- seeds
-
-// Scripts that reach every operation, some of them with genuinely signed packets as raw
-// bytes (so mutations start past the MAC).
-void WriteSeeds(const std::string& dir) {
-  auto write = [&](const char* name, const std::vector<uint8_t>& bytes) {
-    std::ofstream(dir + "/" + name, std::ios::binary)
-        .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  };
-  auto le64 = [](std::vector<uint8_t>* v, int64_t x) {
-    for (int i = 0; i < 8; ++i) v->push_back(static_cast<uint8_t>(static_cast<uint64_t>(x) >> (8 * i)));
-  };
-  // Header: policy byte (even: kFixed), epoch choice byte (0: kEpochs[0]).
-  // Genuine: op, epoch choice (<128: own), seq choice, delta, type, utime(8), seq(8)[, command bytes].
-  std::vector<uint8_t> genuine = {0, 0};
-  for (int type = 0; type < 4; ++type)
-    for (int k = 0; k < 3; ++k) {
-      genuine.insert(genuine.end(), {kGenuine, 0, 0, 0, static_cast<uint8_t>(type)});
-      le64(&genuine, 1700000000000000 + k);
-      if (type == 2) {
-        genuine.insert(genuine.end(), {5, 3});  // command_t: argument length, letter
-      } else {
-        le64(&genuine, k);  // seq
-      }
-      genuine.insert(genuine.end(), {kReplay, static_cast<uint8_t>(k)});
-    }
-  genuine.insert(genuine.end(), {kLogLine, 0x10, 0x27});
-  write("genuine_and_replays", genuine);
-
-  std::vector<uint8_t> flips = {1, 0};  // kAdopt
-  for (int k = 0; k < 8; ++k) {
-    flips.insert(flips.end(), {kFlipped, 0, 2, 7, static_cast<uint8_t>(k % 4)});
-    le64(&flips, 99);
-    if (k % 4 == 2) {
-      flips.insert(flips.end(), {5, 3});
-    } else {
-      le64(&flips, k);
-    }
-    flips.insert(flips.end(), {static_cast<uint8_t>(17 * k), 0, 1});
-    flips.insert(flips.end(), {kWrongKey, 0, 0, 0, 0});
-    le64(&flips, 1);
-    le64(&flips, 2);
-    flips.insert(flips.end(), {kWrongChannel, 0, 0, 0, 1});
-    le64(&flips, 1);
-    le64(&flips, 2);
-  }
-  write("flips_keys_channels", flips);
-
-  std::vector<uint8_t> models = {0, 0};
-  for (int k = 0; k < 6; ++k) {
-    // A pose (own epoch, next seq, utime), a model echoing it, a model echoing nothing
-    // with one byte flipped.
-    models.insert(models.end(), {kRecordPose, 0, 1});
-    le64(&models, 1000 * k);
-    models.insert(models.end(), {kForceModel});
-    le64(&models, 5);
-    le64(&models, k);
-    models.insert(models.end(), {0, 0, 0, 0, 0});
-    models.insert(models.end(), {kForceModel});
-    le64(&models, 5);
-    le64(&models, k);
-    models.push_back(2);
-    le64(&models, 77 + k);
-    le64(&models, 1000 * k);
-    models.insert(models.end(), {0, 0, 0, 230, 40, 0, 9});
-  }
-  models.insert(models.end(), {kSetEpoch, 130, kLogLine, 0xff, 0xff});
-  write("force_models_and_echoes", models);
-
-  // Raw: genuinely signed packets of each type as bytes (header kFixed at kEpochs[0]).
-  std::vector<uint8_t> raw = {0, 0};
-  int64_t seq = 1;
-  auto add_raw = [&](uint8_t type, std::vector<uint8_t> bytes) {
-    const auto size_lo = static_cast<uint8_t>(bytes.size() & 0xff);
-    const auto size_hi = static_cast<uint8_t>(bytes.size() >> 8);
-    raw.insert(raw.end(), {kRaw, type, size_lo, size_hi});
-    raw.insert(raw.end(), bytes.begin(), bytes.end());
-  };
-  {
-    auto m = test_support::Sample<device_state_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(0, s.bytes);
-  }
-  {
-    auto m = test_support::Sample<solver_status_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(1, s.bytes);
-  }
-  {
-    auto m = test_support::Sample<command_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(2, s.bytes);
-  }
-  {
-    auto m = test_support::Sample<force_model_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(3, s.bytes);
-  }
-  {
-    auto m = test_support::Sample<command_reply_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(4, s.bytes);
-  }
-  // What the server signs: a status and a reply.
-  auth::Tagger server;
-  server.signer = &ServerSigner();
-  {
-    auto m = test_support::Sample<solver_status_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, server, kEpochs[0], seq++, &s)) add_raw(5, s.bytes);
-  }
-  {
-    auto m = test_support::Sample<command_reply_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, server, kEpochs[0], seq++, &s)) add_raw(6, s.bytes);
-  }
-  raw.insert(raw.end(), {kReplay, 0, kReplay, 1, kLogLine, 1, 0});
-  write("raw_signed_packets", raw);
-
-  // Server-signed steps: own epoch, next seq, each way of tagging, flipped or not, status
-  // or reply: how, then utime(8), seq(8), flip position(2), xor.
-  std::vector<uint8_t> signed_steps = {1, 0};  // kAdopt
-  for (int k = 0; k < 16; ++k) {
-    const auto how = static_cast<uint8_t>((k % 4) | (k & 4 ? 0x40 : 0) | (k & 8 ? 0x80 : 0));
-    signed_steps.insert(signed_steps.end(), {kServerSigned, 0, 0, 0, how});
-    le64(&signed_steps, 1700000000000000 + k);
-    le64(&signed_steps, k);
-    signed_steps.insert(signed_steps.end(), {static_cast<uint8_t>(13 * k), 0, 1});
-  }
-  write("server_signed", signed_steps);
 }
 
 }  // namespace
