@@ -1,10 +1,11 @@
 // The session key file as an attacker with a local account would plant it, against the
-// real binaries that take a key (server, device, viewer, web, scene-shape): a missing
+// real binaries that take a key (server, device, viewer, web, scene-shape, ctl): a missing
 // file (a typo must not make a new key), a symbolic link, a file owned by another user, a
 // directory others may write, a key others may read. Each binary must refuse to start,
 // exit non-zero within seconds, and name the file and the fix; nothing is created.
 // Also: only snapthread-server --create-key makes a missing key, and not in such a
-// directory.
+// directory; and every binary given a credential of a role it does not play refuses to
+// start, naming the role it needs.
 #include <gtest/gtest.h>
 
 #include <pwd.h>
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,24 @@ std::vector<Binary> KeyTakers() {
       {"snapthread-scene-shape",
        {"--scene", scene, "--steps", "2", "--session", session, "--lcm-url", url, "--duration",
         "1"}},
+      {"snapthread-ctl", {"--session", session, "--lcm-url", url, "--timeout-s", "1", "status"}},
+  };
+}
+
+// The key takers by the role each plays, and the words its refusal of another role's
+// credential must contain.
+struct RolePlayer {
+  std::string binary;
+  std::vector<std::string> refused_roles;  // credentials it must refuse
+  std::string needs;                       // named in the refusal
+};
+std::vector<RolePlayer> RolePlayers() {
+  return {
+      {"snapthread-server", {"observer", "device", "operator"}, "root key"},
+      {"snapthread-device", {"observer", "operator"}, "device"},
+      {"snapthread-viewer", {"device", "operator"}, "observer"},
+      {"snapthread-web", {"device", "operator"}, "observer"},
+      {"snapthread-ctl", {"observer", "device"}, "operator"},
   };
 }
 
@@ -168,6 +188,47 @@ TEST(KeyRefusalAttackTest, EveryBinaryRefusesAPlantedKeyNamingTheFix) {
   EXPECT_EQ(refused, static_cast<int>(Plants().size() * KeyTakers().size()));
 }
 
+// A credential of a role the binary does not play: it refuses to start within seconds,
+// naming the program and the role it needs; nothing listens or publishes.
+TEST(KeyRefusalAttackTest, EveryBinaryRefusesACredentialOfARoleItDoesNotPlay) {
+  const ScopedTempDir root("key_roles");
+  const std::string root_key = root.path() + "/root.key";
+  Outcome o = RunBinary({BinDir() + "/snapthread-keygen", "--key", root_key}, root.path() + "/keygen.txt");
+  ASSERT_EQ(o.code, 0) << o.output;
+  for (const std::string role : {"observer", "device", "operator"}) {
+    std::vector<std::string> argv = {BinDir() + "/snapthread-keygen", "--key", root_key, "--role", role,
+                                     "--out", root.path() + "/" + role + ".cred"};
+    if (role == "device") argv.insert(argv.end(), {"--device", "hand"});
+    o = RunBinary(argv, root.path() + "/keygen_" + role + ".txt");
+    ASSERT_EQ(o.code, 0) << role << "\n" << o.output;
+  }
+  std::map<std::string, std::vector<std::string>> args;
+  for (const Binary& b : KeyTakers()) args[b.name] = b.args;
+  // The viewer observes; with --grasp-mode it would drive a grasp as a device.
+  std::erase(args["snapthread-viewer"], std::string("--grasp-mode"));
+  int refused = 0;
+  for (const RolePlayer& p : RolePlayers()) {
+    if (!fs::exists(BinDir() + "/" + p.binary)) continue;  // a build without the GUI or web
+    for (const std::string& role : p.refused_roles) {
+      std::vector<std::string> argv = {BinDir() + "/" + p.binary};
+      argv.insert(argv.end(), args[p.binary].begin(), args[p.binary].end());
+      argv.insert(argv.end(), {"--key", root.path() + "/" + role + ".cred"});
+      o = RunBinary(argv, root.path() + "/" + p.binary + "_" + role + ".txt");
+      const std::string what = p.binary + " given the " + role + " credential";
+      if (!o.exited) {
+        ADD_FAILURE() << what << ": started (did not exit within 20 s)\n" << o.output;
+        continue;
+      }
+      EXPECT_NE(o.code, 0) << what << " started anyway\n" << o.output;
+      EXPECT_NE(o.output.find(p.needs), std::string::npos) << what << ": does not name \"" << p.needs << "\"\n"
+                                                           << o.output;
+      EXPECT_NE(o.output.find(p.binary), std::string::npos) << what << "\n" << o.output;
+      ++refused;
+    }
+  }
+  EXPECT_GE(refused, 7);  // server, device and ctl at least
+}
+
 // SNAPTHREAD_KEY_FILE naming a missing file is refused the same way, and names the variable.
 TEST(KeyRefusalAttackTest, MissingKeyFromTheEnvironmentIsRefused) {
   const ScopedTempDir root("key_refusal_env");
@@ -212,7 +273,10 @@ TEST(KeyRefusalAttackTest, OnlyCreateKeyMakesAKeyAndNotInAWritableDirectory) {
   ASSERT_EQ(stat(key.c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 07777, 0600u);
   EXPECT_EQ(st.st_size, 32);
-  EXPECT_NE(o.output.find("created a new session key " + key), std::string::npos) << o.output;
+  // "created a new session key FILE" before the roles, "created a new root key FILE" with them.
+  EXPECT_TRUE(o.output.find("created a new session key " + key) != std::string::npos ||
+              o.output.find("created a new root key " + key) != std::string::npos)
+      << o.output;
   // The same server without --create-key now loads it.
   o = RunBinary(server, root.path() + "/load.txt");
   EXPECT_EQ(o.code, 0) << o.output;

@@ -7,7 +7,7 @@ snapthread_add_test(device_key_refusal_test
   LABELS attack
   TIMEOUT 300)
 foreach(binary snapthread-server snapthread-device snapthread-viewer snapthread-web
-               snapthread-scene-shape)
+               snapthread-scene-shape snapthread-ctl snapthread-keygen)
   if(TARGET ${binary})
     add_dependencies(device_key_refusal_test ${binary})
   endif()

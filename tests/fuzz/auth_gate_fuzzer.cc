@@ -1,10 +1,13 @@
 // libFuzzer target: the receive-side authentication gate (common/auth, docs/security.md).
 // The input is a script read front to back: a filter set-up, then operations that feed the
-// gate genuinely signed messages (a fixed test key, so the fuzzer gets past the MAC into
-// the freshness logic), the same with one byte flipped, signed for another channel or
-// with another key, replays of admitted buffers, raw bytes as a packet, new epochs, pose
-// echoes for force models and log lines. Each operation checks what the gate must do:
-//   * a message whose bytes differ from what the key holder signed is never admitted;
+// gate genuinely tagged messages (a fixed test device key for MACs and a fixed server
+// signing key, so the fuzzer gets past the tag into the freshness logic), the same with
+// one byte flipped, tagged for another channel or with another key, messages the server
+// signs (statuses, command replies: AdmitSigned), replays of admitted buffers, raw bytes
+// as a packet, new epochs, pose echoes for force models and log lines. Each operation
+// checks what the gate must do:
+//   * a message whose bytes differ from what the key holder tagged is never admitted;
+//   * a signed message is admitted only with the server's signature and role;
 //   * a buffer admitted once is never admitted again (while the receiver's epoch stays);
 //   * the decision equals the one freshness_filter.h specifies (epoch policy, strictly
 //     increasing auth_seq), computed here by an independent model;
@@ -31,12 +34,15 @@
 #include "auth/message_mac.h"
 #include "auth/pose_echo_window.h"
 #include "auth/session_key.h"
+#include "auth/signature.h"
+#include "auth_gate_fuzzer.h"
 #include "messages/validate.h"
 #include "sample_messages.h"
 
 namespace {
 
 using namespace snapthread;
+using namespace snapthread::fuzz_gate;
 using auth::Reason;
 
 // ---------------------------------------------------------------- input
@@ -65,41 +71,6 @@ class Script {
   const uint8_t* end_;
 };
 
-// Operation codes (the first byte of each step, modulo kOpCount).
-enum Op : uint8_t {
-  kGenuine = 0,      // sign a message with the test key, offer it
-  kFlipped,          // sign, flip one byte, offer it
-  kWrongChannel,     // signed for another channel
-  kWrongKey,         // signed with another key
-  kReplay,           // offer an already admitted buffer again
-  kRaw,              // arbitrary bytes as a packet
-  kSetEpoch,         // the receiver's epoch changes
-  kRecordPose,       // the device sends a pose (PoseEchoWindow)
-  kForceModel,       // a signed force model through AdmitForceModel
-  kLogLine,          // TakeLogLine
-  kOpCount
-};
-
-// ---------------------------------------------------------------- keys and channels
-
-constexpr uint8_t kTestKey[32] = {0x73, 0x6e, 0x61, 0x70, 0x74, 0x68, 0x72, 0x65, 0x61, 0x64, 0x2d,
-                                  0x66, 0x75, 0x7a, 0x7a, 0x2d, 0x6b, 0x65, 0x79, 0x2d, 0x30, 0x31,
-                                  0x02, 0x03, 0x05, 0x07, 0x0b, 0x0d, 0x11, 0x13, 0x17, 0x1d};
-constexpr uint8_t kOtherKey[32] = {0x01};
-constexpr char kChannel[] = "FUZZ_GATE";
-constexpr char kOtherChannel[] = "FUZZ_GATE2";
-
-const auth::SessionKey& Key() {
-  static const auth::SessionKey key = (auth::InitSodium(), auth::SessionKey::FromBytes(kTestKey, 32));
-  return key;
-}
-const auth::SessionKey& OtherKey() {
-  static const auth::SessionKey key = (auth::InitSodium(), auth::SessionKey::FromBytes(kOtherKey, 32));
-  return key;
-}
-
-// A few epochs, so scripts hit equal ones often; 0 is "none".
-constexpr int64_t kEpochs[] = {0x1111, 0x2222, 0, -5, INT64_MIN, INT64_MAX};
 
 [[noreturn]] void Fail(const char* what) {
   std::fprintf(stderr, "auth_gate_fuzzer: invariant broken: %s\n", what);
@@ -211,36 +182,10 @@ Msg Fill(Script& in) {
   return m;
 }
 
-struct Signed {
-  std::vector<uint8_t> bytes;
-  int64_t epoch = 0, seq = 0;
-};
 
+// Counts the gate's decision in the model; an admitted buffer is remembered for replays.
 template <class Msg>
-bool SignInto(Msg* m, const char* channel, const auth::SessionKey& key, int64_t epoch, int64_t seq, Signed* out) {
-  if (!auth::Sign(m, channel, epoch, seq, key)) return false;
-  out->bytes = test_support::Encode(*m);
-  out->epoch = epoch;
-  out->seq = seq;
-  return true;
-}
-
-// What a receiver does with a packet on kChannel: exact decode (else dropped before the
-// gate, as messages::DecodeAndValidate refuses it), then Admit. *offered says whether the
-// gate saw it; the model's expectation is checked and applied.
-template <class Msg>
-Reason Offer(State& st, const std::vector<uint8_t>& bytes, bool* offered) {
-  Msg decoded;
-  *offered = messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &decoded, nullptr);
-  if (!*offered) {
-    // Never handed to the gate; the MAC check must still be safe on any bytes.
-    (void)auth::VerifyEncoded(bytes.data(), bytes.size(), kChannel, Key());
-    return Reason::kBadMac;
-  }
-  const bool mac_ok = auth::VerifyEncoded(bytes.data(), bytes.size(), kChannel, Key());
-  const Reason expected = mac_ok ? st.model.Check(decoded.epoch, decoded.auth_seq) : Reason::kBadMac;
-  const Reason got = auth::Admit(bytes.data(), bytes.size(), decoded, kChannel, Key(), &st.filter);
-  REQUIRE(got == expected);
+Reason Apply(State& st, Reason got, const Msg& decoded, const std::vector<uint8_t>& bytes) {
   ++st.model.counts[static_cast<int>(got)];
   if (got == Reason::kAccepted) {
     st.model.Admit(decoded.epoch, decoded.auth_seq);
@@ -251,13 +196,49 @@ Reason Offer(State& st, const std::vector<uint8_t>& bytes, bool* offered) {
   return got;
 }
 
+// What a receiver does with a packet on kChannel: exact decode (else dropped before the
+// gate, as messages::DecodeAndValidate refuses it), then Admit. *offered says whether the
+// gate saw it; the model's expectation is checked and applied.
+template <class Msg>
+Reason Offer(State& st, const std::vector<uint8_t>& bytes, bool* offered) {
+  Msg decoded;
+  *offered = messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &decoded, nullptr);
+  if (!*offered) {
+    // Never handed to the gate; the tag checks must still be safe on any bytes.
+    (void)auth::VerifyMac(bytes.data(), bytes.size(), kChannel, Key());
+    (void)auth::VerifySignature(bytes.data(), bytes.size(), kChannel, ServerSigner().public_key());
+    return Reason::kBadMac;
+  }
+  const bool mac_ok = auth::VerifyMac(bytes.data(), bytes.size(), kChannel, Key());
+  const Reason expected = mac_ok ? st.model.Check(decoded.epoch, decoded.auth_seq) : Reason::kBadMac;
+  const Reason got = auth::Admit(bytes.data(), bytes.size(), decoded, kChannel, Key(), &st.filter);
+  REQUIRE(got == expected);
+  return Apply(st, got, decoded, bytes);
+}
+
+// What the observers, the devices and snapthread-ctl do with a message the server signs:
+// exact decode, then AdmitSigned (the server's role and signature, then freshness).
+template <class Msg>
+Reason OfferSigned(State& st, const std::vector<uint8_t>& bytes, bool* offered) {
+  Msg decoded;
+  *offered = messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &decoded, nullptr);
+  if (!*offered) return Reason::kBadMac;
+  const bool sig_ok = decoded.sender_role == static_cast<int8_t>(auth::Role::kServer) &&
+                      auth::VerifySignature(bytes.data(), bytes.size(), kChannel, ServerSigner().public_key());
+  const Reason expected = sig_ok ? st.model.Check(decoded.epoch, decoded.auth_seq) : Reason::kBadMac;
+  const Reason got =
+      auth::AdmitSigned(bytes.data(), bytes.size(), decoded, kChannel, ServerSigner().public_key(), &st.filter);
+  REQUIRE(got == expected);
+  return Apply(st, got, decoded, bytes);
+}
+
 using OfferFn = Reason (*)(State&, const std::vector<uint8_t>&, bool*);
 
 // Signs a script-chosen message of a script-chosen type.
 bool MakeSigned(Script& in, State& st, const char* channel, const auth::SessionKey& key, Signed* out, OfferFn* offer) {
   const int64_t epoch = PickEpoch(in, st);
   const int64_t seq = PickSeq(in, st);
-  switch (in.U8() % 4) {
+  switch (in.U8() % 5) {
     case 0: {
       auto m = Fill<device_state_t>(in);
       *offer = &Offer<device_state_t>;
@@ -273,11 +254,54 @@ bool MakeSigned(Script& in, State& st, const char* channel, const auth::SessionK
       *offer = &Offer<command_t>;
       return SignInto(&m, channel, key, epoch, seq, out);
     }
-    default: {
+    case 3: {
       auto m = Fill<force_model_t>(in);
       *offer = &Offer<force_model_t>;
       return SignInto(&m, channel, key, epoch, seq, out);
     }
+    default: {
+      auto m = Fill<command_reply_t>(in);
+      *offer = &Offer<command_reply_t>;
+      return SignInto(&m, channel, key, epoch, seq, out);
+    }
+  }
+}
+
+// A status or a command reply tagged by the server's signer, or by a tagger claiming
+// another role or holding no signer; sometimes one byte flipped where the signature
+// covers it (outside signature2 and mac). Offered through AdmitSigned.
+void ServerSignedStep(Script& in, State& st) {
+  const int64_t epoch = PickEpoch(in, st);
+  const int64_t seq = PickSeq(in, st);
+  const uint8_t how = in.U8();
+  auth::Tagger tagger;
+  tagger.role = how % 8 == 1 ? auth::Role::kOperator : auth::Role::kServer;  // claims another role
+  tagger.signer = how % 8 == 2 ? nullptr : &ServerSigner();                   // 2: unsigned
+  if (how % 8 == 3) tagger.mac_key = &Key();                                  // a MAC instead
+  if (how % 8 == 3) tagger.signer = nullptr;
+  const bool reply = (how & 0x80) != 0;
+  Signed s;
+  OfferFn offer = nullptr;
+  if (reply) {
+    auto m = Fill<command_reply_t>(in);
+    offer = &OfferSigned<command_reply_t>;
+    if (!SignInto(&m, kChannel, tagger, epoch, seq, &s)) return;
+  } else {
+    auto m = Fill<solver_status_t>(in);
+    offer = &OfferSigned<solver_status_t>;
+    if (!SignInto(&m, kChannel, tagger, epoch, seq, &s)) return;
+  }
+  const bool flipped = (how & 0x40) != 0;
+  if (flipped) {
+    const size_t covered = s.bytes.size() - auth::kSignatureBytes - auth::kMacBytes;
+    s.bytes[in.U16() % covered] ^= static_cast<uint8_t>(1u + in.U8() % 255u);
+  }
+  bool offered = false;
+  const Reason got = offer(st, s.bytes, &offered);
+  if (how % 8 >= 1 && how % 8 <= 3) REQUIRE(got != Reason::kAccepted);  // not the server signing as itself
+  if (flipped) {
+    REQUIRE(!auth::VerifySignature(s.bytes.data(), s.bytes.size(), kChannel, ServerSigner().public_key()));
+    REQUIRE(got != Reason::kAccepted);
   }
 }
 
@@ -305,7 +329,7 @@ void ForceModelStep(Script& in, State& st) {
   if (flip >= 224) s.bytes[in.U16() % s.bytes.size()] ^= static_cast<uint8_t>(1u + in.U8() % 255u);
   force_model_t decoded;
   if (!messages::DecodeAndValidate(s.bytes.data(), static_cast<int>(s.bytes.size()), &decoded, nullptr)) return;
-  const bool mac_ok = auth::VerifyEncoded(s.bytes.data(), s.bytes.size(), kChannel, Key());
+  const bool mac_ok = auth::VerifyMac(s.bytes.data(), s.bytes.size(), kChannel, Key());
   const bool echoed = st.poses.Contains(decoded.epoch, decoded.device_seq, decoded.device_utime);
   // No false echo: the window only knows poses that were recorded.
   if (echoed) REQUIRE(st.recorded.count({decoded.epoch, decoded.device_seq, decoded.device_utime}) == 1);
@@ -350,7 +374,7 @@ void Step(Script& in, State& st) {
       const Reason got = offer(st, s.bytes, &offered);
       if (op != kGenuine) {
         // Any byte changed, another channel or another key: refused by the MAC.
-        REQUIRE(!auth::VerifyEncoded(s.bytes.data(), s.bytes.size(), kChannel, Key()));
+        REQUIRE(!auth::VerifyMac(s.bytes.data(), s.bytes.size(), kChannel, Key()));
         if (offered) REQUIRE(got == Reason::kBadMac);
       } else {
         REQUIRE(offered);  // a signed sample always decodes
@@ -369,6 +393,7 @@ void Step(Script& in, State& st) {
       if (!offered) got = Offer<solver_status_t>(st, bytes, &offered);
       if (!offered) got = Offer<command_t>(st, bytes, &offered);
       if (!offered) got = Offer<force_model_t>(st, bytes, &offered);
+      if (!offered) got = Offer<command_reply_t>(st, bytes, &offered);
       REQUIRE(offered);
       if (once) REQUIRE(got != Reason::kAccepted);
       break;
@@ -379,11 +404,14 @@ void Step(Script& in, State& st) {
       const uint8_t type = in.U8();
       const std::vector<uint8_t> bytes = in.Bytes(in.U16() % 4096);
       bool offered = false;
-      switch (type % 4) {
+      switch (type % 7) {
         case 0: Offer<device_state_t>(st, bytes, &offered); break;
         case 1: Offer<solver_status_t>(st, bytes, &offered); break;
         case 2: Offer<command_t>(st, bytes, &offered); break;
-        default: Offer<force_model_t>(st, bytes, &offered); break;
+        case 3: Offer<force_model_t>(st, bytes, &offered); break;
+        case 4: Offer<command_reply_t>(st, bytes, &offered); break;
+        case 5: OfferSigned<solver_status_t>(st, bytes, &offered); break;
+        default: OfferSigned<command_reply_t>(st, bytes, &offered); break;
       }
       break;
     }
@@ -407,6 +435,7 @@ void Step(Script& in, State& st) {
       break;
     }
     case kForceModel: ForceModelStep(in, st); break;
+    case kServerSigned: ServerSignedStep(in, st); break;
     case kLogLine: {
       st.now_us += in.U16();
       std::string line;
@@ -423,108 +452,6 @@ void Step(Script& in, State& st) {
     }
     default: break;
   }
-}
-
-// ---------------------------------------------------------------- seeds
-
-// Scripts that reach every operation, some of them with genuinely signed packets as raw
-// bytes (so mutations start past the MAC).
-void WriteSeeds(const std::string& dir) {
-  auto write = [&](const char* name, const std::vector<uint8_t>& bytes) {
-    std::ofstream(dir + "/" + name, std::ios::binary)
-        .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  };
-  auto le64 = [](std::vector<uint8_t>* v, int64_t x) {
-    for (int i = 0; i < 8; ++i) v->push_back(static_cast<uint8_t>(static_cast<uint64_t>(x) >> (8 * i)));
-  };
-  // Header: policy byte (even: kFixed), epoch choice byte (0: kEpochs[0]).
-  // Genuine: op, epoch choice (<128: own), seq choice, delta, type, utime(8), seq(8)[, command bytes].
-  std::vector<uint8_t> genuine = {0, 0};
-  for (int type = 0; type < 4; ++type)
-    for (int k = 0; k < 3; ++k) {
-      genuine.insert(genuine.end(), {kGenuine, 0, 0, 0, static_cast<uint8_t>(type)});
-      le64(&genuine, 1700000000000000 + k);
-      if (type == 2) {
-        genuine.insert(genuine.end(), {5, 3});  // command_t: argument length, letter
-      } else {
-        le64(&genuine, k);  // seq
-      }
-      genuine.insert(genuine.end(), {kReplay, static_cast<uint8_t>(k)});
-    }
-  genuine.insert(genuine.end(), {kLogLine, 0x10, 0x27});
-  write("genuine_and_replays", genuine);
-
-  std::vector<uint8_t> flips = {1, 0};  // kAdopt
-  for (int k = 0; k < 8; ++k) {
-    flips.insert(flips.end(), {kFlipped, 0, 2, 7, static_cast<uint8_t>(k % 4)});
-    le64(&flips, 99);
-    if (k % 4 == 2) {
-      flips.insert(flips.end(), {5, 3});
-    } else {
-      le64(&flips, k);
-    }
-    flips.insert(flips.end(), {static_cast<uint8_t>(17 * k), 0, 1});
-    flips.insert(flips.end(), {kWrongKey, 0, 0, 0, 0});
-    le64(&flips, 1);
-    le64(&flips, 2);
-    flips.insert(flips.end(), {kWrongChannel, 0, 0, 0, 1});
-    le64(&flips, 1);
-    le64(&flips, 2);
-  }
-  write("flips_keys_channels", flips);
-
-  std::vector<uint8_t> models = {0, 0};
-  for (int k = 0; k < 6; ++k) {
-    // A pose (own epoch, next seq, utime), a model echoing it, a model echoing nothing
-    // with one byte flipped.
-    models.insert(models.end(), {kRecordPose, 0, 1});
-    le64(&models, 1000 * k);
-    models.insert(models.end(), {kForceModel});
-    le64(&models, 5);
-    le64(&models, k);
-    models.insert(models.end(), {0, 0, 0, 0, 0});
-    models.insert(models.end(), {kForceModel});
-    le64(&models, 5);
-    le64(&models, k);
-    models.push_back(2);
-    le64(&models, 77 + k);
-    le64(&models, 1000 * k);
-    models.insert(models.end(), {0, 0, 0, 230, 40, 0, 9});
-  }
-  models.insert(models.end(), {kSetEpoch, 130, kLogLine, 0xff, 0xff});
-  write("force_models_and_echoes", models);
-
-  // Raw: genuinely signed packets of each type as bytes (header kFixed at kEpochs[0]).
-  std::vector<uint8_t> raw = {0, 0};
-  int64_t seq = 1;
-  auto add_raw = [&](uint8_t type, std::vector<uint8_t> bytes) {
-    const auto size_lo = static_cast<uint8_t>(bytes.size() & 0xff);
-    const auto size_hi = static_cast<uint8_t>(bytes.size() >> 8);
-    raw.insert(raw.end(), {kRaw, type, size_lo, size_hi});
-    raw.insert(raw.end(), bytes.begin(), bytes.end());
-  };
-  {
-    auto m = test_support::Sample<device_state_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(0, s.bytes);
-  }
-  {
-    auto m = test_support::Sample<solver_status_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(1, s.bytes);
-  }
-  {
-    auto m = test_support::Sample<command_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(2, s.bytes);
-  }
-  {
-    auto m = test_support::Sample<force_model_t>();
-    Signed s;
-    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(3, s.bytes);
-  }
-  raw.insert(raw.end(), {kReplay, 0, kReplay, 1, kLogLine, 1, 0});
-  write("raw_signed_packets", raw);
 }
 
 }  // namespace
