@@ -1,7 +1,8 @@
-// The whole exchange over LCM memq://, with the auth room only: the device learns the
-// epoch from the server's signed status, its signed poses are answered by signed force
-// models, and a key-less attacker's forged, replayed and re-keyed messages are all
-// refused and counted (never handed on), while the genuine exchange keeps working.
+// The whole exchange over LCM memq://, with the auth room only and the roles' keys: the
+// device learns the epoch from the server's signed status, its poses (MAC, device key)
+// are answered by force models MAC'd under its key, and a key-less attacker's, an
+// observer's (its read key) and another session's forged, replayed and re-keyed messages
+// are all refused and counted (never handed on), while the genuine exchange keeps working.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -11,6 +12,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "auth/freshness_filter.h"
+#include "auth/key_set.h"
 #include "auth/message_gate.h"
 #include "auth/message_mac.h"
 #include "auth/pose_echo_window.h"
@@ -28,6 +30,18 @@ const std::string kModel = "T_FORCE_MODEL";
 
 using Bytes = std::vector<uint8_t>;
 
+// How the server tags a force model for `device`: a MAC under the device's key, claiming
+// the server's role and naming the device.
+Tagger ModelTagger(const KeySet& device) {
+  Tagger t;
+  t.role = Role::kServer;
+  t.name = device.name();
+  t.expires_unix_s = device.expires_unix_s();
+  t.key_id = device.credential()->key_id;
+  t.mac_key = device.mac_key();
+  return t;
+}
+
 Bytes Copy(const lcm::ReceiveBuffer* rbuf) {
   const auto* p = static_cast<const uint8_t*>(rbuf->data);
   return Bytes(p, p + rbuf->data_size);
@@ -36,7 +50,7 @@ Bytes Copy(const lcm::ReceiveBuffer* rbuf) {
 // The device's receive side, as the device client will do it.
 class Device {
  public:
-  Device(lcm::LCM* lcm, const SessionKey* key) : lcm_(lcm), key_(key) {
+  Device(lcm::LCM* lcm, const KeySet* keys) : lcm_(lcm), keys_(keys) {
     messages::Subscribe<&Device::OnStatus>(lcm, kStatus, this);
     messages::Subscribe<&Device::OnModel>(lcm, kModel, this);
   }
@@ -44,7 +58,8 @@ class Device {
   void OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     solver_status_t msg;
     if (!messages::DecodeAndValidate(rbuf, &msg, nullptr)) return;
-    if (Admit(rbuf->data, rbuf->data_size, msg, channel, *key_, &status_filter_) == Reason::kAccepted) {
+    if (AdmitSigned(rbuf->data, rbuf->data_size, msg, channel, keys_->server_public_key(), &status_filter_) ==
+        Reason::kAccepted) {
       model_filter_.SetEpoch(status_filter_.epoch());
     }
   }
@@ -55,7 +70,7 @@ class Device {
       ++malformed_;
       return;
     }
-    if (AdmitForceModel(rbuf->data, rbuf->data_size, msg, channel, *key_, *sent_, &model_filter_) ==
+    if (AdmitForceModel(rbuf->data, rbuf->data_size, msg, channel, *keys_->mac_key(), *sent_, &model_filter_) ==
         Reason::kAccepted) {
       rendered_.push_back(msg.device_seq);
     }
@@ -66,7 +81,7 @@ class Device {
     pose.seq = ++pose_seq_;
     pose.utime = 1000 * pose.seq + 7;
     const int64_t epoch = status_filter_.epoch();
-    ASSERT_TRUE(Sign(&pose, kPose, epoch, seq_.Next(), *key_));
+    ASSERT_TRUE(Sign(&pose, kPose, epoch, seq_.Next(), keys_->tagger()));
     sent_->Record(epoch, pose.seq, pose.utime);
     lcm_->publish(kPose, &pose);
   }
@@ -83,16 +98,18 @@ class Device {
 
  private:
   lcm::LCM* lcm_;
-  const SessionKey* key_;
+  const KeySet* keys_;
   AuthSequence seq_;
 };
 
 // The server's side: answers every admitted pose with a signed model echoing it.
 class Server {
  public:
-  Server(lcm::LCM* lcm, const SessionKey* key)
+  // `server` signs statuses; `device` is the one device it answers (its MAC key).
+  Server(lcm::LCM* lcm, const KeySet* server, const KeySet* device)
       : lcm_(lcm),
-        key_(key),
+        server_(server),
+        device_(device),
         subscription_(messages::Subscribe<&Server::OnPose>(lcm, kPose, this)) {}
   ~Server() { lcm_->unsubscribe(subscription_); }
   Server(const Server&) = delete;
@@ -101,20 +118,21 @@ class Server {
   void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     device_state_t pose;
     if (!messages::DecodeAndValidate(rbuf, &pose, nullptr)) return;
-    if (Admit(rbuf->data, rbuf->data_size, pose, channel, *key_, &pose_filter_) != Reason::kAccepted) {
+    if (Admit(rbuf->data, rbuf->data_size, pose, channel, *device_->mac_key(), &pose_filter_) != Reason::kAccepted ||
+        pose.sender_role != static_cast<int8_t>(Role::kDevice) || pose.sender_name != device_->name()) {
       return;
     }
     force_model_t m = test_support::Sample<force_model_t>();
     m.device_seq = pose.seq;
     m.device_utime = pose.utime;
-    ASSERT_TRUE(Sign(&m, kModel, epoch_, seq_.Next(), *key_));
+    ASSERT_TRUE(Sign(&m, kModel, epoch_, seq_.Next(), ModelTagger(*device_)));
     lcm_->publish(kModel, &m);
     ++answered_;
   }
 
   void SendStatus() {
     solver_status_t s = test_support::Sample<solver_status_t>();
-    ASSERT_TRUE(Sign(&s, kStatus, epoch_, seq_.Next(), *key_));
+    ASSERT_TRUE(Sign(&s, kStatus, epoch_, seq_.Next(), server_->tagger()));
     lcm_->publish(kStatus, &s);
   }
 
@@ -124,7 +142,8 @@ class Server {
 
  private:
   lcm::LCM* lcm_;
-  const SessionKey* key_;
+  const KeySet* server_;
+  const KeySet* device_;
   lcm::Subscription* subscription_;
   AuthSequence seq_;
 };
@@ -145,12 +164,14 @@ void Drain(lcm::LCM* lcm) {
 TEST(AuthOverMemqTest, ForgedReplayedAndRekeyedMessagesAreRefusedAndCounted) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  const SessionKey key = SessionKey::Generate();
+  const SessionKey root = SessionKey::Generate();
+  const KeySet server_keys = KeySet::ForRole(root, Role::kServer);
+  const KeySet device_keys = KeySet::ForRole(root, Role::kDevice, "hand");
   Recorder log;
   messages::Subscribe<&Recorder::OnAny>(lcm, kModel, &log);
   messages::Subscribe<&Recorder::OnAny>(lcm, kStatus, &log);
-  Device device(&lcm, &key);
-  auto server = std::make_unique<Server>(&lcm, &key);
+  Device device(&lcm, &device_keys);
+  auto server = std::make_unique<Server>(&lcm, &server_keys, &device_keys);
 
   // Before any status the device has no epoch: the server refuses its poses.
   device.SendPose();
@@ -179,38 +200,49 @@ TEST(AuthOverMemqTest, ForgedReplayedAndRekeyedMessagesAreRefusedAndCounted) {
     forged.auth_seq = INT64_MAX - i;
     lcm.publish(kModel, &forged);
   }
-  // 2. The same, signed with a key of the attacker's own.
-  const SessionKey rogue = SessionKey::Generate();
-  for (int i = 0; i < 10; ++i) {
+  // 2. The same, tagged as the server tags them by another session's root holder (its
+  //    key for a device "hand"), and by an observer of this session (the only secret it
+  //    holds: the read key).
+  const KeySet rogue_device = KeySet::ForRole(SessionKey::Generate(), Role::kDevice, "hand");
+  const KeySet observer = KeySet::ForRole(root, Role::kObserver);
+  Tagger observer_tagger;
+  observer_tagger.name = "hand";
+  observer_tagger.mac_key = &observer.read_key();
+  for (int i = 0; i < 20; ++i) {
     force_model_t forged = test_support::Sample<force_model_t>();
     forged.device_seq = device.pose_seq_;
     forged.device_utime = 1000 * device.pose_seq_ + 7;
-    ASSERT_TRUE(Sign(&forged, kModel, server->epoch_, INT64_MAX - i, rogue));
+    ASSERT_TRUE(Sign(&forged, kModel, server->epoch_, INT64_MAX - i,
+                     i < 10 ? ModelTagger(rogue_device) : observer_tagger));
     lcm.publish(kModel, &forged);
   }
   Drain(&lcm);
   // 3. The log of the models channel played back (lcm-logplayer): genuine and forged.
   const std::vector<Bytes> logged = log.models;
-  ASSERT_EQ(logged.size(), 80u);  // 20 genuine + 60 forged
+  ASSERT_EQ(logged.size(), 90u);  // 20 genuine + 70 forged
   for (const Bytes& b : logged) lcm.publish(kModel, b.data(), static_cast<unsigned>(b.size()));
-  // 4. Forged poses to the server (no key): never answered.
+  // 4. Forged poses to the server (no key; another session's device key): never answered.
   for (int i = 0; i < 30; ++i) {
     device_state_t pose = test_support::Sample<device_state_t>();
-    pose.epoch = server->epoch_;
-    pose.auth_seq = INT64_MAX - i;
+    if (i < 20) {
+      pose.epoch = server->epoch_;
+      pose.auth_seq = INT64_MAX - i;
+    } else {
+      ASSERT_TRUE(Sign(&pose, kPose, server->epoch_, INT64_MAX - i, rogue_device.tagger()));
+    }
     lcm.publish(kPose, &pose);
   }
   Drain(&lcm);
 
   EXPECT_EQ(device.rendered_.size(), 20u);  // nothing forged or replayed was accepted
-  EXPECT_EQ(device.model_filter_.rejected(Reason::kBadMac), 60u + 60u);  // + the replayed forgeries
+  EXPECT_EQ(device.model_filter_.rejected(Reason::kBadMac), 70u + 70u);  // + the replayed forgeries
   EXPECT_EQ(device.model_filter_.rejected(Reason::kStaleSequence), 20u);
-  EXPECT_EQ(device.models_rejected(), 140u);
+  EXPECT_EQ(device.models_rejected(), 160u);
   EXPECT_EQ(server->answered_, 20);
   EXPECT_EQ(server->pose_filter_.rejected(Reason::kBadMac), 30u);
   std::string line;
   ASSERT_TRUE(device.model_filter_.TakeLogLine(0, &line));
-  EXPECT_NE(line.find("T_FORCE_MODEL: 140 rejected (bad MAC 120, replayed or old sequence number 20)"),
+  EXPECT_NE(line.find("T_FORCE_MODEL: 160 rejected (bad MAC 140, replayed or old sequence number 20)"),
             std::string::npos)
       << line;
 
@@ -224,7 +256,7 @@ TEST(AuthOverMemqTest, ForgedReplayedAndRekeyedMessagesAreRefusedAndCounted) {
   const std::vector<Bytes> old_statuses = log.statuses;
   const std::vector<Bytes> old_models = log.models;
   server.reset();
-  server = std::make_unique<Server>(&lcm, &key);
+  server = std::make_unique<Server>(&lcm, &server_keys, &device_keys);
   server->SendStatus();
   Drain(&lcm);
   ASSERT_EQ(device.status_filter_.epoch(), server->epoch_);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "auth/freshness_filter.h"
+#include "auth/key_set.h"
 #include "auth/message_gate.h"
 #include "auth/message_mac.h"
 #include "auth/pose_echo_window.h"
@@ -183,10 +184,12 @@ TEST(PoseEchoWindowTest, ConcurrentReaderNeverSeesAPoseThatWasNotSent) {
 // ---- the receive gate ------------------------------------------------------------------
 
 TEST(MessageGateTest, AdmitCountsBadMacThenFreshness) {
-  const SessionKey key = SessionKey::Generate();
+  const SessionKey root = SessionKey::Generate();
+  const KeySet device = KeySet::ForRole(root, Role::kDevice, "hand");
+  const SessionKey& key = *device.mac_key();
   FreshnessFilter f("S_DEVICE_STATE", FreshnessFilter::EpochPolicy::kFixed, kEpoch);
   device_state_t pose = test_support::Sample<device_state_t>();
-  ASSERT_TRUE(Sign(&pose, "S_DEVICE_STATE", kEpoch, 7, key));
+  ASSERT_TRUE(Sign(&pose, "S_DEVICE_STATE", kEpoch, 7, device.tagger()));
   const auto bytes = test_support::Encode(pose);
   EXPECT_EQ(Admit(bytes.data(), bytes.size(), pose, "S_DEVICE_STATE", key, &f), Reason::kAccepted);
   EXPECT_EQ(Admit(bytes.data(), bytes.size(), pose, "S_DEVICE_STATE", key, &f),
@@ -195,24 +198,64 @@ TEST(MessageGateTest, AdmitCountsBadMacThenFreshness) {
   EXPECT_EQ(f.accepted(), 1u);
   EXPECT_EQ(f.rejected(Reason::kBadMac), 1u);
   EXPECT_EQ(f.rejected(Reason::kStaleSequence), 1u);
+  // The root key itself, or another device's key, is not this device's key.
+  EXPECT_EQ(Admit(bytes.data(), bytes.size(), pose, "S_DEVICE_STATE", root, &f), Reason::kBadMac);
+  const KeySet other = KeySet::ForRole(root, Role::kDevice, "left");
+  EXPECT_EQ(Admit(bytes.data(), bytes.size(), pose, "S_DEVICE_STATE", *other.mac_key(), &f), Reason::kBadMac);
+  EXPECT_EQ(f.rejected(Reason::kBadMac), 3u);
+}
+
+TEST(MessageGateTest, AdmitSignedNeedsTheServerSignatureAndRole) {
+  const SessionKey root = SessionKey::Generate();
+  const KeySet server = KeySet::ForRole(root, Role::kServer);
+  const KeySet observer = KeySet::ForRole(root, Role::kObserver);
+  const KeySet op = KeySet::ForRole(root, Role::kOperator, "operator");
+  FreshnessFilter f("S_SOLVER_STATUS", FreshnessFilter::EpochPolicy::kAdopt);
+  solver_status_t status = test_support::Sample<solver_status_t>();
+  ASSERT_TRUE(Sign(&status, "S_SOLVER_STATUS", kEpoch, 7, server.tagger()));
+  auto bytes = test_support::Encode(status);
+  const PublicKey& pk = observer.server_public_key();
+  EXPECT_EQ(AdmitSigned(bytes.data(), bytes.size(), status, "S_SOLVER_STATUS", pk, &f), Reason::kAccepted);
+  EXPECT_EQ(AdmitSigned(bytes.data(), bytes.size(), status, "S_SOLVER_STATUS", pk, &f), Reason::kStaleSequence);
+  EXPECT_EQ(AdmitSigned(bytes.data(), bytes.size(), status, "S_SHAPE", pk, &f), Reason::kBadMac);
+  // A status claiming the server's role but MAC'd by an operator: no signature.
+  Tagger claims_server = op.tagger();
+  claims_server.role = Role::kServer;
+  ASSERT_TRUE(Sign(&status, "S_SOLVER_STATUS", kEpoch, 8, claims_server));
+  bytes = test_support::Encode(status);
+  EXPECT_EQ(AdmitSigned(bytes.data(), bytes.size(), status, "S_SOLVER_STATUS", pk, &f), Reason::kBadMac);
+  // Signed by the server's key but not claiming its role.
+  Tagger signed_as_device = server.tagger();
+  signed_as_device.role = Role::kDevice;
+  ASSERT_TRUE(Sign(&status, "S_SOLVER_STATUS", kEpoch, 9, signed_as_device));
+  bytes = test_support::Encode(status);
+  EXPECT_EQ(AdmitSigned(bytes.data(), bytes.size(), status, "S_SOLVER_STATUS", pk, &f), Reason::kBadMac);
+  EXPECT_EQ(f.accepted(), 1u);
+  EXPECT_EQ(f.rejected(Reason::kBadMac), 3u);
 }
 
 TEST(MessageGateTest, ForceModelMustEchoASentPoseAndARefusalKeepsTheFloor) {
-  const SessionKey key = SessionKey::Generate();
+  const SessionKey root = SessionKey::Generate();
+  const KeySet device = KeySet::ForRole(root, Role::kDevice, "hand");
+  const SessionKey& key = *device.mac_key();
+  Tagger model_tagger;  // the server's MAC under the device's key
+  model_tagger.name = "hand";
+  model_tagger.key_id = device.credential()->key_id;
+  model_tagger.mac_key = &key;
   auto sent = std::make_unique<PoseEchoWindow>();
   sent->Record(kEpoch, 41, 123456000);
   FreshnessFilter f("S_FORCE_MODEL", FreshnessFilter::EpochPolicy::kFixed, kEpoch);
 
   force_model_t unsent = test_support::Sample<force_model_t>();
   unsent.device_seq = 40;  // never sent
-  ASSERT_TRUE(Sign(&unsent, "S_FORCE_MODEL", kEpoch, 500, key));
+  ASSERT_TRUE(Sign(&unsent, "S_FORCE_MODEL", kEpoch, 500, model_tagger));
   auto bytes = test_support::Encode(unsent);
   EXPECT_EQ(AdmitForceModel(bytes.data(), bytes.size(), unsent, "S_FORCE_MODEL", key, *sent, &f),
             Reason::kUnsentPoseEcho);
   EXPECT_EQ(f.last_accepted_seq(), 0);
 
   force_model_t genuine = test_support::Sample<force_model_t>();  // echoes (41, 123456000)
-  ASSERT_TRUE(Sign(&genuine, "S_FORCE_MODEL", kEpoch, 400, key));
+  ASSERT_TRUE(Sign(&genuine, "S_FORCE_MODEL", kEpoch, 400, model_tagger));
   bytes = test_support::Encode(genuine);
   EXPECT_EQ(AdmitForceModel(bytes.data(), bytes.size(), genuine, "S_FORCE_MODEL", key, *sent, &f),
             Reason::kAccepted);

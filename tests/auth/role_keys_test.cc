@@ -24,6 +24,15 @@ std::string Bytes(const SessionKey& key) {
 std::string Bytes(const PublicKey& key) { return std::string(key.begin(), key.end()); }
 
 // The root as fixed bytes, so a failure is reproducible.
+// A device `name`'s tagger MACing with `key` (the genuine key or a forger's guess).
+Tagger DeviceMac(const char* name, const SessionKey& key) {
+  Tagger t;
+  t.role = Role::kDevice;
+  t.name = name;
+  t.mac_key = &key;
+  return t;
+}
+
 SessionKey FixedRoot(uint8_t fill) {
   uint8_t bytes[SessionKey::kBytes];
   for (std::size_t i = 0; i < sizeof bytes; ++i) bytes[i] = static_cast<uint8_t>(fill + 7 * i);
@@ -136,16 +145,16 @@ TEST(RoleKeysTest, AnObserverCredentialHoldsNoSecretThatSignsOrMacs) {
     forger.Sign(payload, sizeof payload, signature);
     EXPECT_FALSE(server.Verify(payload, sizeof payload, signature));
     const SessionKey forged_key = SessionKey::FromBytes(reinterpret_cast<const uint8_t*>(d.data()), 32);
-    ASSERT_TRUE(Sign(&pose, "SNAPTHREAD_DEVICE_STATE", 1, 1, forged_key));
+    ASSERT_TRUE(Sign(&pose, "SNAPTHREAD_DEVICE_STATE", 1, 1, DeviceMac("left", forged_key)));
     std::vector<uint8_t> bytes(static_cast<std::size_t>(pose.getEncodedSize()));
     pose.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-    EXPECT_FALSE(VerifyEncoded(bytes.data(), bytes.size(), "SNAPTHREAD_DEVICE_STATE", device_key));
+    EXPECT_FALSE(VerifyMac(bytes.data(), bytes.size(), "SNAPTHREAD_DEVICE_STATE", device_key));
   }
   // ... while the genuine device key does.
-  ASSERT_TRUE(Sign(&pose, "SNAPTHREAD_DEVICE_STATE", 1, 1, device_key));
+  ASSERT_TRUE(Sign(&pose, "SNAPTHREAD_DEVICE_STATE", 1, 1, DeviceMac("left", device_key)));
   std::vector<uint8_t> bytes(static_cast<std::size_t>(pose.getEncodedSize()));
   pose.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  EXPECT_TRUE(VerifyEncoded(bytes.data(), bytes.size(), "SNAPTHREAD_DEVICE_STATE", device_key));
+  EXPECT_TRUE(VerifyMac(bytes.data(), bytes.size(), "SNAPTHREAD_DEVICE_STATE", device_key));
 }
 
 TEST(RoleKeysTest, OneDevicesKeyDoesNotDriveAnotherGrasp) {
@@ -153,11 +162,11 @@ TEST(RoleKeysTest, OneDevicesKeyDoesNotDriveAnotherGrasp) {
   const SessionKey left = DeriveDeviceKey(root, "left", 0);
   const SessionKey right = DeriveDeviceKey(root, "right", 0);
   device_state_t pose = test_support::Sample<device_state_t>();
-  ASSERT_TRUE(Sign(&pose, "SNAPTHREAD_DEVICE_STATE_right", 1, 1, left));
+  ASSERT_TRUE(Sign(&pose, "SNAPTHREAD_DEVICE_STATE_right", 1, 1, DeviceMac("left", left)));
   std::vector<uint8_t> bytes(static_cast<std::size_t>(pose.getEncodedSize()));
   pose.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  EXPECT_FALSE(VerifyEncoded(bytes.data(), bytes.size(), "SNAPTHREAD_DEVICE_STATE_right", right));
-  EXPECT_TRUE(VerifyEncoded(bytes.data(), bytes.size(), "SNAPTHREAD_DEVICE_STATE_right", left));
+  EXPECT_FALSE(VerifyMac(bytes.data(), bytes.size(), "SNAPTHREAD_DEVICE_STATE_right", right));
+  EXPECT_TRUE(VerifyMac(bytes.data(), bytes.size(), "SNAPTHREAD_DEVICE_STATE_right", left));
 }
 
 TEST(RoleKeysTest, ADevicesSignerIsItsOwnAndReDerivableByTheServer) {

@@ -10,9 +10,22 @@
 
 namespace snapthread::ctl {
 
+namespace {
+
+// Whether a received status or reply comes from the server: signed by its key (either
+// slot, for a rotation's grace) and claiming the server's role.
+template <class Msg>
+bool FromServer(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const Msg& decoded,
+                const auth::KeySet& keys) {
+  return decoded.sender_role == static_cast<int8_t>(auth::Role::kServer) &&
+         auth::VerifySignature(rbuf->data, rbuf->data_size, channel, keys.server_public_key());
+}
+
+}  // namespace
+
 CommandClient::CommandClient(lcm::LCM* lcm, const messages::Channels& channels,
-                             const auth::SessionKey& key)
-    : lcm_(lcm), channels_(channels), key_(key) {
+                             const auth::KeySet& keys)
+    : lcm_(lcm), channels_(channels), keys_(keys) {
   status_sub_ = messages::Subscribe<&CommandClient::OnStatus>(lcm_, channels_.solver_status, this);
   reply_sub_ = messages::Subscribe<&CommandClient::OnReply>(lcm_, channels_.command_reply, this);
 }
@@ -26,7 +39,7 @@ void CommandClient::OnStatus(const lcm::ReceiveBuffer* rbuf, const std::string& 
   solver_status_t status;
   std::string why;
   if (!messages::DecodeAndValidate(rbuf, &status, &why) ||
-      !auth::VerifyEncoded(rbuf->data, rbuf->data_size, channel, key_) ||
+      !FromServer(rbuf, channel, status, keys_) ||
       status_filter_.Admit(status.epoch, status.auth_seq) != auth::Reason::kAccepted) {
     ++refused_statuses_;
     return;
@@ -39,7 +52,7 @@ void CommandClient::OnReply(const lcm::ReceiveBuffer* rbuf, const std::string& c
   command_reply_t reply;
   std::string why;
   if (!messages::DecodeAndValidate(rbuf, &reply, &why) ||
-      !auth::VerifyEncoded(rbuf->data, rbuf->data_size, channel, key_) ||
+      !FromServer(rbuf, channel, reply, keys_) ||
       reply.epoch != status_filter_.epoch()) {
     ++refused_replies_;
     return;
@@ -83,7 +96,7 @@ CommandOutcome CommandClient::Send(int8_t command, const std::string& argument,
   msg.command = command;
   msg.argument = argument;
   const int64_t seq = auth_seq_.Next();
-  if (!auth::Sign(&msg, channels_.command, status_filter_.epoch(), seq, key_) ||
+  if (!auth::Sign(&msg, channels_.command, status_filter_.epoch(), seq, keys_.tagger()) ||
       lcm_->publish(channels_.command, &msg) != 0) {
     out.kind = CommandOutcome::Kind::kNotSent;
     return out;

@@ -1,9 +1,10 @@
 // The operator's side of the COMMAND channel (docs/security.md): learns the server's
-// epoch from an authenticated SOLVER_STATUS, sends one command signed with the session
-// key under that epoch and a fresh auth_seq, and waits for the server's authenticated
-// COMMAND_REPLY that names this command's auth_seq. Nothing unauthenticated is used:
-// a status or reply whose MAC does not verify is counted and ignored, and no command is
-// sent before a verified status gave the epoch.
+// epoch from a SOLVER_STATUS signed by the server, sends one command tagged with the
+// operator's key (its MAC) under that epoch and a fresh auth_seq, and waits for the
+// server's signed COMMAND_REPLY that names this command's auth_seq. Nothing
+// unauthenticated is used: a status or reply whose server signature does not verify, or
+// that does not claim the server's role, is counted and ignored, and no command is sent
+// before a verified status gave the epoch.
 //
 // One thread: every call runs LCM's handlers on the calling thread.
 #pragma once
@@ -17,7 +18,7 @@
 
 #include "auth/freshness_filter.h"
 #include "auth/session_epoch.h"
-#include "auth/session_key.h"
+#include "auth/key_set.h"
 #include "messages/channels.h"
 #include "snapthread/command_reply_t.hpp"
 #include "snapthread/solver_status_t.hpp"
@@ -41,8 +42,9 @@ struct CommandOutcome {
 
 class CommandClient {
  public:
-  // lcm and key must outlive the client. Subscribes to SOLVER_STATUS and COMMAND_REPLY.
-  CommandClient(lcm::LCM* lcm, const messages::Channels& channels, const auth::SessionKey& key);
+  // lcm and keys (an operator's: keys.tagger() MACs) must outlive the client. Subscribes
+  // to SOLVER_STATUS and COMMAND_REPLY.
+  CommandClient(lcm::LCM* lcm, const messages::Channels& channels, const auth::KeySet& keys);
   ~CommandClient();
   CommandClient(const CommandClient&) = delete;
   CommandClient& operator=(const CommandClient&) = delete;
@@ -53,7 +55,7 @@ class CommandClient {
   // Sends command_t `command` with `argument` and waits for its reply (see above).
   CommandOutcome Send(int8_t command, const std::string& argument, Clock::time_point deadline);
 
-  // Statuses and replies refused (bad MAC, malformed, foreign epoch), for the diagnosis
+  // Statuses and replies refused (bad signature, malformed, foreign epoch), for the diagnosis
   // of a timeout: "another key?".
   uint64_t refused_statuses() const { return refused_statuses_; }
   uint64_t refused_replies() const { return refused_replies_; }
@@ -67,7 +69,7 @@ class CommandClient {
 
   lcm::LCM* lcm_;
   messages::Channels channels_;
-  const auth::SessionKey& key_;
+  const auth::KeySet& keys_;
   lcm::Subscription* status_sub_ = nullptr;
   lcm::Subscription* reply_sub_ = nullptr;
   // The server's statuses: the first verified one gives the epoch (kAdopt).

@@ -5,6 +5,8 @@
 //     reset             back to the scene's start state
 //     status            the server's scene, method, state, rates and refusals
 // Each waits for the server's authenticated answer and prints it.
+// --key: an operator credential, or the root key (acting as operator "operator"); any other
+// credential refuses to start (exit 1), naming the operator role.
 // Exit codes: 0 applied (status: printed); 1 the server refused (its reason on standard
 // error), or LCM / the key file failed; 2 bad arguments; 3 (app::kExitNoReply) no
 // authenticated answer within --timeout-s: no server on this session, another key, or a
@@ -31,6 +33,8 @@ namespace {
 
 using namespace snapthread;
 constexpr const char* kProgram = "snapthread-ctl";
+// The operator the server host's root key acts as.
+constexpr const char* kRootOperatorName = "operator";
 
 // What a timeout means, with the likeliest cause.
 std::string NoAnswer(const ctl::CommandClient& client, const std::string& what, double timeout_s) {
@@ -39,7 +43,7 @@ std::string NoAnswer(const ctl::CommandClient& client, const std::string& what, 
   std::string text = "no " + what + " within " + seconds + " s";
   if (client.refused_statuses() + client.refused_replies() > 0) {
     text += " (" + std::to_string(client.refused_statuses() + client.refused_replies()) +
-            " messages from the session failed authentication: is --key the server's key?)";
+            " messages from the session failed authentication: was --key issued by this session's root key?)";
   } else {
     text += " (is a server running on this --session and --lcm-url?)";
   }
@@ -90,8 +94,13 @@ int main(int argc, char** argv) {
   if (auto code = app::ParseCommandLine(cli, argc, argv, app::kExitUsage)) return *code;
   if (auto code = app::CheckCommonFlags(common, kProgram, app::kExitUsage)) return *code;
 
-  const std::optional<auth::SessionKey> key = app::LoadSessionKey(common, kProgram);
-  if (!key) return app::kExitFailure;
+  // The operator's credential, or the root key (the server host), acting as operator
+  // "operator"; any other credential is refused here, naming the operator role.
+  std::optional<auth::KeySet> keys = app::LoadKeySet(common, auth::Role::kOperator, kProgram);
+  if (!keys) return app::kExitFailure;
+  if (keys->role() == auth::Role::kServer) {
+    keys = auth::KeySet::ForRole(*keys->root(), auth::Role::kOperator, kRootOperatorName);
+  }
   const std::string url = app::LcmUrl(common);
   lcm::LCM lcm(url);
   if (!lcm.good()) {
@@ -99,7 +108,7 @@ int main(int argc, char** argv) {
                      "LCM failed to start on " + url + ": " + messages::LcmStartHint(url));
   }
   const messages::Channels channels(common.session);
-  ctl::CommandClient client(&lcm, channels, *key);
+  ctl::CommandClient client(&lcm, channels, *keys);
   const auto deadline = ctl::Clock::now() + std::chrono::duration_cast<ctl::Clock::duration>(
                                                 std::chrono::duration<double>(timeout_s));
   if (*status) {

@@ -53,7 +53,8 @@ std::string StatusText(const solver_status_t& s) {
          "method: " + EscapeForDisplay(s.method) + "\n" +
          "status: " + StatusName(s.status) + "\n" + numbers +
          "knot: " + knot + "\n" +
-         "contacts: " + std::to_string(s.contacts) + "\n";
+         "contacts: " + std::to_string(s.contacts) + "\n" +
+         "refusals: " + (s.refusals.empty() ? std::string("none") : EscapeForDisplay(s.refusals)) + "\n";
 }
 
 }  // namespace snapthread::ctl
