@@ -21,8 +21,8 @@ int64_t RealtimeMicros() {
 }  // namespace
 
 Forger::Forger(const std::string& session, const std::string& lcm_url, const auth::KeySet* keys,
-               bool commands)
-    : lcm_(lcm_url), channels_(session), keys_(keys), commands_(commands) {
+               ForgerPlan plan)
+    : lcm_(lcm_url), channels_(session), keys_(keys), plan_(plan) {
   messages::Subscribe<&Forger::OnDeviceState>(lcm_.lcm(), channels_.device_state, this);
   messages::Subscribe<&Forger::OnStatus>(lcm_.lcm(), channels_.solver_status, this);
   lcm_.Start();
@@ -145,7 +145,7 @@ void Forger::PublishSlow(int64_t i) {
     epoch = epoch_;
   }
   ForgerCounts sent;
-  if (commands_) {
+  if (plan_.commands) {
     command_t command = test_support::Sample<command_t>();
     static const int8_t kCommands[] = {command_t::LOAD_SCENE, command_t::SET_METHOD, command_t::RESET};
     static const char* const kArguments[] = {"zeeman", "newton", ""};
@@ -156,6 +156,11 @@ void Forger::PublishSlow(int64_t i) {
       lcm_.lcm().publish(channels_.command, &command);
       ++sent.commands;
     }
+  }
+  if (!plan_.views) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    sent_.commands += sent.commands;
+    return;
   }
   thread_shape_t shape = test_support::SampleShape(12);
   shape.scene = kForgedMarker;
@@ -191,8 +196,8 @@ void Forger::PublishSlow(int64_t i) {
 
 void Forger::Run() {
   for (int64_t i = 0; !stop_; ++i) {
-    PublishPose(i);
-    PublishModel(i);
+    if (plan_.poses) PublishPose(i);
+    if (plan_.models) PublishModel(i);
     if (i % 10 == 0) PublishSlow(i / 10);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }

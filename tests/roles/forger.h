@@ -25,12 +25,20 @@ struct ForgerCounts {
   int64_t poses = 0, models = 0, commands = 0, shapes = 0, statuses = 0, device_statuses = 0;
 };
 
+// What a forger sends. Commands off for a holder that may send them (an operator), whose
+// commands are no forgeries; only poses for a device's own stale credential.
+struct ForgerPlan {
+  bool poses = true;
+  bool models = true;
+  bool commands = true;
+  bool views = true;  // shapes, solver statuses, device statuses
+};
+
 class Forger {
  public:
-  // `keys` (nullptr: a forger holding nothing) must outlive the forger. `commands`: false
-  // for a holder that may send commands (an operator), whose commands are not forgeries.
+  // `keys` (nullptr: a forger holding nothing) must outlive the forger.
   Forger(const std::string& session, const std::string& lcm_url, const auth::KeySet* keys,
-         bool commands = true);
+         ForgerPlan plan = {});
   ~Forger();
   Forger(const Forger&) = delete;
   Forger& operator=(const Forger&) = delete;
@@ -57,7 +65,7 @@ class Forger {
   test_support::LcmThread lcm_;
   const messages::Channels channels_;
   const auth::KeySet* keys_;
-  const bool commands_;
+  const ForgerPlan plan_;
   std::mutex mutex_;
   int64_t epoch_ = 0;
   int64_t pose_seq_ = 0, pose_utime_ = 0, poses_heard_ = 0;

@@ -103,7 +103,7 @@ TEST_P(ForgerMatrixTest, NothingForgedIsAccepted) {
   device->Signal(SIGSTOP);
   std::this_thread::sleep_for(300ms);
   Forger forger(session_, test_support::kLoopbackLcmUrl, keys ? &*keys : nullptr,
-                /*commands=*/GetParam() != Holder::kOperator);
+                ForgerPlan{.commands = GetParam() != Holder::kOperator});
   const auto s0 = watch_->NextStatus(10);
   ASSERT_TRUE(s0);
   const ForgerCounts sent = Forge(&forger);

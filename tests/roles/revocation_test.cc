@@ -32,7 +32,7 @@ TEST_F(RevocationTest, RevokedDeviceIsRefusedFromItsNextPose) {
   ASSERT_TRUE(live);
   const auto live_status = watch_->NextStatus(10);
   ASSERT_TRUE(live_status);
-  EXPECT_EQ(Refusals(live_status->refusals, "device"), 0) << live_status->refusals;
+  EXPECT_EQ(Refusals(live_status->refusals, "device/revoked"), 0) << live_status->refusals;
 
   const test_support::ProcessResult revoked = Keygen({"--revoke", "hand"});
   ASSERT_EQ(revoked.exit_code, 0) << revoked.out << revoked.err;

@@ -18,7 +18,7 @@ using test_support::ProcessResult;
 
 class WrongCredentialTest : public RoleSessionTest {
  protected:
-  // Runs `program` with `key` and `args` and expects a non-zero exit whose output names `role`.
+  // Runs `program` with `key` and `args` and expects a non-zero exit whose output holds `role`.
   void ExpectRefused(const std::string& program, const std::string& key, const std::vector<std::string>& args,
                      const std::string& role) {
     std::vector<std::string> all{"--key", key, "--session", session_, "--lcm-url", test_support::kLoopbackLcmUrl};
@@ -40,15 +40,16 @@ TEST_F(WrongCredentialTest, EachProgramRefusesAnotherRolesCredential) {
   const std::vector<std::string> device_args{"--backend", "sim-path", "--scene",
                                              test_support::ScenePath("curve2d_snap.yaml"), "--duration", "20",
                                              "--no-rt"};
-  ExpectRefused("snapthread-server", observer, server_args, "root");
-  ExpectRefused("snapthread-server", device, server_args, "root");
-  ExpectRefused("snapthread-device", observer, device_args, "device");
-  ExpectRefused("snapthread-device", op, device_args, "device");
-  ExpectRefused("snapthread-ctl", device, {"--timeout-s", "5", "status"}, "operator");
-  ExpectRefused("snapthread-ctl", observer, {"--timeout-s", "5", "load-scene", "zeeman"}, "operator");
-  ExpectRefused("snapthread-viewer", device, {"--print-rates", "--duration-s", "20"}, "observer");
+  // The words name the role needed (the program's own name says "device" too).
+  ExpectRefused("snapthread-server", observer, server_args, "root key");
+  ExpectRefused("snapthread-server", device, server_args, "root key");
+  ExpectRefused("snapthread-device", observer, device_args, "device credential");
+  ExpectRefused("snapthread-device", op, device_args, "device credential");
+  ExpectRefused("snapthread-ctl", device, {"--timeout-s", "5", "status"}, "operator credential");
+  ExpectRefused("snapthread-ctl", observer, {"--timeout-s", "5", "load-scene", "zeeman"}, "operator credential");
+  ExpectRefused("snapthread-viewer", device, {"--print-rates", "--duration-s", "20"}, "observer credential");
 #ifdef SNAPTHREAD_ROLES_TEST_WEB
-  ExpectRefused("snapthread-web", device, {"--port", "0", "--duration-s", "20"}, "observer");
+  ExpectRefused("snapthread-web", device, {"--port", "0", "--duration-s", "20"}, "observer credential");
 #endif
 }
 
