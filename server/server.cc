@@ -6,6 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "auth/key_set.h"
 #include "auth/session_epoch.h"
 #include "lcm_server_transport.h"
 #include "messages/lcm_url.h"
@@ -16,11 +17,19 @@ namespace {
 
 constexpr int kReceiveTimeoutMs = 50;  // how long Stop() may wait for the receive thread
 
+// The root key of --key: made first with --create-key when missing. A credential file is
+// refused naming the root key as what the server needs (auth::LoadKeySet).
 auth::SessionKey LoadServerKey(const auth::KeyLocation& where, bool create, bool* created) {
-  if (!create) return auth::LoadKey(where);
-  auth::LoadedKey loaded = auth::LoadOrCreateKey(where);
-  *created = loaded.created;
-  return std::move(loaded.key);
+  if (create && !auth::LooksLikeCredential(where.path)) {
+    auth::LoadedKey loaded = auth::LoadOrCreateKey(where);
+    *created = loaded.created;
+    return std::move(loaded.key);
+  }
+  const auth::KeySet keys = auth::LoadKeySet(where.path, auth::Role::kServer, "snapthread-server");
+  if (keys.root() == nullptr) {
+    throw auth::KeyFileError(where.path + " is not the session's root key, which snapthread-server needs");
+  }
+  return auth::SessionKey::FromBytes(keys.root()->data(), auth::SessionKey::kBytes);
 }
 
 std::unique_ptr<ServerTransport> OwnLcmTransport(const ServerParams& params) {
@@ -45,6 +54,9 @@ Server::Server(const ServerParams& params, ServerTransport* transport,
       epoch_(auth::NewEpoch()) {
   std::string error;
   if (!params_.IsValid(&error)) throw std::invalid_argument(error);
+  keys_ = std::make_unique<ServerKeys>(key_location_.path,
+                                       auth::SessionKey::FromBytes(key_.data(), auth::SessionKey::kBytes),
+                                       params_.key_grace_s);
   channels_ = messages::Channels(params_.session);
   if (params_.scene_dir.empty()) params_.scene_dir = DefaultSceneDir();
   solve_loop_ = std::make_unique<SolveLoop>(params_, channels_, key_, epoch_, std::move(hooks),
@@ -52,8 +64,8 @@ Server::Server(const ServerParams& params, ServerTransport* transport,
   if (make_transport) owned_transport_ = make_transport(params_);
   transport_ = owned_transport_ ? owned_transport_.get() : transport;
   if (transport_ == nullptr) throw std::invalid_argument("the server needs a transport");
-  gate_ = std::make_unique<InboundGate>(channels_, key_, epoch_, &inbox_, &counters_);
-  publisher_ = std::make_unique<Publisher>(transport_, channels_, key_, epoch_, &counters_);
+  gate_ = std::make_unique<InboundGate>(channels_, keys_.get(), epoch_, &inbox_, &counters_);
+  publisher_ = std::make_unique<Publisher>(transport_, channels_, keys_.get(), epoch_, &counters_);
 }
 
 Server::~Server() { Stop(); }
@@ -66,12 +78,12 @@ void Server::Start() {
   solve_thread_ = std::thread([this] { solve_loop_->Run(&inbox_, publisher_.get()); });
   receive_thread_ = std::thread([this] { ReceiveLoop(); });
   spdlog::info("server: session {} on {}, {}", channels_.session, transport_->Describe(), serving);
-  spdlog::info("server: {} session key {} ({}), key id {}, epoch {:016x}",
+  spdlog::info("server: {} root key {} ({}), key id {}, epoch {:016x}",
                key_created_ ? "created a new" : "using the", key_location_.path,
                key_location_.origin, key_.Id(), static_cast<uint64_t>(epoch_));
   if (key_created_) {
-    spdlog::info("server: copy {} to every machine of the session (scp -p; mode 0600) and "
-                 "pass it with --key or SNAPTHREAD_KEY_FILE", key_location_.path);
+    spdlog::info("server: keep {} on this host only; issue each machine its role's credential "
+                 "(snapthread-keygen --role ROLE --key {} --out FILE)", key_location_.path, key_location_.path);
   }
 }
 
@@ -84,8 +96,14 @@ void Server::Stop() {
   solve_loop_->Finish();
 }
 
+void Server::RequestReload() { reload_requested_.store(true, std::memory_order_release); }
+
+int64_t Server::key_reloads() const { return keys_->reloads(); }
+
 void Server::ReceiveLoop() {
   while (!stop_.load()) {
+    // A reload is applied here, between two receives: the ring belongs to this thread.
+    if (reload_requested_.exchange(false, std::memory_order_acq_rel)) keys_->Reload(UnixSeconds());
     if (transport_->Receive(kReceiveTimeoutMs, gate_.get()) < 0) {
       // A transport error (socket gone): do not spin on it.
       std::this_thread::sleep_for(std::chrono::milliseconds(10));

@@ -36,6 +36,7 @@
 #include "messages/channels.h"
 #include "publisher.h"
 #include "server_inbox.h"
+#include "server_keys.h"
 #include "server_params.h"
 #include "server_stats.h"
 #include "server_transport.h"
@@ -46,7 +47,9 @@ namespace snapthread::server {
 class Server {
  public:
   // Validates params (std::invalid_argument naming the flag), loads or creates the
-  // session key (auth::KeyFileError naming the file and the fix), loads the scene
+  // root key (auth::KeyFileError naming the file and the fix; auth::CredentialError for a
+  // role's credential, naming the root key as what the server needs), FILE.previous and
+  // FILE.revoked (ServerKeys), loads the scene
   // (SceneError), prepares --state-dir (CheckpointIoError) and resets the tracker at the
   // scene's grasp_start (or resumes a checkpoint). Then opens its own LCM transport on
   // ResolveLcmUrl(params.lcm_url) (LcmInitError when it does not start).
@@ -62,6 +65,11 @@ class Server {
   // Stops and joins both threads, writes the last checkpoint. Idempotent; called by the
   // destructor.
   void Stop();
+  // Asks the receive thread to reload the keys (ServerKeys::Reload: the root file, a
+  // rotation, FILE.revoked) before its next receive (SIGHUP). Any thread.
+  void RequestReload();
+  // Reloads done since the start (a test waits for its request to be applied).
+  int64_t key_reloads() const;
 
   ServerStats Stats() const;
   // {"updates": ..., "update_rate_hz": ..., "solve_us_p50": ..., "solve_us_p99": ...,
@@ -72,7 +80,8 @@ class Server {
 
   const messages::Channels& channels() const { return channels_; }
   const ServerParams& params() const { return params_; }
-  // This start's session epoch (new at each construction) and the key in use.
+  // This start's session epoch (new at each construction) and the root key loaded at the
+  // start (checkpoints are MACed with it).
   int64_t epoch() const { return epoch_; }
   const auth::SessionKey& key() const { return key_; }
   const auth::KeyLocation& key_location() const { return key_location_; }
@@ -99,12 +108,14 @@ class Server {
   std::unique_ptr<SolveLoop> solve_loop_;
   std::unique_ptr<ServerTransport> owned_transport_;
   ServerTransport* transport_ = nullptr;
+  std::unique_ptr<ServerKeys> keys_;
   std::unique_ptr<InboundGate> gate_;
   std::unique_ptr<Publisher> publisher_;
 
   std::thread receive_thread_, solve_thread_;
   std::atomic<bool> running_{false};
   std::atomic<bool> stop_{false};
+  std::atomic<bool> reload_requested_{false};
   bool started_ = false;
 };
 

@@ -10,7 +10,7 @@ bool ServerInbox::PutPose(const ReceivedPose& pose) {
     std::lock_guard<std::mutex> lock(mutex_);
     bool stored = false;
     for (ReceivedPose& p : poses_) {
-      if (p.state.grasp == pose.state.grasp) {
+      if (p.state.grasp == pose.state.grasp && p.state.sender_name == pose.state.sender_name) {
         p = pose;
         superseded = stored = true;
         break;

@@ -1,5 +1,6 @@
 // The hand-over from the receive thread to the solve thread: the newest device pose of
-// each grasp (device_state_t.grasp; latest wins: a pose that arrives before the solver
+// each grasp of each sender (device_state_t.grasp and sender_name, so one device cannot
+// displace another's pose; latest wins: a pose that arrives before the solver
 // took the previous one of its grasp replaces it, so the solver never works through a
 // queue of stale poses) and a short FIFO of commands (commands are rare and must not be
 // lost). One mutex and one condition variable; the receive thread is not real-time, so
@@ -22,10 +23,14 @@
 
 namespace snapthread::server {
 
-// A validated pose and when it arrived.
+struct DeviceKey;  // server_keys.h
+
+// A validated pose, when it arrived and the device key it was made with (kept by the
+// gate's ServerKeys for the server's life: the force model answering it is MACed with it).
 struct ReceivedPose {
   device_state_t state;
   int64_t receive_utime = 0;  // server CLOCK_REALTIME, microseconds
+  const DeviceKey* key = nullptr;
 };
 
 class ServerInbox {

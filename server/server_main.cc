@@ -1,10 +1,17 @@
 // snapthread-server: the solver server process. See server.h for what it does and
 // server_params.h for the flags.
 //
+// SIGHUP reloads the keys (the root file after snapthread-keygen --rotate, FILE.revoked).
+//
 // Exit codes (app/exit_codes.h): 0 after a clean stop (SIGINT/SIGTERM or --duration), 1
 // when LCM does not start (or the --summary file cannot be written), 2 for bad arguments
 // (including a scene that does not load).
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
+
+#include <algorithm>
+#include <chrono>
 
 #include <exception>
 #include <fstream>
@@ -20,6 +27,8 @@
 #include "app/common_flags.h"
 #include "app/exit_codes.h"
 #include "app/stop_signals.h"
+#include "auth/credential.h"
+#include "auth/revocation_list.h"
 #include "scene/scene.h"
 #include "scene_dir.h"
 #include "server.h"
@@ -84,7 +93,11 @@ void AddRunFlags(CLI::App* cli, ServerFlags* f) {
   cli->add_option("--summary", p->summary_path,
                   "Write a JSON summary (updates, update_rate_hz, solve_us_p50/p99, snaps, "
                   "dropped_poses, rejected_messages) here at exit");
-  cli->add_flag("--create-key", p->create_key, "Make the session key (mode 0600) when the --key file does not exist");
+  cli->add_flag("--create-key", p->create_key, "Make the root key (mode 0600) when the --key file does not exist");
+  cli->add_option("--key-grace-s", p->key_grace_s,
+                  "Seconds the previous root key stays accepted after a reload (SIGHUP) finds a "
+                  "rotated --key (snapthread-keygen --rotate), or after a start that finds FILE.previous")
+      ->capture_default_str();
   cli->add_option("--state-dir", p->state_dir,
                   "Checkpoint the scene, method, grasp and state here (>= 5 Hz, atomically); "
                   "restarted with the same directory and --session the server resumes on the "
@@ -133,6 +146,10 @@ std::optional<int> MakeServer(const ServerParams& params, std::unique_ptr<Server
     *out = std::make_unique<Server>(params);
   } catch (const auth::KeyFileError& e) {
     return usage(std::string("--key: ") + e.what());
+  } catch (const auth::CredentialError& e) {
+    return usage(std::string("--key: ") + e.what());
+  } catch (const auth::RevocationListError& e) {
+    return usage(std::string("--key: ") + e.what());
   } catch (const CheckpointIoError& e) {
     return usage(e.what());
   } catch (const LcmInitError& e) {
@@ -145,6 +162,37 @@ std::optional<int> MakeServer(const ServerParams& params, std::unique_ptr<Server
     return usage(std::string("--scene ") + params.scene_path + ": " + e.what());
   }
   return std::nullopt;
+}
+
+// SIGHUP, taken synchronously like the stop signals: blocked here, before any thread, so
+// that every thread inherits the mask and only RunUntilStop sees it.
+sigset_t BlockReloadSignal() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  return set;
+}
+
+// Until SIGINT/SIGTERM or the duration: each SIGHUP asks the server to reload its keys
+// (applied by its receive thread). Returns the stop signal, 0 when the duration ended.
+int RunUntilStop(app::StopSignals* stop, const sigset_t& reload, double duration_s, Server* server) {
+  constexpr double kSliceS = 0.2;  // how late a reload may be applied
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration_s);
+  while (true) {
+    double slice = kSliceS;
+    if (duration_s > 0.0) {
+      const double left = std::chrono::duration<double>(end - std::chrono::steady_clock::now()).count();
+      if (left <= 0.0) return 0;
+      slice = std::min(slice, left);
+    }
+    if (const int sig = stop->Wait(slice); sig > 0) return sig;
+    const timespec zero{};
+    if (sigtimedwait(&reload, nullptr, &zero) == SIGHUP) {
+      spdlog::info("server: SIGHUP, reloading the keys");
+      server->RequestReload();
+    }
+  }
 }
 
 // --summary: the run's JSON; kExitFailure when it cannot be written.
@@ -176,10 +224,13 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
 
   app::StopSignals stop;  // before the server's threads (and LCM's): they inherit the mask
+  const sigset_t reload = server::BlockReloadSignal();
   std::unique_ptr<server::Server> running;
   if (auto code = server::MakeServer(params, &running)) return *code;
   running->Start();
-  if (const int sig = stop.Wait(params.duration_s); sig > 0) spdlog::info("server: signal {}, stopping", sig);
+  if (const int sig = server::RunUntilStop(&stop, reload, params.duration_s, running.get()); sig > 0) {
+    spdlog::info("server: signal {}, stopping", sig);
+  }
   running->Stop();
   spdlog::info("server: {}", running->FinalReport());
   return server::WriteSummary(params, *running);

@@ -244,6 +244,7 @@ solver_status_t BuildSolverStatus(const StatusInputs& in) {
   msg.snaps = in.snaps;
   msg.dropped_poses = in.dropped_poses;
   msg.rejected_messages = in.rejected_messages;
+  msg.refusals = in.refusals;
   msg.contacts = in.contacts;
   msg.knot = in.knot;
   msg.knot_determinant = in.knot_determinant;

@@ -86,6 +86,7 @@ struct StatusInputs {
   int64_t snaps = 0;
   int64_t dropped_poses = 0;
   int64_t rejected_messages = 0;
+  std::string refusals;  // "role/reason=count ..." (refusal_counts.h)
   int32_t contacts = 0;  // active self-contact pairs at the last update
   std::string knot;              // KnotWatch: "" = not computed
   int32_t knot_determinant = 0;  // 0 = not computed

@@ -47,6 +47,11 @@ bool ServerParams::IsValid(std::string* error) const {
   if (!std::isfinite(time_budget_us)) {
     return Fail(error, "--time-budget-us: must be a finite number (>= 0; omit it for the scene's)");
   }
+  // Bounded so that now + grace stays far from int64's end (a year is beyond any rotation).
+  if (!std::isfinite(key_grace_s) || key_grace_s < 0.0 || key_grace_s > kMaxKeyGraceS) {
+    return Fail(error, "--key-grace-s: must be in [0, " + std::to_string(static_cast<int64_t>(kMaxKeyGraceS)) +
+                           "] seconds, got " + std::to_string(key_grace_s));
+  }
   if (!method.empty()) {
     if (SolverRegistry::Global().Find(method) == nullptr) {
       return Fail(error, "--method: unknown method '" + method + "' (expected " +

@@ -13,6 +13,8 @@ namespace snapthread::server {
 
 // LCM channel names are at most 63 bytes; the longest channel suffix is 14 bytes.
 inline constexpr size_t kMaxSessionLength = messages::kMaxSessionNameLength;
+// The longest --key-grace-s: a year.
+inline constexpr double kMaxKeyGraceS = 365.0 * 24 * 3600;
 
 struct ServerParams {
   // LCM provider URL. Empty: the environment's LCM_DEFAULT_URL if set, else the loopback
@@ -52,12 +54,17 @@ struct ServerParams {
   double duration_s = 0.0;
   // Where to write the end-of-run JSON summary; empty = none.
   std::string summary_path;
-  // The session key file (--key): "" = $SNAPTHREAD_KEY_FILE, else the XDG default
-  // (auth/key_file.h). It must exist unless create_key.
+  // The root key file (--key): "" = $SNAPTHREAD_KEY_FILE, else the XDG default
+  // (auth/key_file.h). It must exist unless create_key. FILE.previous (a rotation) and
+  // FILE.revoked (revocations) beside it are read at the start and on reload.
   std::string key_path;
   // --create-key: make the key (mode 0600) when the file does not exist. Without it a
   // missing key is refused (a typo in --key must not give a new key).
   bool create_key = false;
+  // --key-grace-s: after a reload (SIGHUP) finds a new root key, or at a start that finds
+  // FILE.previous, messages made under the previous root are accepted for this many
+  // seconds (a session rides through a rotation), then refused as grace-over. Finite, >= 0.
+  double key_grace_s = 60.0;
   // Where the server checkpoints the scene, method, grasp and state (--state-dir; "" =
   // no checkpoints). Restarted with the same directory and session it resumes on the
   // same branch (server/checkpoint.h). Made (mode 0700) when missing.

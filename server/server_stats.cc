@@ -39,6 +39,7 @@ void ServerCounters::CopyTo(ServerStats* s) const {
   s->snaps = snaps.load();
   s->dropped_poses = dropped_poses.load();
   s->rejected_messages = rejected_messages.load();
+  s->refusals = refusals.Format();
   s->commands_applied = commands_applied.load();
   s->commands_refused = commands_refused.load();
   s->shapes_published = shapes_published.load();

@@ -12,6 +12,7 @@
 
 #include "checkpoint_writer.h"
 #include "realtime/percentiles.h"
+#include "refusal_counts.h"
 
 namespace snapthread::server {
 
@@ -24,6 +25,7 @@ struct ServerStats {
   int64_t snaps = 0;              // updates that snapped
   int64_t dropped_poses = 0;      // poses superseded before the solver took them
   int64_t rejected_messages = 0;  // malformed / invalid DEVICE_STATE or COMMAND packets
+  std::string refusals;           // per claimed role and reason (RefusalCounts::Format)
   int64_t commands_applied = 0;
   int64_t commands_refused = 0;   // bad scene, unknown method, queue full
   int64_t shapes_published = 0;
@@ -49,11 +51,14 @@ struct ServerCounters {
   std::atomic<int64_t> poses_received{0}, updates{0}, invalid_models{0}, snaps{0},
       dropped_poses{0}, rejected_messages{0}, commands_applied{0}, commands_refused{0},
       shapes_published{0}, statuses_published{0}, publish_failures{0};
+  // Refused DEVICE_STATE and COMMAND messages by claimed role and reason (each also in
+  // rejected_messages).
+  RefusalCounts refusals;
   // Last log time (steady µs) of a "bad message" warning and of a solve-thread error.
   std::atomic<int64_t> last_reject_log_us{0};
   std::atomic<int64_t> last_solve_error_log_us{0};
 
-  // The counters into *s (the fields above update_rate_hz).
+  // The counters into *s (the fields above update_rate_hz, and refusals).
   void CopyTo(ServerStats* s) const;
 };
 

@@ -126,6 +126,7 @@ void SolveLoop::Run(ServerInbox* inbox, Publisher* publisher) {
       changed_session = true;
     }
     if (PollSceneLoad()) changed_session = true;
+    RefuseForeignGrasps(&taken.poses);
     if (!taken.poses.empty()) SolveAndPublish(taken.poses);
     now = SteadyClock::now();
     if (changed_session) knot_watch_.Reset();
@@ -205,7 +206,24 @@ void SolveLoop::PublishGraspModel(const ReceivedPose& pose, int grasp, const Ses
     for (int i = 0; i < 3; ++i) last_force_n_[i] = msg.f0[i];
     if (msg.status == force_model_t::STATUS_INVALID) counters_->invalid_models.fetch_add(1);
   }
-  publisher_->ForceModel(&msg);
+  publisher_->ForceModel(&msg, grasp, pose.key);
+}
+
+void SolveLoop::RefuseForeignGrasps(std::vector<ReceivedPose>* poses) {
+  // A pose naming no grasp drives the scene's first one (FindGrasp): only the device of
+  // that name may send it ("hand" for the single unnamed grasp). The gate checked the
+  // poses that name their grasp.
+  const auto& grasps = session_->scene.grasps;
+  const std::string_view own = grasps.empty() || grasps[0].name.empty() ? std::string_view("hand")
+                                                                       : std::string_view(grasps[0].name);
+  std::erase_if(*poses, [&](const ReceivedPose& p) {
+    if (!p.state.grasp.empty() || p.state.sender_name == own) return false;
+    counters_->refusals.Count(p.state.sender_role, Refusal::kWrongGrasp);
+    CountRejection(counters_, channels_.device_state,
+                   "wrong-grasp: device '" + p.state.sender_name + "' sent a pose for grasp '" +
+                       std::string(own) + "'");
+    return true;
+  });
 }
 
 void SolveLoop::PublishShape() {
@@ -249,6 +267,7 @@ void SolveLoop::PublishStatus() {
   in.snaps = counters_->snaps.load();
   in.dropped_poses = counters_->dropped_poses.load();
   in.rejected_messages = counters_->rejected_messages.load();
+  in.refusals = counters_->refusals.Format();
   in.contacts = static_cast<int32_t>(session_->tracker->ActiveContacts().size());
   in.knot = knot_watch_.name();
   in.knot_determinant = knot_watch_.determinant();

@@ -71,6 +71,9 @@ class SolveLoop {
 
  private:
   SessionSettings Settings() const;
+  // Drops (and counts as wrong-grasp) poses naming no grasp whose device is not the one
+  // of the grasp such a pose drives.
+  void RefuseForeignGrasps(std::vector<ReceivedPose>* poses);
   void SolveAndPublish(const std::vector<ReceivedPose>& poses);
   // The force model of one grasp for the pose that moved it (its block of F and K).
   void PublishGraspModel(const ReceivedPose& pose, int grasp, const SessionUpdate& update,
