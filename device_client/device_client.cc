@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <thread>
 #include <utility>
@@ -57,7 +58,7 @@ DeviceClient::DeviceClient(HapticDevice* device, DeviceTransport* transport,
       channels_(config_.session),
       sent_poses_(std::make_unique<auth::PoseEchoWindow>()),
       receiver_(config_.limits, models_.get(),
-                ModelAuth{config_.key, channels_.force_model, channels_.solver_status,
+                ModelAuth{config_.keys, channels_.force_model, channels_.solver_status,
                                     sent_poses_.get()}),
       tick_(device_, &safety_, models_.get(), poses_.get(),
             trace_file_ ? trace_ring_.get() : nullptr, lateness_.get(), config_.tick),
@@ -131,16 +132,17 @@ int DeviceClient::Receive(int wait_ms) {
     receiver_.Receive(data, size, Now());
   });
   transport_->PollSolverStatus(
-      [this](const void* data, int size) { receiver_.ReceiveStatus(data, size); });
+      [this](const void* data, int size) { receiver_.ReceiveStatus(data, size, Now()); });
   return n;
 }
 
 bool DeviceClient::SignPose() {
-  if (config_.key == nullptr) return true;
+  if (config_.keys == nullptr) return true;
   // Epoch 0 until an authenticated status was heard: the server refuses such poses and
   // no model can answer them, so the device stays in its fade.
   const int64_t epoch = receiver_.epoch();
-  if (!auth::Sign(&state_msg_, channels_.device_state, epoch, auth_seq_.Next(), *config_.key)) {
+  if (!auth::Sign(&state_msg_, channels_.device_state, epoch, auth_seq_.Next(),
+                  config_.keys->current().tagger())) {
     return false;
   }
   // Before it leaves: a model answering it may arrive before Publish returns.
@@ -149,9 +151,17 @@ bool DeviceClient::SignPose() {
 }
 
 bool DeviceClient::SignStatus(device_status_t* st) {
-  if (config_.key == nullptr) return true;
-  return auth::Sign(st, channels_.device_status, receiver_.epoch(), auth_seq_.Next(),
-                    *config_.key);
+  if (config_.keys == nullptr) return true;
+  // One set for the whole status: a reload between the fields and the tag would
+  // certify one key and sign with another.
+  const auth::KeySet& keys = config_.keys->current();
+  const auth::PublicKey* pk = keys.device_public_key();
+  const auth::DeviceCertificateBytes* cert = keys.device_certificate();
+  const auth::Tagger* tagger = keys.device_status_tagger();
+  if (pk == nullptr || cert == nullptr || tagger == nullptr) return false;
+  std::memcpy(st->device_public_key, pk->data(), sizeof st->device_public_key);
+  std::memcpy(st->device_certificate, cert->data(), sizeof st->device_certificate);
+  return auth::Sign(st, channels_.device_status, receiver_.epoch(), auth_seq_.Next(), *tagger);
 }
 
 void DeviceClient::Drain() {

@@ -19,7 +19,7 @@
 
 #include "auth/pose_echo_window.h"
 #include "auth/session_epoch.h"
-#include "auth/session_key.h"
+#include "device_keys.h"
 #include "haptic_device.h"
 #include "messages/channels.h"
 #include "model_receiver.h"
@@ -48,10 +48,12 @@ struct DeviceClientConfig {
   int64_t log_period_us = 5000000;   // a summary line every 5 s (0 = never)
   int receive_wait_ms = 20;          // receive thread: longest wait per poll
   MicrosClock clock = nullptr;       // CLOCK_MONOTONIC when null; tests use a fake clock
-  // The session key (must outlive the client): poses and statuses are signed, force
-  // models and solver statuses checked (docs/security.md). snapthread-device always
-  // sets it; nullptr (no authentication) is for in-process tests of other concerns.
-  const auth::SessionKey* key = nullptr;
+  // The device's credential (must outlive the client): poses are MACed and statuses
+  // MACed and signed with it, force models and solver statuses checked (docs/security.md,
+  // "Roles on the wire"); a reload (DeviceKeys::Replace, any thread) takes effect from the
+  // next pose. snapthread-device always sets it; nullptr (no authentication) is for
+  // in-process tests of other concerns.
+  const DeviceKeys* keys = nullptr;
   std::string session = messages::kDefaultSession;  // channel prefix (for the MACs)
   // Snap-ahead (snap_ahead.h): switch to a fold's post-snap model at the tick the hand
   // crosses its boundary. --no-snap-ahead turns it off.
@@ -125,8 +127,8 @@ class DeviceClient {
  private:
   int64_t Now() const;
   void Drain();
-  // io thread: sign state_msg_ / a status (no-ops without a key); false when it cannot
-  // be signed (then it is not sent).
+  // io thread: tag state_msg_ / a status with the current credential (no-ops without
+  // one); false when it cannot be tagged (then it is not sent).
   bool SignPose();
   bool SignStatus(device_status_t* st);
   void MaybeReport(int64_t now_us);

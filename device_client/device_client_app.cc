@@ -1,5 +1,6 @@
 #include "device_client_app.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -14,8 +15,10 @@
 #include "app/exit_codes.h"
 #include "app/stop_signals.h"
 #include "auth/key_file.h"
-#include "auth/session_key.h"
+#include "auth/key_set.h"
+#include "auth/role.h"
 #include "device_client.h"
+#include "device_keys.h"
 #include "device_factory.h"
 #include "lcm_transport.h"
 #include "messages/lcm_url.h"
@@ -83,10 +86,11 @@ constexpr int kContinue = -1;
 
 void PrintError(const std::string& what) { std::fprintf(stderr, "%s: %s\n", kProgram, what.c_str()); }
 
-// What RunDeviceClient sets up before the transport: the key, the scene and its grasp,
-// the backend (built, not open).
+// What RunDeviceClient sets up before the transport: the credential (and the file it
+// came from, reloaded on SIGHUP), the scene and its grasp, the backend (built, not open).
 struct ClientSetup {
-  std::optional<auth::SessionKey> key;
+  std::unique_ptr<DeviceKeys> keys;
+  std::string key_path;
   std::optional<Scene> scene;
   int grasp = 0;
   BackendConfig config;
@@ -122,13 +126,68 @@ int CheckOptions(const DeviceClientOptions& o) {
   return kContinue;
 }
 
-// The session key: without it nothing the server sends can be trusted.
-int LoadSessionKey(const DeviceClientOptions& o, ClientSetup* setup) {
+// The name the server knows this device by: the grasp its poses name (--grasp, or the
+// scene's grasp), "hand" when they name none (the server's effective grasp name).
+std::string DeviceName(const DeviceClientOptions& o, const ClientSetup& setup) {
+  if (!o.grasp.empty()) return o.grasp;
+  if (setup.scene && !setup.scene->grasps.empty()) return setup.scene->grasps[setup.grasp].name;
+  return "";
+}
+
+// What --key loaded, as the device: a device credential as it is; on the server host the
+// root key acting as device `name` ("hand" when empty). Throws when `name` cannot name a
+// device.
+auth::KeySet AsDevice(auth::KeySet keys, const std::string& name) {
+  if (keys.role() != auth::Role::kServer) return keys;
+  return auth::KeySet::ForRole(*keys.root(), auth::Role::kDevice, name.empty() ? "hand" : name);
+}
+
+// --key: the device's credential (without it nothing the server sends can be trusted).
+// A credential of another device than the grasp held is refused: the server would refuse
+// every pose as another grasp's.
+int LoadDeviceKeys(const DeviceClientOptions& o, ClientSetup* setup) {
+  const std::string name = DeviceName(o, *setup);
   auth::KeyLocation where;
-  setup->key = app::LoadSessionKey(o.common, kProgram, &where);  // says why it failed
-  if (!setup->key) return app::kExitUsage;
-  spdlog::info("device: session key {} ({}), key id {}", where.path, where.origin, setup->key->Id());
+  // Says why it failed (a credential of another role: the role needed).
+  std::optional<auth::KeySet> loaded = app::LoadKeySet(o.common, auth::Role::kDevice, kProgram, &where);
+  if (!loaded) return app::kExitUsage;
+  try {
+    auth::KeySet keys = AsDevice(std::move(*loaded), name);
+    if (!name.empty() && keys.name() != name) {
+      PrintError("--key: " + where.path + " is device '" + keys.name() + "'s credential, but this device holds grasp '" +
+                 name + "': the server would refuse every pose. Fix: --key the credential of device '" + name +
+                 "' (snapthread-keygen --role device --device " + name + "), or --grasp " + keys.name());
+      return app::kExitUsage;
+    }
+    spdlog::info("device: {} ({}) as device '{}', key id {}", where.path, where.origin, keys.name(),
+                 auth::KeyIdToWire(keys.tagger().key_id));
+    setup->keys = std::make_unique<DeviceKeys>(std::move(keys), static_cast<int64_t>(1e6 * o.key_grace_s));
+    setup->key_path = where.path;
+  } catch (const std::exception& e) {
+    PrintError(std::string("--key: ") + e.what());
+    return app::kExitUsage;
+  }
   return kContinue;
+}
+
+// SIGHUP: the credential file again. On success the device tags with it from the next
+// pose and accepts models under the previous key for --key-grace-s; otherwise it keeps
+// the credential it has.
+void ReloadDeviceKeys(const ClientSetup& setup) {
+  try {
+    auth::KeySet next =
+        AsDevice(auth::LoadKeySet(setup.key_path, auth::Role::kDevice, kProgram), setup.keys->name());
+    const int64_t id = auth::KeyIdToWire(next.tagger().key_id);
+    std::string error;
+    if (!setup.keys->Replace(std::move(next), realtime::MonotonicMicros(), &error)) {
+      spdlog::error("device: reload of {} refused, keeping the current credential: {}", setup.key_path, error);
+      return;
+    }
+    spdlog::info("device: reloaded {}: key id {}; the previous key is accepted for {:.0f} s", setup.key_path, id,
+                 1e-6 * static_cast<double>(setup.keys->grace_us()));
+  } catch (const std::exception& e) {
+    spdlog::error("device: reload of {} failed, keeping the current credential: {}", setup.key_path, e.what());
+  }
 }
 
 // --scene and --grasp: the scene (if any) and the index of the grasp this device holds.
@@ -236,7 +295,7 @@ void FillClientConfig(const DeviceClientOptions& o, const ClientSetup& setup, co
   cc->loop.rate_hz = o.rate_hz;
   cc->loop.realtime = o.realtime;
   cc->trace_file = o.trace_file;
-  cc->key = &*setup.key;
+  cc->keys = setup.keys.get();
   cc->session = o.common.session;
   cc->snap_ahead = o.snap_ahead;
 }
@@ -282,18 +341,24 @@ int ConfigureClient(const DeviceClientOptions& o, const ClientSetup& setup, cons
 
 // Runs the client until the duration elapses or SIGINT / SIGTERM arrives, then fades the
 // force to zero within the safety ramp (fade_time_s) before the servo loop stops.
-void RunUntilStopped(const DeviceClientOptions& o, double fade_time_s, app::StopSignals* stop,
-                     DeviceClient* client) {
+void RunUntilStopped(const DeviceClientOptions& o, const ClientSetup& setup, double fade_time_s,
+                     app::StopSignals* stop, ReloadSignal* reload, DeviceClient* client) {
   std::string notes;
   client->Start(&notes);
   if (!notes.empty()) spdlog::warn("{}", notes);
   if (o.realtime && client->realtime_active()) spdlog::info("servo: SCHED_FIFO active");
-  // The main thread waits; the servo thread runs on (the signals are blocked in it).
-  if (o.duration_s <= 0.0) {
-    stop->Wait(0.0);  // no limit
-  } else if (const double left = o.duration_s - Seconds(realtime::MonotonicMicros() - client->start_us());
-             left > 0.0) {
-    stop->Wait(left);
+  // The main thread waits, and reloads the credential on SIGHUP; the servo thread runs
+  // on (the signals are blocked in it).
+  constexpr double kReloadPollS = 0.2;
+  while (true) {
+    double wait_s = kReloadPollS;
+    if (o.duration_s > 0.0) {
+      const double left = o.duration_s - Seconds(realtime::MonotonicMicros() - client->start_us());
+      if (left <= 0.0) break;
+      wait_s = std::min(wait_s, left);
+    }
+    if (stop->Wait(wait_s) != 0) break;
+    if (reload != nullptr && reload->Take()) ReloadDeviceKeys(setup);
   }
   if (!client->FadeOut(fade_time_s + 0.3)) {
     spdlog::warn("device: the force did not fade to zero within {} ms; stopping anyway",
@@ -374,6 +439,10 @@ std::optional<int> ParseDeviceClientArgs(int argc, char** argv, DeviceClientOpti
   cli.add_flag("--no-snap-ahead", no_snap_ahead,
                "render only the server's models: no switch to a post-snap model at a fold "
                "boundary (docs/snap-ahead.md)");
+  cli.add_option("--key-grace-s", o->key_grace_s,
+                 "after a reload (SIGHUP) of --key, accept force models under the previous key this long")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
   cli.add_option("--trace", o->trace_file, "write a per-tick CSV trace");
   cli.add_option("--trace-divisor", o->trace_divisor, "trace every k-th tick")
       ->check(CLI::Range(1, 100000))
@@ -388,13 +457,13 @@ std::optional<int> ParseDeviceClientArgs(int argc, char** argv, DeviceClientOpti
   return app::CheckCommonFlags(o->common, kProgram, app::kExitUsage);
 }
 
-int RunDeviceClient(const DeviceClientOptions& o, app::StopSignals* stop) {
+int RunDeviceClient(const DeviceClientOptions& o, app::StopSignals* stop, ReloadSignal* reload) {
   spdlog::set_level(spdlog::level::from_str(o.common.log_level));
   // Configuration, in this order; bad input ends the program with app::kExitUsage.
   ClientSetup setup;
   if (const int code = CheckOptions(o); code != kContinue) return code;
-  if (const int code = LoadSessionKey(o, &setup); code != kContinue) return code;
   if (const int code = LoadSceneAndGrasp(o, &setup); code != kContinue) return code;
+  if (const int code = LoadDeviceKeys(o, &setup); code != kContinue) return code;
   if (const int code = MakeConfiguredBackend(o, &setup); code != kContinue) return code;
 
   const std::string url = app::LcmUrl(o.common, messages::kServiceBufferBytes);
@@ -417,7 +486,7 @@ int RunDeviceClient(const DeviceClientOptions& o, app::StopSignals* stop) {
     device.Close();
     return app::kExitFailure;
   }
-  RunUntilStopped(o, cc.limits.fade_time_s, stop, client.get());
+  RunUntilStopped(o, setup, cc.limits.fade_time_s, stop, reload, client.get());
   device.Close();
   return ReportSummary(o, *client, lcm);
 }

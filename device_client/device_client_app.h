@@ -8,6 +8,7 @@
 
 #include "app/common_flags.h"
 #include "app/stop_signals.h"
+#include "reload_signal.h"
 
 namespace snapthread::device {
 
@@ -17,6 +18,7 @@ struct DeviceClientOptions {
   std::string grasp;                     // scene grasp to hold (--grasp); "" = the first
   std::string path_csv;                  // alternative scripted path, metres
   app::CommonFlags common;               // --session, --lcm-url, --key, --log-level
+  double key_grace_s = 60.0;             // previous key accepted this long after a reload
   double duration_s = 0.0;               // 0 = until SIGINT / SIGTERM
   double rate_hz = 1000.0;
   int publish_divisor = 1;               // publish every k-th pose
@@ -46,8 +48,10 @@ struct DeviceClientOptions {
 std::optional<int> ParseDeviceClientArgs(int argc, char** argv, DeviceClientOptions* options);
 
 // Runs the client until the duration elapses or `stop` sees SIGINT / SIGTERM (the main
-// thread waits on it; the servo thread never does); returns an exit code. `stop` must
+// thread waits on it; the servo thread never does); returns an exit code. On each SIGHUP
+// `reload` sees, the --key file is loaded again (device_keys.h). `stop` and `reload` must
 // exist before any thread does (app/stop_signals.h).
-int RunDeviceClient(const DeviceClientOptions& options, app::StopSignals* stop);
+int RunDeviceClient(const DeviceClientOptions& options, app::StopSignals* stop,
+                    ReloadSignal* reload = nullptr);
 
 }  // namespace snapthread::device

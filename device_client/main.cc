@@ -7,5 +7,6 @@ int main(int argc, char** argv) {
   if (auto code = snapthread::device::ParseDeviceClientArgs(argc, argv, &options)) return *code;
   // Before any thread (LCM's, the render and servo threads): they inherit the mask.
   snapthread::app::StopSignals stop;
-  return snapthread::device::RunDeviceClient(options, &stop);
+  snapthread::device::ReloadSignal reload;  // SIGHUP reloads --key, never stops
+  return snapthread::device::RunDeviceClient(options, &stop, &reload);
 }

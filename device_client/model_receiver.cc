@@ -4,7 +4,9 @@
 
 #include <utility>
 
+#include "auth/message_mac.h"
 #include "auth/message_gate.h"
+#include "auth/role.h"
 #include "messages/validate.h"
 #include "realtime/clock.h"
 #include "snapthread/force_model_t.hpp"
@@ -13,23 +15,29 @@
 namespace snapthread::device {
 
 ModelReceiver::ModelReceiver(const SafetyLimits& limits, ModelSlot* slot, ModelAuth auth)
-    : limits_(limits), slot_(slot), auth_(std::move(auth)), order_(auth_.key == nullptr) {}
+    : limits_(limits), slot_(slot), auth_(std::move(auth)), order_(auth_.keys == nullptr) {}
 
 void ModelReceiver::LogAuth(auth::FreshnessFilter* filter, int64_t now_us) {
   std::string line;
   if (filter->TakeLogLine(now_us, &line)) spdlog::warn("device: refused {}", line);
 }
 
-bool ModelReceiver::ReceiveStatus(const void* data, int size) {
-  if (auth_.key == nullptr) return false;
+bool ModelReceiver::ReceiveStatus(const void* data, int size, int64_t now_us) {
+  if (auth_.keys == nullptr) return false;
   try {
     solver_status_t msg;
     std::string why;
     if (!messages::DecodeAndValidate(data, size, &msg, &why)) return false;
     const int64_t before = status_filter_.epoch();
-    if (auth::Admit(data, static_cast<size_t>(size), msg, auth_.status_channel, *auth_.key,
-                    &status_filter_) != auth::Reason::kAccepted) {
-      LogAuth(&status_filter_, realtime::MonotonicMicros());
+    const auto n = static_cast<size_t>(size);
+    const auth::KeySet* previous = auth_.keys->Previous(now_us);
+    const bool signed_by_server =
+        auth::VerifySignature(data, n, auth_.status_channel, auth_.keys->current().server_public_key()) ||
+        (previous != nullptr &&
+         auth::VerifySignature(data, n, auth_.status_channel, previous->server_public_key()));
+    if (!signed_by_server) status_filter_.Reject(auth::Reason::kBadMac);
+    if (!signed_by_server || status_filter_.Admit(msg.epoch, msg.auth_seq) != auth::Reason::kAccepted) {
+      LogAuth(&status_filter_, now_us);
       return false;
     }
     if (status_filter_.epoch() != before) {
@@ -50,21 +58,13 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
       Reject(why);
       return false;
     }
-    // The MAC before anything of the message is looked at: a forged model's grasp name
-    // must not decide how it is counted (it is a bad MAC, not another hand's model).
-    if (auth_.key != nullptr &&
-        !auth::VerifyEncoded(data, static_cast<size_t>(size), auth_.force_model_channel,
-                             *auth_.key)) {
-      model_filter_.Reject(auth::Reason::kBadMac);
-      LogAuth(&model_filter_, now_us);
-      return false;
-    }
+    if (auth_.keys != nullptr && !CheckSender(data, size, msg, now_us)) return false;
     // Another hand's model (issue 15): it answers that device's poses, never this one's.
     if (msg.grasp != grasp_) {
       other_grasp_.fetch_add(1);
       return false;
     }
-    if (auth_.key != nullptr) {
+    if (auth_.keys != nullptr) {
       // Models must carry the epoch learned from the server's status (0: none yet, so
       // everything is refused and the device stays in its fade).
       const int64_t epoch = status_filter_.epoch();
@@ -106,6 +106,41 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
   } catch (...) {
     rejected_.fetch_add(1);
     return false;
+  }
+}
+
+bool ModelReceiver::CheckSender(const void* data, int size, const force_model_t& msg, int64_t now_us) {
+  if (msg.sender_role != static_cast<int8_t>(auth::Role::kServer)) {
+    RejectSender("not from the server (sender_role)", msg);
+    return false;
+  }
+  if (msg.sender_name != auth_.keys->name()) {
+    // Another device's model: another hand's when it is for another grasp.
+    if (msg.grasp != grasp_) {
+      other_grasp_.fetch_add(1);
+    } else {
+      RejectSender("addressed to another device (sender_name)", msg);
+    }
+    return false;
+  }
+  // This device's key (or its previous one during a reload's grace), named by key_id;
+  // the MAC covers key_id, so a forged one only picks the key that refuses it.
+  const auth::KeySet* keys = auth_.keys->ForKeyId(msg.key_id, now_us);
+  if (keys == nullptr || !auth::VerifyMac(data, static_cast<size_t>(size), auth_.force_model_channel,
+                                          *keys->mac_key())) {
+    model_filter_.Reject(auth::Reason::kBadMac);
+    LogAuth(&model_filter_, now_us);
+    return false;
+  }
+  return true;
+}
+
+void ModelReceiver::RejectSender(const char* why, const force_model_t& msg) {
+  const uint64_t n = sender_rejected_.fetch_add(1) + 1;
+  // Rate-limited as Reject: a flood must not become a flood of log lines.
+  if (n <= 5 || n % 1000 == 0) {
+    spdlog::warn("device: refused FORCE_MODEL ({} so far for its sender): {}: role {}, name '{}'", n, why,
+                 static_cast<int>(msg.sender_role), msg.sender_name);
   }
 }
 

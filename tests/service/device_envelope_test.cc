@@ -184,13 +184,14 @@ void RunHostileStreams(bool signed_session, uint32_t seed) {
   link.seed = seed;
   testing::LossyTransport lossy(&wire, link, &FakeClock);
   const auth::SessionKey key = auth::SessionKey::Generate();
+  const std::unique_ptr<DeviceKeys> keys = testing::DeviceKeysFor(key);
   DeviceClientConfig config;
   config.device_id = "envelope-test";
   config.limits.max_force_n = 2.5;  // the configured limit, not the default
   config.loop.realtime = false;
   config.log_period_us = 0;
   config.clock = &FakeClock;
-  if (signed_session) config.key = &key;
+  if (signed_session) config.keys = keys.get();
   HostileServer server(&wire, signed_session ? &key : nullptr, config.session, seed);
   DeviceClient client(&device, &lossy, config);
   const SafetyLimits& limits = client.safety().limits();

@@ -2,8 +2,10 @@
 // server in the test process over udpm on loopback. The fake server answers every pose
 // with the local model of a linear spring anchored at the device origin,
 //   F(u) = -k u  ->  f0 = -k u0, K = -k I (plus a negative stiffness along z to clamp),
-// signed with the session key and its own epoch, which it announces in a signed solver
-// status every 50 ms (the device learns the epoch from it, as from the real server).
+// tagged as the real server does (MAC with the device's key, sender_role server,
+// sender_name the device) with its own epoch, which it announces in a solver status signed
+// with the server key every 50 ms (the device learns the epoch from it, as from the real
+// server).
 #pragma once
 
 #include <atomic>
@@ -15,7 +17,9 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
+#include "auth/role.h"
 #include "auth/session_epoch.h"
 #include "auth/session_key.h"
 #include "messages/channels.h"
@@ -55,14 +59,26 @@ class DeviceProcess : public test_support::ChildProcess {
   }
 };
 
-// The fake server: answers each device pose with the spring's local model, signed with
-// the session key and its own epoch, which it announces in a signed solver status every
-// 50 ms (the device learns the epoch from it, as from the real server).
+// The fake server: answers each device pose with the spring's local model, MACed with
+// device `device_name`'s key issued from the root key `root` (the device's own key when it
+// runs on that device's credential, or on the root key as that device), with its own
+// epoch, which it announces in a solver status signed with the server key every 50 ms
+// (the device learns the epoch from it, as from the real server).
 class FakeServer {
  public:
-  FakeServer(const std::string& session, const auth::SessionKey* key,
-             const std::string& lcm_url = test_support::kLoopbackLcmUrl)
-      : channels_(session), lcm_(lcm_url), key_(key), epoch_(auth::NewEpoch()) {
+  FakeServer(const std::string& session, const auth::SessionKey* root,
+             const std::string& lcm_url = test_support::kLoopbackLcmUrl,
+             const std::string& device_name = "hand")
+      : channels_(session),
+        lcm_(lcm_url),
+        server_keys_(auth::KeySet::ForRole(*root, auth::Role::kServer)),
+        device_keys_(auth::KeySet::ForRole(*root, auth::Role::kDevice, device_name)),
+        epoch_(auth::NewEpoch()) {
+    model_tagger_.role = auth::Role::kServer;
+    model_tagger_.name = device_keys_.name();
+    model_tagger_.expires_unix_s = device_keys_.expires_unix_s();
+    model_tagger_.key_id = device_keys_.tagger().key_id;
+    model_tagger_.mac_key = device_keys_.mac_key();
     if (!lcm_.good()) return;
     messages::Subscribe<&FakeServer::OnPose>(lcm_, channels_.device_state, this);
     thread_ = std::thread([this] {
@@ -106,7 +122,7 @@ class FakeServer {
     // A negative stiffness along z (dF_z/dz > 0), which the device must clamp to zero in
     // every model. The sim-path stays at z = 0, so the spring law is unaffected.
     m.K[2][2] = +kNegativeStiffnessNPerM;
-    if (!auth::Sign(&m, channels_.force_model, epoch_, auth_seq_.Next(), *key_)) return;
+    if (!auth::Sign(&m, channels_.force_model, epoch_, auth_seq_.Next(), model_tagger_)) return;
     lcm_.publish(channels_.force_model, &m);
   }
 
@@ -115,13 +131,15 @@ class FakeServer {
     st.seq = ++status_seq_;
     st.scene = "fake";
     st.method = "spring";
-    if (!auth::Sign(&st, channels_.solver_status, epoch_, auth_seq_.Next(), *key_)) return;
+    if (!auth::Sign(&st, channels_.solver_status, epoch_, auth_seq_.Next(), server_keys_.tagger())) return;
     if (lcm_.publish(channels_.solver_status, &st) == 0) statuses_sent_.fetch_add(1);
   }
 
   messages::Channels channels_;
   lcm::LCM lcm_;
-  const auth::SessionKey* key_;
+  auth::KeySet server_keys_;
+  auth::KeySet device_keys_;
+  auth::Tagger model_tagger_;  // the handler thread's only
   int64_t epoch_;
   auth::AuthSequence auth_seq_;
   int64_t status_seq_ = 0;

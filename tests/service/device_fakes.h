@@ -2,18 +2,23 @@
 // one thread without LCM: InMemoryTransport keeps what the client publishes and hands it
 // encoded force models; SpringServer answers each new pose with the force model of a
 // known linear spring, echoing the pose's sequence number and time (optionally with one
-// snap, and signed with a session key as the real server does).
+// snap, and tagged as the real server does: force models MACed with the device's key,
+// sender_role server, sender_name the device; solver statuses signed by the server).
 #pragma once
 
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
+#include "auth/role.h"
 #include "auth/session_epoch.h"
 #include "auth/session_key.h"
+#include "device_keys.h"
 #include "messages/channels.h"
 #include "snapthread/force_model_t.hpp"
 #include "snapthread/solver_status_t.hpp"
@@ -27,6 +32,29 @@ std::vector<uint8_t> Encoded(const Msg& msg) {
   std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
   msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   return bytes;
+}
+
+// The device name snapthread-device takes on the root key when its poses name no grasp.
+inline constexpr const char* kDefaultDeviceName = "hand";
+
+// Device `name`'s keys issued from `root` (what the device client is given), with a
+// reload grace of grace_us.
+inline std::unique_ptr<DeviceKeys> DeviceKeysFor(const auth::SessionKey& root,
+                                                 const std::string& name = kDefaultDeviceName,
+                                                 int64_t grace_us = 60000000) {
+  return std::make_unique<DeviceKeys>(auth::KeySet::ForRole(root, auth::Role::kDevice, name), grace_us);
+}
+
+// How the server tags a force model for the device whose keys are `device` (no signature:
+// the server signs models at display rate only).
+inline auth::Tagger ForceModelTagger(const auth::KeySet& device) {
+  auth::Tagger t;
+  t.role = auth::Role::kServer;
+  t.name = device.name();
+  t.expires_unix_s = device.expires_unix_s();
+  t.key_id = device.tagger().key_id;
+  t.mac_key = device.mac_key();
+  return t;
 }
 
 class InMemoryTransport final : public DeviceTransport {
@@ -75,13 +103,24 @@ class SpringServer {
 
   void set_stiffness(double k_n_per_m) { k_ = k_n_per_m; }
 
-  // Signs every model AnswerAll sends, and DeliverStatus, for `session` (key must
-  // outlive the server): the device then learns `epoch` and checks as in production.
-  void SignWith(const auth::SessionKey* key, int64_t epoch, const std::string& session) {
-    key_ = key;
+  // Tags every model AnswerAll sends (MAC with device `device_name`'s key issued from
+  // `root`), and signs DeliverStatus (the server key of `root`), for `session`: the device
+  // then learns `epoch` and checks as in production.
+  void SignWith(const auth::SessionKey* root, int64_t epoch, const std::string& session,
+                const std::string& device_name = kDefaultDeviceName) {
+    server_keys_ = std::make_unique<auth::KeySet>(auth::KeySet::ForRole(*root, auth::Role::kServer));
+    MacWith(auth::KeySet::ForRole(*root, auth::Role::kDevice, device_name));
     epoch_ = epoch;
     channels_ = messages::Channels(session);
   }
+  // From now on, MACs models with `device`'s key (a rotation: the server's new key for the
+  // device, or another device's key for a forger).
+  void MacWith(auth::KeySet device) {
+    device_keys_ = std::make_unique<auth::KeySet>(std::move(device));
+    model_tagger_ = ForceModelTagger(*device_keys_);
+  }
+  // Tags models as `tagger` says instead (a forger: another role, no MAC...).
+  void TagModelsWith(const auth::Tagger& tagger) { model_tagger_ = tagger; }
 
   force_model_t ModelFor(const device_state_t& s) {
     force_model_t m{};
@@ -110,8 +149,8 @@ class SpringServer {
     solver_status_t st{};
     st.scene = "spring";
     st.method = "spring";
-    if (key_ != nullptr &&
-        auth::Sign(&st, channels_.solver_status, epoch_, auth_seq_.Next(), *key_)) {
+    if (server_keys_ != nullptr &&
+        auth::Sign(&st, channels_.solver_status, epoch_, auth_seq_.Next(), server_keys_->tagger())) {
       t_->DeliverStatus(Encoded(st));
     }
   }
@@ -133,7 +172,8 @@ class SpringServer {
   // Sends a model (signed with this server's epoch after SignWith); false when it
   // cannot be signed.
   bool Send(force_model_t m) {
-    if (key_ != nullptr && !auth::Sign(&m, channels_.force_model, epoch_, auth_seq_.Next(), *key_)) {
+    if (server_keys_ != nullptr &&
+        !auth::Sign(&m, channels_.force_model, epoch_, auth_seq_.Next(), model_tagger_)) {
       return false;
     }
     t_->Deliver(m);
@@ -155,7 +195,9 @@ class SpringServer {
   size_t taken_ = 0;
   bool snapped_ = false;
   int snaps_ = 0;
-  const auth::SessionKey* key_ = nullptr;
+  std::unique_ptr<auth::KeySet> server_keys_;  // null: nothing is tagged
+  std::unique_ptr<auth::KeySet> device_keys_;
+  auth::Tagger model_tagger_;
   int64_t epoch_ = 0;
   auth::AuthSequence auth_seq_{0};
   messages::Channels channels_{messages::kDefaultSession};

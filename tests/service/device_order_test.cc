@@ -144,13 +144,14 @@ Rendered RunThroughSnaps(const LinkOptions* link, bool signed_session) {
   server.snap_jump_n[0] = 1.5;
 
   const auth::SessionKey key = auth::SessionKey::Generate();
+  const std::unique_ptr<DeviceKeys> keys = testing::DeviceKeysFor(key);
   DeviceClientConfig config;
   config.device_id = "order-test";
   config.loop.realtime = false;
   config.log_period_us = 0;
   config.clock = &FakeClock;
   if (signed_session) {
-    config.key = &key;
+    config.keys = keys.get();
     server.SignWith(&key, auth::NewEpoch(), config.session);
   }
   DeviceClient client(&device,
