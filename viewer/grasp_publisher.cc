@@ -12,12 +12,12 @@
 namespace snapthread::viewer {
 
 GraspPublisher::GraspPublisher(lcm::LCM* lcm, const std::string& session,
-                               const DeviceMapping& mapping, const auth::SessionKey* key,
+                               const DeviceMapping& mapping, const auth::Tagger* tagger,
                                std::function<int64_t()> epoch)
     : lcm_(lcm),
       channel_(messages::Channels(session).device_state),
       mapping_(mapping),
-      key_(key),
+      tagger_(tagger),
       epoch_(std::move(epoch)) {}
 
 bool GraspPublisher::Publish(const Eigen::Vector3d& model_position, bool held) {
@@ -31,8 +31,8 @@ bool GraspPublisher::Publish(const Eigen::Vector3d& model_position, bool held) {
   msg.orientation[1] = msg.orientation[2] = msg.orientation[3] = 0.0;
   msg.buttons = held ? 1 : 0;
   if (!messages::Validate(msg, nullptr)) return false;  // e.g. a non-finite drag target
-  if (key_ != nullptr &&
-      !auth::Sign(&msg, channel_, epoch_ ? epoch_() : 0, auth_seq_.Next(), *key_)) {
+  if (tagger_ != nullptr &&
+      !auth::Sign(&msg, channel_, epoch_ ? epoch_() : 0, auth_seq_.Next(), *tagger_)) {
     return false;
   }
   return lcm_->publish(channel_, &msg) == 0;

@@ -4,8 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "auth/message_gate.h"
-
+#include "observer_check.h"
 #include "shape_check.h"
 #include "messages/channels.h"
 #include "messages/subscribe.h"
@@ -13,9 +12,9 @@
 namespace snapthread::viewer {
 
 SessionReceiver::SessionReceiver(lcm::LCM* lcm, const std::string& session,
-                                 const auth::SessionKey* key)
+                                 const auth::PublicKey* server_key)
     : lcm_(lcm),
-      key_(key),
+      server_key_(server_key),
       shape_channel_(messages::Channels(session).shape),
       status_channel_(messages::Channels(session).solver_status) {
   lcm::Subscription* shapes =
@@ -64,12 +63,13 @@ double SessionReceiver::NowS() const {
 template <class Msg>
 bool SessionReceiver::Authentic(const lcm::ReceiveBuffer* rbuf, const Msg& msg,
                                 const std::string& channel, auth::FreshnessFilter* filter) {
-  if (key_ == nullptr) return true;
+  if (server_key_ == nullptr) return true;
   if (filter == &shape_filter_ && shape_filter_.epoch() != status_filter_.epoch()) {
     shape_filter_.SetEpoch(status_filter_.epoch());
   }
-  if (auth::Admit(rbuf->data, rbuf->data_size, msg, channel, *key_, filter) ==
-      auth::Reason::kAccepted) {
+  if (CheckObserved(rbuf->data, rbuf->data_size, channel, msg, *server_key_) != ObserverVerdict::kAccepted) {
+    filter->Reject(auth::Reason::kBadMac);  // a bad signature: counted with the bad MACs
+  } else if (filter->Admit(msg.epoch, msg.auth_seq) == auth::Reason::kAccepted) {
     return true;
   }
   std::string line;

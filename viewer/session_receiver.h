@@ -20,7 +20,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "auth/freshness_filter.h"
-#include "auth/session_key.h"
+#include "auth/key_id.h"
 #include "snapthread/solver_status_t.hpp"
 #include "snapthread/thread_shape_t.hpp"
 
@@ -48,7 +48,7 @@ struct SessionSnapshot {
   int64_t shapes_received = 0;   // valid shapes since start
   int64_t statuses_received = 0;
   int64_t bad_messages = 0;      // malformed messages dropped (both channels)
-  int64_t auth_rejected = 0;     // refused by authentication (bad MAC, epoch, sequence)
+  int64_t auth_rejected = 0;     // refused by authentication (bad signature, role, epoch, sequence)
   double shape_rate_hz = 0.0;    // valid shapes over the last second
   std::vector<ForceSample> force_history;  // last kHistorySeconds
   double now_s = 0.0;            // seconds since the receiver started
@@ -62,11 +62,12 @@ class SessionReceiver {
 
   // Subscribes on `lcm` (which must be good()). Call Start() to begin handling.
   // `session` must be a valid session name (messages::Channels throws otherwise).
-  // With a key (which must outlive the receiver) statuses are taken only with a valid
-  // MAC and fresh sequence (their epoch adopted) and shapes only with a valid MAC, that
-  // epoch and a fresh sequence (docs/security.md); nullptr checks nothing (tests).
+  // With the server's public key (which must outlive the receiver) statuses are taken
+  // only signed by the server (observer_check.h) with a fresh sequence (their epoch
+  // adopted), and shapes only signed by the server, in that epoch and with a fresh
+  // sequence (docs/security.md); nullptr checks nothing (tests).
   SessionReceiver(lcm::LCM* lcm, const std::string& session,
-                  const auth::SessionKey* key = nullptr);
+                  const auth::PublicKey* server_key = nullptr);
   ~SessionReceiver();
   SessionReceiver(const SessionReceiver&) = delete;
   SessionReceiver& operator=(const SessionReceiver&) = delete;
@@ -98,7 +99,7 @@ class SessionReceiver {
                  auth::FreshnessFilter* filter);
 
   lcm::LCM* lcm_;
-  const auth::SessionKey* key_;
+  const auth::PublicKey* server_key_;
   auth::FreshnessFilter status_filter_{"SOLVER_STATUS", auth::FreshnessFilter::EpochPolicy::kAdopt};
   auth::FreshnessFilter shape_filter_{"SHAPE"};
   std::string shape_channel_;

@@ -166,6 +166,25 @@ bool LcmOpened(const lcm::LCM& lcm, const ViewerOptions& options) {
 }
 
 // The scene of --grasp-mode (its device mapping), or nullopt after saying why not.
+// The device the viewer drives as: the grasp it moves (the scene's only grasp's name, else
+// "hand"), as the server names a pose that names no grasp.
+std::string DrivenGraspName(const Scene& scene) {
+  if (scene.grasps.size() == 1 && !scene.grasps.front().name.empty()) return scene.grasps.front().name;
+  return "hand";
+}
+
+// What --key gives the viewer: an observer credential (or the root key, verified with its
+// server key) to watch; a device credential (or the root key, acting as the driven grasp's
+// device) to drive a grasp too. nullopt after saying why not, naming the role needed.
+std::optional<auth::KeySet> LoadViewerKeys(const ViewerOptions& options, const Scene* driven) {
+  const auth::Role role = driven != nullptr ? auth::Role::kDevice : auth::Role::kObserver;
+  std::optional<auth::KeySet> keys = app::LoadKeySet(options.common, role, kProgram);
+  if (keys && driven != nullptr && keys->root() != nullptr) {
+    keys.emplace(auth::KeySet::ForRole(*keys->root(), auth::Role::kDevice, DrivenGraspName(*driven)));
+  }
+  return keys;
+}
+
 std::optional<Scene> LoadGraspScene(const ViewerOptions& options) {
   try {
     return LoadScene(options.scene_path);
@@ -343,14 +362,14 @@ int RunWindow(const ViewerOptions& options, GLFWwindow* window, SessionReceiver*
 }  // namespace
 
 int RunPrintRates(const ViewerOptions& options, app::StopSignals* stop) {
-  const std::optional<auth::SessionKey> key = app::LoadSessionKey(options.common, kProgram);
-  if (!key) return kExitSetupFailed;
+  const std::optional<auth::KeySet> keys = LoadViewerKeys(options, nullptr);
+  if (!keys) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
   if (!LcmOpened(lcm, options)) return kExitSetupFailed;
   const std::string& session = options.common.session;
   ChannelRateMonitor monitor(&lcm, session + "_.*");
   // Checks shapes and statuses on the same LCM (handled by this loop) to count refusals.
-  SessionReceiver checked(&lcm, session, &*key);
+  SessionReceiver checked(&lcm, session, &keys->server_public_key());
   const auto start = Clock::now();
   auto last_report = start;
   std::printf("channel rates of session %s on %s (once per second)\n", session.c_str(), options.lcm_url.c_str());
@@ -382,17 +401,17 @@ int RunViewer(const ViewerOptions& options, app::StopSignals* stop) {
     scene = LoadGraspScene(options);
     if (!scene) return kExitSetupFailed;
   }
-  const std::optional<auth::SessionKey> key = app::LoadSessionKey(options.common, kProgram);
-  if (!key) return kExitSetupFailed;
+  const std::optional<auth::KeySet> keys = LoadViewerKeys(options, scene ? &*scene : nullptr);
+  if (!keys) return kExitSetupFailed;
   lcm::LCM lcm(options.lcm_url);
   if (!LcmOpened(lcm, options)) return kExitSetupFailed;
-  SessionReceiver receiver(&lcm, options.common.session, &*key);
+  SessionReceiver receiver(&lcm, options.common.session, &keys->server_public_key());
   // Receiving starts before the window: GL start-up takes seconds on a loaded machine, and
   // LCM drops what the shape queue cannot hold meanwhile.
   receiver.Start();
   std::unique_ptr<GraspPublisher> grasp;
   if (scene) {
-    grasp = std::make_unique<GraspPublisher>(&lcm, options.common.session, scene->device, &*key,
+    grasp = std::make_unique<GraspPublisher>(&lcm, options.common.session, scene->device, &keys->tagger(),
                                              [&receiver] { return receiver.epoch(); });
   }
   GLFWwindow* window = OpenWindow(options);

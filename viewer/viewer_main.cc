@@ -16,6 +16,8 @@ void AddViewerFlags(CLI::App* app, snapthread::viewer::ViewerOptions* o) {
   using snapthread::app::FiniteNumber;
   snapthread::app::CommonFlagSet common;
   common.session_from_environment = true;
+  common.key_note = "; an observer credential (snapthread-keygen --role observer) or the root key; "
+                    "--grasp-mode needs a device credential";
   snapthread::app::AddCommonFlags(app, &o->common, common);
   app->add_option("--width", o->width, "window width, pixels")->capture_default_str()
       ->check(CLI::Range(64, 8192));
@@ -35,7 +37,8 @@ void AddViewerFlags(CLI::App* app, snapthread::viewer::ViewerOptions* o) {
   app->add_option("--max-fps", o->max_fps, "render at most this many frames per second")
       ->capture_default_str()->check(CLI::Range(1.0, 1000.0))->check(FiniteNumber());
   app->add_flag("--grasp-mode", o->grasp_mode,
-                "drag the grasp with the mouse: publishes device_state_t on <SESSION>_DEVICE_STATE");
+                "drag the grasp with the mouse: publishes device_state_t on <SESSION>_DEVICE_STATE, "
+                "as the device --key's device credential names (the root key: the scene's grasp)");
   app->add_option("--scene", o->scene_path, "scene YAML (its device mapping; needed by --grasp-mode)")
       ->check(CLI::ExistingFile);
 }

@@ -5,12 +5,13 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "auth/message_mac.h"
+#include "auth/freshness_filter.h"
 #include "message_json.h"
 #include "messages/channels.h"
 #include "messages/lcm_url.h"
 #include "messages/subscribe.h"
 #include "messages/validate.h"
+#include "observer_check.h"
 #include "snapthread/device_status_t.hpp"
 #include "snapthread/force_model_t.hpp"
 #include "snapthread/solver_status_t.hpp"
@@ -19,9 +20,9 @@
 namespace snapthread::web {
 namespace {
 
-// Authenticated devices tracked separately; more are refused. Only a key holder can add
-// one (the MAC is checked before a device id is looked at), so this bounds a key holder's
-// mistakes, not a stranger's flood.
+// Authenticated devices tracked separately; more are refused. Only a device the server
+// certified can add one (the certificate and the signature are checked before its name is
+// used), so this bounds the server's mistakes, not a stranger's flood.
 constexpr size_t kMaxDevices = 16;
 
 std::string ToJson(const thread_shape_t& m) { return ShapeJson(m, DrawsSmooth(m.model)); }
@@ -42,8 +43,8 @@ int64_t NowUs() {
 }  // namespace
 
 LiveFeed::LiveFeed(const std::string& lcm_url, const std::string& session,
-                   const auth::SessionKey& key, PublishFn publish)
-    : lcm_(lcm_url), key_(key), publish_(std::move(publish)) {
+                   const auth::PublicKey& server_key, PublishFn publish)
+    : lcm_(lcm_url), server_key_(server_key), publish_(std::move(publish)) {
   if (!lcm_.good()) {
     throw std::runtime_error("cannot open LCM at " + lcm_url + ". " + messages::LcmStartHint(lcm_url));
   }
@@ -113,12 +114,12 @@ auth::FreshnessFilter* LiveFeed::FilterFor(const Msg& msg) {
     if constexpr (std::is_same_v<Msg, thread_shape_t>) filter = &shape_filter_;
     if constexpr (std::is_same_v<Msg, force_model_t>) filter = &model_filter_;
     if constexpr (std::is_same_v<Msg, device_status_t>) {
-      auto it = device_filters_.find(msg.device_id);
+      auto it = device_filters_.find(msg.sender_name);
       if (it == device_filters_.end()) {
         if (device_filters_.size() >= kMaxDevices) return nullptr;
         it = device_filters_
-                 .emplace(msg.device_id, std::make_unique<auth::FreshnessFilter>(
-                                             "DEVICE_STATUS " + msg.device_id))
+                 .emplace(msg.sender_name, std::make_unique<auth::FreshnessFilter>(
+                                               "DEVICE_STATUS " + msg.sender_name))
                  .first;
       }
       filter = it->second.get();
@@ -139,24 +140,27 @@ auth::FreshnessFilter* LiveFeed::BadMacCounter() {
 
 template <class Msg>
 void LiveFeed::OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  // The MAC over the bytes as received comes first: nothing is decoded into state, and
-  // nothing keyed by a field of the message (a device id) is created, for a sender
-  // without the key. Its refusal is counted on the channel's own counter.
-  if (!auth::VerifyEncoded(rbuf->data, rbuf->data_size, channel, key_)) {
-    auth_rejected_++;
-    auth::FreshnessFilter* counter = BadMacCounter<Msg>();
-    counter->Reject(auth::Reason::kBadMac);
-    LogRefusals(counter);
-    return;
-  }
+  // Force models between the server's display-rate ones carry no signature: they are for
+  // the device, not for observers, and are skipped before any work.
+  if (std::is_same_v<Msg, force_model_t> && viewer::SignaturesAbsent(rbuf->data, rbuf->data_size)) return;
   Msg msg;
   std::string why;
   if (!messages::DecodeAndValidate(rbuf, &msg, &why)) {
     malformed_++;
     return;
   }
+  // The signature (and a device's certificate) before anything keyed by a field of the
+  // message (a device name) is created. Its refusal is counted on the channel's counter.
+  if (viewer::CheckObserved(rbuf->data, rbuf->data_size, channel, msg, server_key_) !=
+      viewer::ObserverVerdict::kAccepted) {
+    auth_rejected_++;
+    auth::FreshnessFilter* counter = BadMacCounter<Msg>();
+    counter->Reject(auth::Reason::kBadMac);
+    LogRefusals(counter);
+    return;
+  }
   auth::FreshnessFilter* filter = FilterFor(msg);
-  if (filter == nullptr) {  // a key holder's 17th device
+  if (filter == nullptr) {  // a 17th certified device
     auth_rejected_++;
     return;
   }

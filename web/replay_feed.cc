@@ -12,6 +12,7 @@
 #include "json_writer.h"
 #include "message_json.h"
 #include "messages/validate.h"
+#include "observer_check.h"
 
 namespace snapthread::web {
 namespace {
@@ -37,6 +38,13 @@ bool Decode(const lcm::LogEvent& e, Msg* msg) {
   return messages::DecodeAndValidate(e.data, e.datalen, msg, nullptr);
 }
 
+// Whether the decoded message of `e` is genuine (observer_check.h).
+template <class Msg>
+bool Genuine(const lcm::LogEvent& e, const Msg& msg, const auth::PublicKey& server_key) {
+  return viewer::CheckObserved(e.data, static_cast<std::size_t>(e.datalen), e.channel, msg, server_key) ==
+         viewer::ObserverVerdict::kAccepted;
+}
+
 // The session of the log's first shape channel ("" when none).
 std::string FirstShapeSession(const std::string& path) {
   lcm::LogFile log(path, "r");
@@ -51,13 +59,13 @@ std::string FirstShapeSession(const std::string& path) {
 
 }  // namespace
 
-ReplayFeed::ReplayFeed(const std::string& path, const std::string& session, PublishFn publish)
-    : publish_(std::move(publish)), session_(session) {
+ReplayFeed::ReplayFeed(const std::string& path, const std::string& session,
+                       const auth::PublicKey& server_key, PublishFn publish)
+    : publish_(std::move(publish)), session_(session), server_key_(server_key) {
   if (session_.empty()) session_ = FirstShapeSession(path);
   lcm::LogFile log(path, "r");
   if (!log.good()) throw std::runtime_error("cannot read the log file " + path);
   int64_t first_us = -1;
-  double last_force_s = -1e9;
   while (const lcm::LogEvent* e = log.readNextEvent()) {
     FeedKind kind;
     std::string channel_session;
@@ -65,41 +73,57 @@ ReplayFeed::ReplayFeed(const std::string& path, const std::string& session, Publ
     if (channel_session != session_) continue;
     if (first_us < 0) first_us = e->timestamp;
     const int64_t t_us = e->timestamp - first_us;
-    std::string json;
-    bool ok = false;
-    if (kind == FeedKind::kShape) {
-      thread_shape_t m;
-      ok = Decode(*e, &m) && m.num_nodes > 0;
-      if (ok) {
-        json = ShapeJson(m, DrawsSmooth(m.model));
-        shape_events_.push_back(static_cast<int64_t>(events_.size()));
-        last_seq_ = m.seq;
-      }
-    } else if (kind == FeedKind::kForceModel) {
-      if (1e-6 * t_us - last_force_s < kForceModelMinIntervalS) continue;
-      force_model_t m;
-      ok = Decode(*e, &m);
-      if (ok) json = ForceModelJson(m), last_force_s = 1e-6 * t_us;
-    } else if (kind == FeedKind::kSolverStatus) {
-      solver_status_t m;
-      ok = Decode(*e, &m);
-      if (ok) json = SolverStatusJson(m);
-    } else {
-      device_status_t m;
-      ok = Decode(*e, &m);
-      if (ok) json = DeviceStatusJson(m);
-    }
-    if (!ok) {
-      counts_.malformed++;
-      continue;
-    }
+    bool skip = false;
+    std::string json = Vet(*e, kind, t_us, &skip);
+    if (skip || json.empty()) continue;
     counts_.received[Index(kind)]++;
     events_.push_back({t_us, kind, std::make_shared<const std::string>(std::move(json))});
   }
   if (shape_events_.empty()) {
     throw std::runtime_error(path + " holds no valid thread_shape_t of " +
-                             (session_.empty() ? std::string("any session") : "session " + session_));
+                             (session_.empty() ? std::string("any session") : "session " + session_) +
+                             " signed by the server of --key" +
+                             (counts_.auth_rejected > 0
+                                  ? " (" + std::to_string(counts_.auth_rejected) +
+                                        " messages refused: is it the log of another session's server?)"
+                                  : std::string()));
   }
+}
+
+std::string ReplayFeed::Vet(const lcm::LogEvent& e, FeedKind kind, int64_t t_us, bool* skip) {
+  const auto vet = [&](auto* m) -> bool {
+    if (!Decode(e, m)) {
+      counts_.malformed++;
+      return false;
+    }
+    if (!Genuine(e, *m, server_key_)) {
+      counts_.auth_rejected++;
+      return false;
+    }
+    return true;
+  };
+  if (kind == FeedKind::kShape) {
+    thread_shape_t m;
+    if (!vet(&m) || m.num_nodes <= 0) return "";
+    shape_events_.push_back(static_cast<int64_t>(events_.size()));
+    last_seq_ = m.seq;
+    return ShapeJson(m, DrawsSmooth(m.model));
+  }
+  if (kind == FeedKind::kForceModel) {
+    // Models the server did not sign are the device's, not the observers'.
+    *skip = viewer::SignaturesAbsent(e.data, static_cast<std::size_t>(e.datalen)) ||
+            1e-6 * t_us - last_force_s_ < kForceModelMinIntervalS;
+    force_model_t m;
+    if (*skip || !vet(&m)) return "";
+    last_force_s_ = 1e-6 * t_us;
+    return ForceModelJson(m);
+  }
+  if (kind == FeedKind::kSolverStatus) {
+    solver_status_t m;
+    return vet(&m) ? SolverStatusJson(m) : "";
+  }
+  device_status_t m;
+  return vet(&m) ? DeviceStatusJson(m) : "";
 }
 
 ReplayFeed::~ReplayFeed() { Stop(); }

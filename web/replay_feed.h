@@ -3,7 +3,10 @@
 // models and statuses as the JSON the page reads, and plays them to `publish` at the
 // recorded pace times a speed, with pause, seek and speed commands from the page.
 // The log is read from disk as recorded: messages are validated (malformed ones skipped
-// and counted) but not authenticated, and seeking back is allowed (no freshness).
+// and counted) and checked as the live feed checks them (viewer/observer_check.h: the
+// server's signature, a device's certificate and signature; refused ones skipped and
+// counted, force models the server did not sign skipped uncounted), so an observer
+// credential reviews a log; seeking back is allowed (no freshness).
 #pragma once
 
 #include <atomic>
@@ -14,6 +17,9 @@
 #include <thread>
 #include <vector>
 
+#include <lcm/lcm-cpp.hpp>
+
+#include "auth/key_id.h"
 #include "client_pacer.h"
 #include "live_feed.h"
 
@@ -37,9 +43,11 @@ class ReplayFeed {
   static constexpr double kForceModelMinIntervalS = 1.0 / 120.0;
   static constexpr double kMaxSpeed = 64.0;
 
-  // Reads the whole log; `session` "" takes the session of the first shape channel.
-  // Throws std::runtime_error when the file cannot be read or holds no shape of a session.
-  ReplayFeed(const std::string& path, const std::string& session, PublishFn publish);
+  // Reads the whole log, keeping what `server_key` (the server's public key) vouches for;
+  // `session` "" takes the session of the first shape channel. Throws std::runtime_error
+  // when the file cannot be read or holds no genuine shape of a session.
+  ReplayFeed(const std::string& path, const std::string& session, const auth::PublicKey& server_key,
+             PublishFn publish);
   ~ReplayFeed();
   ReplayFeed(const ReplayFeed&) = delete;
   ReplayFeed& operator=(const ReplayFeed&) = delete;
@@ -64,10 +72,15 @@ class ReplayFeed {
   // kind before it (a seek).
   void PlayTo(int64_t t_us, bool latest_only);
   void PublishPosition();
+  // The JSON of one logged message of `kind` when it is valid and genuine, else "" (and
+  // counted); `skip` set for a force model not meant for observers or shown too soon.
+  std::string Vet(const lcm::LogEvent& e, FeedKind kind, int64_t t_us, bool* skip);
   ReplayPosition PositionLocked() const;
 
   PublishFn publish_;
   std::string session_;
+  auth::PublicKey server_key_;
+  double last_force_s_ = -1e9;
   std::vector<Event> events_;
   std::vector<int64_t> shape_events_;  // indices of the shapes in events_
   int64_t last_seq_ = -1;

@@ -11,7 +11,8 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "access_policy.h"
-#include "auth/key_file.h"
+#include "app/common_flags.h"
+#include "auth/key_set.h"
 #include "http_server.h"
 #include "hub.h"
 #include "live_feed.h"
@@ -60,17 +61,18 @@ bool ResolveToken(const asio::ip::address& address, WebOptions* o) {
 struct Feeds {
   std::unique_ptr<LiveFeed> live;
   std::unique_ptr<ReplayFeed> replay;
-  std::optional<auth::SessionKey> key;
+  std::optional<auth::KeySet> keys;  // the observer credential (or the root key)
   std::shared_ptr<Hub> hub;
   const std::string& session(const WebOptions& o) const { return replay ? replay->session() : o.common.session; }
 };
 
-// Opens the feed of `o` into `f`; throws with the reason when it cannot.
+// Opens the feed of `o` into `f` with the keys in `f`; throws with the reason when it cannot.
 void OpenFeeds(asio::io_context& io, const WebOptions& o, Feeds* f) {
   auto publish = [f](FeedKind k, Text t) { f->hub->Publish(k, std::move(t)); };
+  const auth::PublicKey& server_key = f->keys->server_public_key();
   if (!o.log_path.empty()) {
     // The hub is set below, once it exists: the feed publishes to it.
-    f->replay = std::make_unique<ReplayFeed>(o.log_path, o.common.session, publish);
+    f->replay = std::make_unique<ReplayFeed>(o.log_path, o.common.session, server_key, publish);
     f->hub = std::make_shared<Hub>(io, "replay", f->replay->session(), [f] { return f->replay->counts(); });
     f->hub->SetCommandHandler([f](const std::string& c) { return f->replay->Command(c); });
     const ReplayPosition p = f->replay->position();
@@ -79,9 +81,8 @@ void OpenFeeds(asio::io_context& io, const WebOptions& o, Feeds* f) {
                 o.log_path.c_str(), messages::EscapeForDisplay(f->replay->session()).c_str(),
                 static_cast<long long>(p.shape_count), p.duration_s, static_cast<long long>(p.last_seq));
   } else {
-    f->key.emplace(auth::LoadKey(auth::ResolveKeyPath(o.common.key_path)));
     f->hub = std::make_shared<Hub>(io, "live", o.common.session, [f] { return f->live->counts(); });
-    f->live = std::make_unique<LiveFeed>(o.lcm_url, o.common.session, *f->key, publish);
+    f->live = std::make_unique<LiveFeed>(o.lcm_url, o.common.session, server_key, publish);
   }
 }
 
@@ -137,6 +138,10 @@ int RunWeb(WebOptions o) {
   }
   if (!ResolveToken(address, &o)) return 1;
   Feeds feeds;
+  // An observer credential (or the root key): a device's or an operator's is refused,
+  // naming the observer role.
+  feeds.keys = app::LoadKeySet(o.common, auth::Role::kObserver, "snapthread-web");
+  if (!feeds.keys) return 1;
   std::shared_ptr<const PageFiles> files;
   std::optional<HttpServer> server;
   try {

@@ -41,7 +41,8 @@ void AddWebFlags(CLI::App* app, snapthread::web::WebOptions* o) {
       ->capture_default_str()->check(CLI::Range(1, 4096));
   snapthread::app::CommonFlagSet common;
   common.session_from_environment = true;
-  common.key_note = "; not needed with --log";
+  common.key_note = "; an observer credential (snapthread-keygen --role observer) or the root key; "
+                    "with --log it verifies the log";
   snapthread::app::AddCommonFlags(app, &o->common, common);
   app->add_option("--log", o->log_path,
                   "replay this LCM log (snapthread-logger / lcm-logger) instead of the live session; "

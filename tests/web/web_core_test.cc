@@ -13,6 +13,9 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/credential.h"
+#include "auth/key_set.h"
+#include "auth/message_mac.h"
 #include "client_pacer.h"
 #include "json_writer.h"
 #include "message_json.h"
@@ -160,9 +163,27 @@ TEST(PageFiles, ServesOnlyTheFilesOfTheFolder) {
   EXPECT_THROW(PageFiles{empty.path()}, std::runtime_error);
 }
 
-// A log of `shapes` shapes of session S 10 ms apart, with a status, a shape of another
-// session and a malformed shape mixed in.
-std::string WriteLog(const std::string& dir, int shapes) {
+// The keys of a logged session: its server (root key) and the observer credential that
+// reviews the log, and another session's server.
+struct LogKeys {
+  auth::SessionKey root = auth::SessionKey::Generate();
+  auth::KeySet server = auth::KeySet::FromRoot(auth::SessionKey::FromBytes(root.data(), auth::SessionKey::kBytes));
+  auth::KeySet observer =
+      auth::KeySet::FromCredential(auth::IssueCredential(root, auth::Role::kObserver, "", auth::kNeverExpires));
+  auth::KeySet other_server = auth::KeySet::FromRoot(auth::SessionKey::Generate());
+};
+
+// msg signed by `server` for `channel` (sequence `seq`), encoded.
+template <class Msg>
+std::vector<uint8_t> Signed(Msg msg, const std::string& channel, int64_t seq, const auth::KeySet& server) {
+  EXPECT_TRUE(auth::Sign(&msg, channel, 77, seq, server.tagger()));
+  return test_support::Encode(msg);
+}
+
+// A log of `shapes` shapes of session S 10 ms apart signed by keys.server, with a status,
+// a shape of another session, a malformed shape, a shape signed by another session's
+// server and a force model the server did not sign mixed in.
+std::string WriteLog(const std::string& dir, int shapes, const LogKeys& keys) {
   const std::string path = dir + "/session.lcmlog";
   lcm::LogFile log(path, "w");
   auto write = [&](const std::string& channel, const std::vector<uint8_t>& bytes, int64_t t_us) {
@@ -174,13 +195,18 @@ std::string WriteLog(const std::string& dir, int shapes) {
     e.data = const_cast<uint8_t*>(bytes.data());
     log.writeEvent(&e);
   };
-  write("S_SOLVER_STATUS", test_support::Encode(test_support::Sample<solver_status_t>()), 0);
+  write("S_SOLVER_STATUS", Signed(test_support::Sample<solver_status_t>(), "S_SOLVER_STATUS", 1, keys.server), 0);
   for (int i = 0; i < shapes; ++i) {
     thread_shape_t s = test_support::SampleShape(4);
     s.seq = 100 + i;
-    write("S_SHAPE", test_support::Encode(s), 10'000 * i);
-    if (i == 2) write("OTHER_SHAPE", test_support::Encode(s), 10'000 * i + 1);
+    write("S_SHAPE", Signed(s, "S_SHAPE", 2 + i, keys.server), 10'000 * i);
+    if (i == 2) write("OTHER_SHAPE", Signed(s, "OTHER_SHAPE", 2 + i, keys.server), 10'000 * i + 1);
     if (i == 3) write("S_SHAPE", {1, 2, 3}, 10'000 * i + 2);
+    if (i == 4) {
+      s.seq = 999;
+      write("S_SHAPE", Signed(s, "S_SHAPE", 1000, keys.other_server), 10'000 * i + 3);
+      write("S_FORCE_MODEL", test_support::Encode(test_support::Sample<force_model_t>()), 10'000 * i + 4);
+    }
   }
   return path;
 }
@@ -201,13 +227,19 @@ struct Received {
   }
 };
 
+// Reviewed with an observer credential: the server's signed messages play; the shape signed
+// by another session's server is refused and counted, the unsigned force model skipped.
 TEST(ReplayFeed, PlaysTheSessionToItsLastShapeAndSeeksBack) {
   test_support::ScopedTempDir dir("web-replay");
-  const std::string path = WriteLog(dir.path(), 20);
+  const LogKeys keys;
+  const std::string path = WriteLog(dir.path(), 20, keys);
   Received received;
-  ReplayFeed replay(path, "", [&](FeedKind k, Text t) { received.Add(k, std::move(t)); });
+  ReplayFeed replay(path, "", keys.observer.server_public_key(),
+                    [&](FeedKind k, Text t) { received.Add(k, std::move(t)); });
   EXPECT_EQ(replay.session(), "S");
   EXPECT_EQ(replay.counts().malformed, 1);
+  EXPECT_EQ(replay.counts().auth_rejected, 1) << "the shape signed by another server";
+  EXPECT_EQ(replay.counts().received[Index(FeedKind::kForceModel)], 0) << "the unsigned force model";
   EXPECT_EQ(replay.counts().received[Index(FeedKind::kShape)], 20) << "OTHER_SHAPE is not S's";
   EXPECT_EQ(replay.counts().received[Index(FeedKind::kSolverStatus)], 1)
       << "the status before the first shape is the session's too";
@@ -237,9 +269,26 @@ TEST(ReplayFeed, PlaysTheSessionToItsLastShapeAndSeeksBack) {
 
 TEST(ReplayFeed, RefusesALogWithoutShapes) {
   test_support::ScopedTempDir dir("web-replay-empty");
-  const std::string path = WriteLog(dir.path(), 0);
-  EXPECT_THROW(ReplayFeed(path, "", [](FeedKind, Text) {}), std::runtime_error);
-  EXPECT_THROW(ReplayFeed(dir.path() + "/missing.lcmlog", "", [](FeedKind, Text) {}), std::runtime_error);
+  const LogKeys keys;
+  const auth::PublicKey& server = keys.observer.server_public_key();
+  const std::string path = WriteLog(dir.path(), 0, keys);
+  EXPECT_THROW(ReplayFeed(path, "", server, [](FeedKind, Text) {}), std::runtime_error);
+  EXPECT_THROW(ReplayFeed(dir.path() + "/missing.lcmlog", "", server, [](FeedKind, Text) {}), std::runtime_error);
+}
+
+// An observer credential of another session finds no genuine shape in the log: refused,
+// saying how many messages its key refused.
+TEST(ReplayFeed, RefusesALogOfAnotherSessionsServer) {
+  test_support::ScopedTempDir dir("web-replay-foreign");
+  const LogKeys keys;
+  const LogKeys other;
+  const std::string path = WriteLog(dir.path(), 5, keys);
+  try {
+    ReplayFeed replay(path, "", other.observer.server_public_key(), [](FeedKind, Text) {});
+    ADD_FAILURE() << "a log of another server was replayed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("refused"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

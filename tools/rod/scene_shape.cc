@@ -16,6 +16,7 @@
 #include "../sweep.h"
 #include "../tool_main.h"
 #include "auth/key_file.h"
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "messages/channels.h"
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
   app.add_option("--row", row, "the path row to show (-1: the last)")->capture_default_str();
   app.add_option("--session", session, "session name (channel prefix)")->capture_default_str();
   app.add_option("--lcm-url", lcm_url, "LCM URL (default: env LCM_DEFAULT_URL, else udpm loopback)");
-  app.add_option("--key", key_path, "session key file (default: $SNAPTHREAD_KEY_FILE, else XDG)");
+  app.add_option("--key", key_path, "the root key file (default: $SNAPTHREAD_KEY_FILE, else XDG)");
   app.add_option("--duration", duration_s, "publish for this many seconds")->capture_default_str();
   app.add_option("--rate-hz", rate_hz, "shapes per second")->capture_default_str()
       ->check(CLI::Range(1.0, 200.0));
@@ -60,7 +61,8 @@ int main(int argc, char** argv) {
                 last.negative_pivots, last.u.size() >= 6 ? last.u[3] * 180.0 / 3.14159265358979 : 0.0);
     std::fflush(stdout);
 
-    const auth::SessionKey key = auth::LoadKey(auth::ResolveKeyPath(key_path));
+    // Published as the server would: signed with the root key's server signer.
+    const auth::KeySet keys = auth::KeySet::FromRoot(auth::LoadKey(auth::ResolveKeyPath(key_path)));
     lcm::LCM lcm(messages::ResolveLcmUrl(lcm_url));
     if (!lcm.good()) throw std::runtime_error("cannot open LCM");
     const messages::Channels channels(session);
@@ -89,13 +91,13 @@ int main(int argc, char** argv) {
       st.residual = last.residual;
       st.lambda_min = last.lambda_min;
       st.negative_pivots = last.negative_pivots;
-      if (auth::Sign(&st, channels.solver_status, epoch, auth_seq.Next(), key)) {
+      if (auth::Sign(&st, channels.solver_status, epoch, auth_seq.Next(), keys.tagger())) {
         lcm.publish(channels.solver_status, &st);
       }
       in.seq = seq;
       in.utime = realtime::RealtimeMicros();
       thread_shape_t shape = server::BuildShape(in);
-      if (auth::Sign(&shape, channels.shape, epoch, auth_seq.Next(), key)) {
+      if (auth::Sign(&shape, channels.shape, epoch, auth_seq.Next(), keys.tagger())) {
         lcm.publish(channels.shape, &shape);
       }
       std::this_thread::sleep_for(std::chrono::duration<double>(1.0 / rate_hz));
