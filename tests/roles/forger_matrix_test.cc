@@ -13,6 +13,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <thread>
@@ -118,14 +119,32 @@ TEST_P(ForgerMatrixTest, NothingForgedIsAccepted) {
   EXPECT_EQ(s1->method, s0->method);
   const int64_t refused = TotalRefusals(s1->refusals) - TotalRefusals(s0->refusals);
   EXPECT_GE(refused, (sent.poses + sent.commands) / 2) << s0->refusals << " -> " << s1->refusals;
-  // By the role each forgery claimed: its own, and the device's (impersonated poses).
+  // By the role each forgery claimed and why: its own role where it may not speak
+  // (wrong-role), another grasp (wrong-grasp), a key no root of this session gives
+  // (unknown-key: another root's, none, or its own key under a name it is not).
   auto grew = [&](const std::string& key) { return Refusals(s1->refusals, key) > Refusals(s0->refusals, key); };
-  EXPECT_TRUE(grew("device")) << s1->refusals;
+  EXPECT_TRUE(grew("device")) << s1->refusals;  // its poses in the name of "hand"
   switch (GetParam()) {
-    case Holder::kObserver: EXPECT_TRUE(grew("observer")) << s1->refusals; break;
-    case Holder::kOperator: EXPECT_TRUE(grew("operator")) << s1->refusals; break;
-    case Holder::kOtherDevice: EXPECT_TRUE(grew("device/wrong-grasp")) << s1->refusals; [[fallthrough]];
-    default: EXPECT_TRUE(grew("operator")) << s1->refusals; break;  // forged commands
+    case Holder::kObserver:
+      EXPECT_TRUE(grew("observer/wrong-role")) << s1->refusals;
+      break;
+    case Holder::kOperator:
+      EXPECT_TRUE(grew("operator/wrong-role")) << s1->refusals;
+      EXPECT_TRUE(grew("device/unknown-key")) << s1->refusals;
+      break;
+    case Holder::kOtherDevice:
+      EXPECT_TRUE(grew("device/wrong-grasp")) << s1->refusals;
+      EXPECT_TRUE(grew("device/wrong-role")) << s1->refusals;  // its commands
+      EXPECT_TRUE(grew("device/unknown-key")) << s1->refusals;
+      break;
+    case Holder::kForeignDevice:
+      EXPECT_TRUE(grew("device/unknown-key")) << s1->refusals;
+      EXPECT_TRUE(grew("device/wrong-role")) << s1->refusals;
+      break;
+    case Holder::kNone:
+      EXPECT_TRUE(grew("device/unknown-key")) << s1->refusals;
+      EXPECT_TRUE(grew("operator/unknown-key")) << s1->refusals;
+      break;
   }
 
   // The device, with only the forger answering its poses.
@@ -153,6 +172,12 @@ TEST_P(ForgerMatrixTest, NothingForgedIsAccepted) {
   EXPECT_GT(watch_->device_statuses().forged_heard, 10);
   EXPECT_EQ(watch_->device_statuses().forged_verified, 0);
   EXPECT_GT(watch_->statuses().verified, 5);
+  std::printf("forger %s: sent %lld poses, %lld commands, %lld models; server refusals \"%s\" -> \"%s\"; "
+              "device models_rejected %lld -> %lld\n",
+              HolderName({GetParam(), 0}).c_str(), static_cast<long long>(sent.poses),
+              static_cast<long long>(sent.commands), static_cast<long long>(models.models), s0->refusals.c_str(),
+              s1->refusals.c_str(), static_cast<long long>(d0->models_rejected),
+              static_cast<long long>(d1->models_rejected));
   // The session goes on.
   EXPECT_TRUE(ModelsFlow(20)) << device->Out();
   EXPECT_TRUE(test_support::TerminateTogether({server.get(), device.get()}, 10.0));
