@@ -49,7 +49,9 @@ std::unique_ptr<ChildProcess> RoleSessionTest::StartDevice(const std::string& ke
                                 "--summary", dir() + "/" + tag + ".json"};
   // A test may shorten the staleness (the revocation test).
   if (std::find(extra.begin(), extra.end(), "--model-timeout-ms") == extra.end()) {
-    argv.insert(argv.end(), {"--model-timeout-ms", "400", "--fade-ms", "100"});
+    // Staleness is about speed: scaled for a slower build (SNAPTHREAD_SPEED_SCALE).
+    argv.insert(argv.end(), {"--model-timeout-ms", std::to_string(static_cast<int>(400 * test_support::SpeedScale())),
+                             "--fade-ms", "100"});
   }
   argv.insert(argv.end(), extra.begin(), extra.end());
   auto device = std::make_unique<ChildProcess>(argv, test_support::OneLog(dir() + "/" + tag + ".log", true));
