@@ -8,8 +8,9 @@
 //     scene and method stay, and its refusals grow by the claimed role;
 //   * the device applies none of its models: with the server stopped, so that only the
 //     forger answers the device's poses, models_received stays and models_rejected grows;
-//   * an observer verifying with the server's public key accepts none of its shapes,
-//     solver statuses or device statuses.
+//   * an observer verifying with the server's public key (the test's own, and the web
+//     bridge on an observer credential) accepts none of its shapes, solver statuses or
+//     device statuses.
 #include <signal.h>
 
 #include <chrono>
@@ -22,6 +23,7 @@
 
 #include "forger.h"
 #include "role_session.h"
+#include "web_feed.h"
 #include "test_support.h"
 
 namespace snapthread::roles_test {
@@ -99,6 +101,10 @@ TEST_P(ForgerMatrixTest, NothingForgedIsAccepted) {
   auto server = StartServer(creds_->root_path());
   auto device = StartDevice(device_key, "hand");
   ASSERT_TRUE(WaitForModels("hand", 30)) << device->Out() << server->Out();
+#ifdef SNAPTHREAD_ROLES_TEST_WEB
+  WebFeed web(bin_, creds_->Issue(auth::Role::kObserver, "", "web-observer.cred"), session_, dir());
+  ASSERT_TRUE(web.ok()) << web.error();
+#endif
 
   // The server, with only the forger speaking (it reads the epoch off the statuses).
   device->Signal(SIGSTOP);
@@ -172,6 +178,11 @@ TEST_P(ForgerMatrixTest, NothingForgedIsAccepted) {
   EXPECT_GT(watch_->device_statuses().forged_heard, 10);
   EXPECT_EQ(watch_->device_statuses().forged_verified, 0);
   EXPECT_GT(watch_->statuses().verified, 5);
+#ifdef SNAPTHREAD_ROLES_TEST_WEB
+  // The web bridge passed on the genuine shapes and nothing forged.
+  EXPECT_GT(web.shapes(), 5) << web.process().Err();
+  EXPECT_EQ(web.forged(), 0) << web.process().Err();
+#endif
   std::printf("forger %s: sent %lld poses, %lld commands, %lld models; server refusals \"%s\" -> \"%s\"; "
               "device models_rejected %lld -> %lld\n",
               HolderName({GetParam(), 0}).c_str(), static_cast<long long>(sent.poses),
@@ -180,7 +191,11 @@ TEST_P(ForgerMatrixTest, NothingForgedIsAccepted) {
               static_cast<long long>(d1->models_rejected));
   // The session goes on.
   EXPECT_TRUE(ModelsFlow(20)) << device->Out();
+#ifdef SNAPTHREAD_ROLES_TEST_WEB
+  EXPECT_TRUE(test_support::TerminateTogether({server.get(), device.get(), &web.process()}, 10.0));
+#else
   EXPECT_TRUE(test_support::TerminateTogether({server.get(), device.get()}, 10.0));
+#endif
 }
 
 INSTANTIATE_TEST_SUITE_P(Holders, ForgerMatrixTest,

@@ -1,7 +1,7 @@
 // Issue 25's "Done when" on real processes over udpm on loopback: the session runs from
 // role credentials (the server on the root key, the device on its credential "hand", the
 // viewer on an observer credential, snapthread-ctl on an operator's); the device gets
-// force models with no fade, the viewer shows the live thread, an operator loads a scene
+// force models with no fade, the viewer and the web bridge show the live thread, an operator loads a scene
 // and an observer cannot.
 #include <signal.h>
 
@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "role_session.h"
+#include "web_feed.h"
 #include "test_support.h"
 
 namespace snapthread::roles_test {
@@ -40,6 +41,11 @@ TEST_F(RolesSessionTest, SessionRunsFromRoleCredentials) {
                                   "--after-shapes", "5", "--timeout-s", "60"}),
                       test_support::OneLog(dir() + "/viewer.log", true));
   ASSERT_TRUE(viewer.started());
+#ifdef SNAPTHREAD_ROLES_TEST_WEB
+  // The web bridge on the observer credential, read as its page reads it.
+  WebFeed web(bin_, observer_key, session_, dir());
+  ASSERT_TRUE(web.ok()) << web.error();
+#endif
 
   ASSERT_TRUE(WaitForModels("hand", 30)) << device->Out() << server->Out();
   // Steady state: models keep arriving, no fade, nothing refused (the device's poses
@@ -76,6 +82,12 @@ TEST_F(RolesSessionTest, SessionRunsFromRoleCredentials) {
       },
       15))
       << (watch_->status() ? watch_->status()->scene : "no status");
+#ifdef SNAPTHREAD_ROLES_TEST_WEB
+  // The page shows the live thread, the new scene's too.
+  EXPECT_TRUE(test_support::WaitUntil([&] { return web.last_scene() == "zeeman"; }, 15))
+      << web.shapes() << " shapes, the last of scene " << web.last_scene() << "\n" << web.process().Err();
+  EXPECT_GT(web.shapes(), 5);
+#endif
   r = Ctl(operator_key, {"--timeout-s", "30", "status"});
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("scene: zeeman"), std::string::npos) << r.out;
@@ -90,7 +102,11 @@ TEST_F(RolesSessionTest, SessionRunsFromRoleCredentials) {
   EXPECT_EQ(watch_->statuses().refused, 0);
   EXPECT_GT(watch_->device_statuses().verified, 2);
   EXPECT_EQ(watch_->device_statuses().refused, 0);
+#ifdef SNAPTHREAD_ROLES_TEST_WEB
+  EXPECT_TRUE(test_support::TerminateTogether({server.get(), device.get(), &web.process()}, 10.0));
+#else
   EXPECT_TRUE(test_support::TerminateTogether({server.get(), device.get()}, 10.0));
+#endif
 }
 
 }  // namespace
