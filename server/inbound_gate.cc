@@ -49,7 +49,7 @@ void InboundGate::OnCommand(const void* data, size_t size) {
 }
 
 void InboundGate::Refuse(const std::string& channel, int8_t claimed_role, std::string_view name,
-                         Refusal refusal) {
+                         RefusalReason refusal, std::string_view detail) {
   counters_->refusals.Count(claimed_role, refusal);
   const int64_t total = counters_->rejected_messages.fetch_add(1) + 1;
   if (ShouldLog(&counters_->last_reject_log_us)) {
@@ -57,8 +57,9 @@ void InboundGate::Refuse(const std::string& channel, int8_t claimed_role, std::s
         claimed_role >= 0 && claimed_role <= static_cast<int8_t>(auth::Role::kOperator)
             ? auth::RoleToString(static_cast<auth::Role>(claimed_role))
             : std::string_view("unknown");
-    spdlog::warn("server: refused a message on {} from {} '{}': {} ({} refused since start: {})", channel,
-                 role, name, RefusalName(refusal), total, counters_->refusals.Format());
+    spdlog::warn("server: refused a message on {} from {} '{}': {}{}{} ({} refused since start: {})", channel,
+                 role, name, RefusalName(refusal), detail.empty() ? "" : ": ", detail, total,
+                 counters_->refusals.Format());
   }
 }
 
@@ -66,7 +67,7 @@ template <class Msg>
 const auth::SessionKey* InboundGate::Authenticate(const void* data, size_t size, const Msg& msg,
                                                   const std::string& channel, auth::Role role) {
   if (msg.sender_role != static_cast<int8_t>(role)) {
-    Refuse(channel, msg.sender_role, msg.sender_name, Refusal::kWrongRole);
+    Refuse(channel, msg.sender_role, msg.sender_name, RefusalReason::kWrongRole);
     return nullptr;
   }
   const auth::ResolvedKey resolved = keys_->Resolve(role, msg.sender_name, msg.key_expires,
@@ -76,7 +77,7 @@ const auth::SessionKey* InboundGate::Authenticate(const void* data, size_t size,
     return nullptr;
   }
   if (!auth::VerifyMac(data, size, channel, *resolved.key)) {
-    Refuse(channel, msg.sender_role, msg.sender_name, Refusal::kBadMac);
+    Refuse(channel, msg.sender_role, msg.sender_name, RefusalReason::kBadMac);
     return nullptr;
   }
   return resolved.key;
@@ -87,7 +88,7 @@ void InboundGate::AdmitDeviceState(const void* data, size_t size) {
   ReceivedPose sample;
   std::string why;
   if (!Decode(data, size, &sample.state, &why)) {
-    Refuse(channel, kUnknownRole, why, Refusal::kMalformed);
+    Refuse(channel, kUnknownRole, "", RefusalReason::kMalformed, why);
     return;
   }
   const device_state_t& s = sample.state;
@@ -96,7 +97,7 @@ void InboundGate::AdmitDeviceState(const void* data, size_t size) {
   // A device drives only its own grasp (a pose naming none is checked by the solve
   // thread, which knows the scene's grasps).
   if (!s.grasp.empty() && s.grasp != s.sender_name) {
-    Refuse(channel, s.sender_role, s.sender_name, Refusal::kWrongGrasp);
+    Refuse(channel, s.sender_role, s.sender_name, RefusalReason::kWrongGrasp);
     return;
   }
   auth::FreshnessFilter* filter = Filter(&device_filters_, s.sender_name);
@@ -104,7 +105,7 @@ void InboundGate::AdmitDeviceState(const void* data, size_t size) {
                                                        auth::KeyIdFromWire(s.key_id), *key)
                                  : nullptr;
   if (sample.key == nullptr) {
-    Refuse(channel, s.sender_role, s.sender_name, Refusal::kTooMany);
+    Refuse(channel, s.sender_role, s.sender_name, RefusalReason::kTooMany);
     return;
   }
   if (const auth::Reason fresh = filter->Admit(s.epoch, s.auth_seq); fresh != auth::Reason::kAccepted) {
@@ -121,13 +122,13 @@ void InboundGate::AdmitCommand(const void* data, size_t size) {
   command_t command;
   std::string why;
   if (!Decode(data, size, &command, &why)) {
-    Refuse(channel, kUnknownRole, why, Refusal::kMalformed);
+    Refuse(channel, kUnknownRole, "", RefusalReason::kMalformed, why);
     return;
   }
   if (Authenticate(data, size, command, channel, auth::Role::kOperator) == nullptr) return;
   auth::FreshnessFilter* filter = Filter(&operator_filters_, command.sender_name);
   if (filter == nullptr) {
-    Refuse(channel, command.sender_role, command.sender_name, Refusal::kTooMany);
+    Refuse(channel, command.sender_role, command.sender_name, RefusalReason::kTooMany);
     return;
   }
   if (const auth::Reason fresh = filter->Admit(command.epoch, command.auth_seq);

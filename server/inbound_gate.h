@@ -48,8 +48,10 @@ class InboundGate final : public InboundSink {
   void OnCommand(const void* data, size_t size) override;
 
  private:
-  // Counts a refusal (rejected_messages, the role/reason table) and logs it rate-limited.
-  void Refuse(const std::string& channel, int8_t claimed_role, std::string_view name, Refusal refusal);
+  // Counts a refusal (rejected_messages, the role/reason table) and logs it rate-limited
+  // (with `detail`, what was wrong, when given).
+  void Refuse(const std::string& channel, int8_t claimed_role, std::string_view name, RefusalReason refusal,
+              std::string_view detail = {});
   // The key of a message claimed by `role` (whose sender_role must be `role`) if its
   // MAC verifies under it; else refuses it and returns nullptr.
   template <class Msg>

@@ -16,23 +16,23 @@ std::string_view SlotName(int slot) {
 
 }  // namespace
 
-std::string_view RefusalName(Refusal refusal) { return kNames[static_cast<int>(refusal)]; }
+std::string_view RefusalName(RefusalReason refusal) { return kNames[static_cast<int>(refusal)]; }
 
-Refusal RefusalOf(auth::KeyVerdict verdict) {
+RefusalReason RefusalOf(auth::KeyVerdict verdict) {
   switch (verdict) {
-    case auth::KeyVerdict::kExpired: return Refusal::kExpired;
-    case auth::KeyVerdict::kRevoked: return Refusal::kRevoked;
-    case auth::KeyVerdict::kGraceOver: return Refusal::kGraceOver;
-    case auth::KeyVerdict::kInvalidClaim: return Refusal::kMalformed;
-    default: return Refusal::kUnknownKey;
+    case auth::KeyVerdict::kExpired: return RefusalReason::kExpired;
+    case auth::KeyVerdict::kRevoked: return RefusalReason::kRevoked;
+    case auth::KeyVerdict::kGraceOver: return RefusalReason::kGraceOver;
+    case auth::KeyVerdict::kInvalidClaim: return RefusalReason::kMalformed;
+    default: return RefusalReason::kUnknownKey;
   }
 }
 
-Refusal RefusalOf(auth::Reason reason) {
+RefusalReason RefusalOf(auth::Reason reason) {
   switch (reason) {
-    case auth::Reason::kBadMac: return Refusal::kBadMac;
-    case auth::Reason::kForeignEpoch: return Refusal::kForeignEpoch;
-    default: return Refusal::kReplay;
+    case auth::Reason::kBadMac: return RefusalReason::kBadMac;
+    case auth::Reason::kForeignEpoch: return RefusalReason::kForeignEpoch;
+    default: return RefusalReason::kReplay;
   }
 }
 
@@ -40,11 +40,11 @@ int RefusalCounts::Slot(int8_t claimed_role) {
   return claimed_role >= 0 && claimed_role < kRoleSlots - 1 ? claimed_role : kRoleSlots - 1;
 }
 
-void RefusalCounts::Count(int8_t claimed_role, Refusal refusal) {
+void RefusalCounts::Count(int8_t claimed_role, RefusalReason refusal) {
   counts_[Slot(claimed_role)][static_cast<int>(refusal)].fetch_add(1, std::memory_order_relaxed);
 }
 
-int64_t RefusalCounts::Get(int8_t claimed_role, Refusal refusal) const {
+int64_t RefusalCounts::Get(int8_t claimed_role, RefusalReason refusal) const {
   return counts_[Slot(claimed_role)][static_cast<int>(refusal)].load(std::memory_order_relaxed);
 }
 

@@ -17,7 +17,7 @@
 
 namespace snapthread::server {
 
-enum class Refusal : uint8_t {
+enum class RefusalReason : uint8_t {
   kMalformed,     // does not decode or validate
   kWrongRole,     // a role that may not speak on this channel
   kUnknownKey,    // no root gives the claimed key (another session's credential, a bad claim)
@@ -32,18 +32,18 @@ enum class Refusal : uint8_t {
 };
 inline constexpr int kRefusalCount = 11;
 // "malformed", "wrong-role", ... as published.
-std::string_view RefusalName(Refusal refusal);
+std::string_view RefusalName(RefusalReason refusal);
 // The refusal of a key ring verdict (not kAccepted) and of a freshness reason.
-Refusal RefusalOf(auth::KeyVerdict verdict);
-Refusal RefusalOf(auth::Reason reason);
+RefusalReason RefusalOf(auth::KeyVerdict verdict);
+RefusalReason RefusalOf(auth::Reason reason);
 
 class RefusalCounts {
  public:
   // Claimed sender_role values 0..3 (auth::Role), anything else counts as "unknown".
   static constexpr int kRoleSlots = 5;
 
-  void Count(int8_t claimed_role, Refusal refusal);
-  int64_t Get(int8_t claimed_role, Refusal refusal) const;
+  void Count(int8_t claimed_role, RefusalReason refusal);
+  int64_t Get(int8_t claimed_role, RefusalReason refusal) const;
   int64_t Total() const;
   // "device/bad-mac=3 observer/wrong-role=1" (non-zero counts only); "" when none.
   std::string Format() const;

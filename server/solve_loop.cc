@@ -218,7 +218,7 @@ void SolveLoop::RefuseForeignGrasps(std::vector<ReceivedPose>* poses) {
                                                                        : std::string_view(grasps[0].name);
   std::erase_if(*poses, [&](const ReceivedPose& p) {
     if (!p.state.grasp.empty() || p.state.sender_name == own) return false;
-    counters_->refusals.Count(p.state.sender_role, Refusal::kWrongGrasp);
+    counters_->refusals.Count(p.state.sender_role, RefusalReason::kWrongGrasp);
     CountRejection(counters_, channels_.device_state,
                    "wrong-grasp: device '" + p.state.sender_name + "' sent a pose for grasp '" +
                        std::string(own) + "'");

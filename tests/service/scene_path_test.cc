@@ -75,7 +75,8 @@ TEST(ScenePath, SweepAndServerFollowTheSameEquilibria) {
   const Scene scene = LoadScene(file);
   Recorder recorder;
   testing::MemoryServerTransport transport;
-  const test_support::SessionKeyFile key_file;  // the server's key; poses signed with it
+  const test_support::SessionKeyFile key_file;  // the server's root key
+  const auth::KeySet hand = testing::DeviceKeys(key_file.key());  // poses are the device "hand"'s
   auth::AuthSequence auth_seq;
   ServerParams params;
   params.key_path = key_file.path();
@@ -92,8 +93,7 @@ TEST(ScenePath, SweepAndServerFollowTheSameEquilibria) {
   const std::vector<Vec> path = PathControls(scene, 120);
   for (size_t i = 1; i < path.size(); ++i) {
     device_state_t s = Pose(static_cast<int64_t>(i), messages::ControlsToPosition(scene.device, scene.grasp_layout, path[i]));
-    ASSERT_TRUE(auth::Sign(&s, server.channels().device_state, server.epoch(), auth_seq.Next(),
-                           key_file.key()));
+    ASSERT_TRUE(auth::Sign(&s, server.channels().device_state, server.epoch(), auth_seq.Next(), hand.tagger()));
     transport.DeliverDeviceState(test_support::Encode(s));
     ASSERT_TRUE(recorder.WaitCount(i)) << "no update for pose " << i;
   }

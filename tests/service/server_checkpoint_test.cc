@@ -162,7 +162,7 @@ class ServerCheckpointTest : public ::testing::Test {
     s.orientation[0] = 1.0;
     s.buttons = 1;
     ASSERT_TRUE(auth::Sign(&s, server_->channels().device_state, server_->epoch(),
-                           auth_seq_.Next(), key_file_.key()));
+                           auth_seq_.Next(), device_.tagger()));
     const int64_t before = server_->Stats().updates;
     transport_->DeliverDeviceState(test_support::Encode(s));
     ASSERT_TRUE(test_support::WaitUntil([&] { return server_->Stats().updates > before; }, kWaitS,
@@ -217,6 +217,8 @@ class ServerCheckpointTest : public ::testing::Test {
   }
 
   test_support::SessionKeyFile key_file_;
+  const auth::KeySet device_ = testing::DeviceKeys(key_file_.key());
+  const auth::KeySet operator_ = testing::OperatorKeys(key_file_.key());
   test_support::ScopedTempDir state_{"server-checkpoint"};
   std::unique_ptr<testing::MemoryServerTransport> transport_;
   Scene scene_;
@@ -276,7 +278,7 @@ TEST_F(ServerCheckpointTest, LoadedSceneAndSwitchedMethodAreResumed) {
   auto command = [&](int8_t code, const std::string& argument, int64_t applied) {
     command_t c = test_support::MakeCommand(code, argument);
     ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
-                           key_file_.key()));
+                           operator_.tagger()));
     transport_->DeliverCommand(test_support::Encode(c));
     ASSERT_TRUE(test_support::WaitUntil(
         [&] { return server_->Stats().commands_applied >= applied; }, kWaitS));

@@ -87,10 +87,8 @@ class CommandsTest : public ::testing::Test {
         for (int i = 0; i < 3; ++i) s.position[i] = pose_[i];
         for (int i = 0; i < 4; ++i) s.orientation[i] = i == 0 ? 1.0 : 0.0;
         s.buttons = 1;
-        if (auth::Sign(&s, server_->channels().device_state, server_->epoch(), auth_seq_.Next(),
-                       key_file_.key())) {
-          transport_.DeliverDeviceState(test_support::Encode(s));
-        }
+        transport_.DeliverDeviceState(testing::Tagged(s, server_->channels().device_state, server_->epoch(),
+                                                      auth_seq_.Next(), device_.tagger()));
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
     });
@@ -105,24 +103,23 @@ class CommandsTest : public ::testing::Test {
   size_t Models() { return arrivals_.count(); }
   double MaxGapSince(size_t from) { return arrivals_.MaxGapSince(from); }
 
-  // Sends a command signed with `key` (the session's by default); returns its auth_seq.
-  int64_t Command(int8_t command, const std::string& argument,
-                  const auth::SessionKey* key = nullptr) {
+  // Sends a command tagged by `sender` (the session's operator by default); returns its auth_seq.
+  int64_t Command(int8_t command, const std::string& argument, const auth::KeySet* sender = nullptr) {
     command_t c = MakeCommand(command, argument);
     const int64_t seq = auth_seq_.Next();
-    EXPECT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), seq,
-                           key != nullptr ? *key : key_file_.key()));
-    transport_.DeliverCommand(test_support::Encode(c));
+    transport_.DeliverCommand(testing::Tagged(c, server_->channels().command, server_->epoch(), seq,
+                                              (sender != nullptr ? *sender : operator_).tagger()));
     return seq;
   }
-  // A reply as a console checks it: it decodes, validates and its MAC verifies.
+  // A reply as a console checks it: it decodes, validates and carries the server's
+  // signature (the session's server public key).
   void KeepReply(const std::vector<uint8_t>& bytes) {
     command_reply_t reply;
     std::string why;
     const bool valid =
         messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &reply, &why) &&
-        auth::VerifyEncoded(bytes.data(), bytes.size(), server_->channels().command_reply,
-                            key_file_.key());
+        auth::VerifySignature(bytes.data(), bytes.size(), server_->channels().command_reply,
+                              operator_.server_public_key());
     std::lock_guard<std::mutex> lock(mutex_);
     if (valid) {
       replies_.push_back(reply);
@@ -152,6 +149,8 @@ class CommandsTest : public ::testing::Test {
   }
 
   test_support::SessionKeyFile key_file_;
+  const auth::KeySet device_ = testing::DeviceKeys(key_file_.key());
+  const auth::KeySet operator_ = testing::OperatorKeys(key_file_.key());
   auth::AuthSequence auth_seq_;
   testing::MemoryServerTransport transport_;
   std::unique_ptr<test_support::ScopedTempDir> scene_dir_;
@@ -187,12 +186,18 @@ TEST_F(CommandsTest, EveryAuthenticatedCommandIsAnsweredAndNoOtherOne) {
   expect(load, command_t::LOAD_SCENE, true, "now scene 'zeeman'");
   expect(missing, command_t::LOAD_SCENE, false, "nothere");
   // After the load: the RESET goes back to the start of the new scene.
-  auth::SessionKey other = auth::SessionKey::Generate();
+  // Refused and not answered: an operator of another session, and the session's device
+  // (only an operator sends commands).
+  const auth::KeySet other = testing::OperatorKeys(auth::SessionKey::Generate());
   const int64_t forged = Command(command_t::RESET, "", &other);
+  const int64_t by_device = Command(command_t::RESET, "", &device_);
   const int64_t reset = Command(command_t::RESET, "");
   expect(reset, command_t::RESET, true, "start of scene 'zeeman'");
-  // A sender without the key learns nothing: its command is refused and not answered.
   EXPECT_FALSE(ReplyTo(forged, 0.5).has_value());
+  EXPECT_FALSE(ReplyTo(by_device, 0.1).has_value());
+  const std::string refusals = server_->Stats().refusals;
+  EXPECT_NE(refusals.find("operator/unknown-key=1"), std::string::npos) << refusals;
+  EXPECT_NE(refusals.find("device/wrong-role=1"), std::string::npos) << refusals;
   std::lock_guard<std::mutex> lock(mutex_);
   EXPECT_EQ(replies_.size(), 6u);
   EXPECT_EQ(invalid_replies_, 0);

@@ -15,6 +15,9 @@
 #include <utility>
 #include <vector>
 
+#include "auth/key_set.h"
+#include "auth/message_mac.h"
+#include "auth/role.h"
 #include "sample_messages.h"
 #include "server_transport.h"
 
@@ -95,5 +98,23 @@ class MemoryServerTransport final : public ServerTransport {
   std::condition_variable cv_;
   std::deque<Datagram> inbox_;
 };
+
+// Credentials issued from the session's root, as snapthread-keygen issues them: a device
+// (named as the grasp it drives; "hand" for a scene's single unnamed grasp) and an operator.
+inline auth::KeySet DeviceKeys(const auth::SessionKey& root, const std::string& name = "hand",
+                               int64_t expires_unix_s = auth::kNeverExpires) {
+  return auth::KeySet::ForRole(root, auth::Role::kDevice, name, expires_unix_s);
+}
+inline auth::KeySet OperatorKeys(const auth::SessionKey& root, const std::string& name = "ops") {
+  return auth::KeySet::ForRole(root, auth::Role::kOperator, name);
+}
+
+// `msg` tagged by `sender` for `channel` and encoded as it goes on the wire.
+template <class Msg>
+std::vector<uint8_t> Tagged(Msg msg, const std::string& channel, int64_t epoch, int64_t auth_seq,
+                            const auth::Tagger& sender) {
+  if (!auth::Sign(&msg, channel, epoch, auth_seq, sender)) return {};
+  return test_support::Encode(msg);
+}
 
 }  // namespace snapthread::server::testing

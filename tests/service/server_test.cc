@@ -30,6 +30,7 @@
 #include "scene/scene.h"
 #include "tracking/tracker.h"
 #include "messages/validate.h"
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "environment.h"
@@ -85,18 +86,15 @@ class ServerTest : public ::testing::Test {
     server_.reset();
   }
 
-  // Signed with the session key and the server's epoch, as a genuine device does.
+  // Tagged by the device "hand" with the server's epoch, as a genuine device does.
   void Publish(const device_state_t& s) {
-    device_state_t signed_state = s;
-    ASSERT_TRUE(auth::Sign(&signed_state, server_->channels().device_state, server_->epoch(),
-                           auth_seq_.Next(), key_file_.key()));
-    transport_.DeliverDeviceState(test_support::Encode(signed_state));
+    transport_.DeliverDeviceState(testing::Tagged(s, server_->channels().device_state, server_->epoch(),
+                                                  auth_seq_.Next(), device_.tagger()));
   }
+  // Tagged by the operator "ops".
   void Command(int8_t command, const std::string& argument) {
-    command_t c = MakeCommand(command, argument);
-    ASSERT_TRUE(auth::Sign(&c, server_->channels().command, server_->epoch(), auth_seq_.Next(),
-                           key_file_.key()));
-    transport_.DeliverCommand(test_support::Encode(c));
+    transport_.DeliverCommand(testing::Tagged(MakeCommand(command, argument), server_->channels().command,
+                                              server_->epoch(), auth_seq_.Next(), operator_.tagger()));
   }
   void PublishRaw(const std::string& channel, const std::vector<uint8_t>& bytes) {
     if (channel == server_->channels().command) {
@@ -108,6 +106,8 @@ class ServerTest : public ::testing::Test {
   }
 
   test_support::SessionKeyFile key_file_;
+  const auth::KeySet device_ = testing::DeviceKeys(key_file_.key());
+  const auth::KeySet operator_ = testing::OperatorKeys(key_file_.key());
   auth::AuthSequence auth_seq_;
   testing::MemoryServerTransport transport_;
   std::unique_ptr<Server> server_;
@@ -494,6 +494,7 @@ TEST_F(ServerTest, BadPacketsAreCountedAndDropped) {
   EXPECT_EQ(stats.updates, 1);
   EXPECT_EQ(stats.commands_applied + stats.commands_refused, 0);
   EXPECT_EQ(stats.rejected_messages, bad);
+  EXPECT_EQ(stats.refusals, "unknown/malformed=" + std::to_string(bad));
   EXPECT_EQ(probe_->models().size(), 1u);
   EXPECT_EQ(probe_->invalid(), 0);
 }

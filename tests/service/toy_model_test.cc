@@ -194,7 +194,8 @@ TEST(ToyModel, InProcessServerAnswersWithTheEquilibriumForce) {
   std::condition_variable cv;
   std::vector<Row> rows;
   server::testing::MemoryServerTransport transport;
-  const test_support::SessionKeyFile key_file;  // the server's key; poses signed with it
+  const test_support::SessionKeyFile key_file;  // the server's root key
+  const auth::KeySet hand = server::testing::DeviceKeys(key_file.key());  // poses are the device "hand"'s
   auth::AuthSequence auth_seq;
   server::ServerParams params;
   params.key_path = key_file.path();
@@ -219,8 +220,7 @@ TEST(ToyModel, InProcessServerAnswersWithTheEquilibriumForce) {
     for (int a = 0; a < 3; ++a) s.position[a] = p[a];
     s.orientation[0] = 1.0;
     s.buttons = 1;
-    ASSERT_TRUE(auth::Sign(&s, srv.channels().device_state, srv.epoch(), auth_seq.Next(),
-                           key_file.key()));
+    ASSERT_TRUE(auth::Sign(&s, srv.channels().device_state, srv.epoch(), auth_seq.Next(), hand.tagger()));
     transport.DeliverDeviceState(test_support::Encode(s));
     std::unique_lock<std::mutex> lock(mutex);
     ASSERT_TRUE(cv.wait_for(lock, 20s, [&] { return rows.size() >= i; })) << "no update for pose " << i;
