@@ -15,6 +15,7 @@
 #include "app/exit_codes.h"
 #include "app/stop_signals.h"
 #include "auth/key_file.h"
+#include "auth/key_id.h"
 #include "auth/key_set.h"
 #include "auth/role.h"
 #include "device_client.h"
@@ -160,7 +161,7 @@ int LoadDeviceKeys(const DeviceClientOptions& o, ClientSetup* setup) {
       return app::kExitUsage;
     }
     spdlog::info("device: {} ({}) as device '{}', key id {}", where.path, where.origin, keys.name(),
-                 auth::KeyIdToWire(keys.tagger().key_id));
+                 auth::KeyIdToHex(keys.tagger().key_id));
     setup->keys = std::make_unique<DeviceKeys>(std::move(keys), static_cast<int64_t>(1e6 * o.key_grace_s));
     setup->key_path = where.path;
   } catch (const std::exception& e) {
@@ -177,7 +178,7 @@ void ReloadDeviceKeys(const ClientSetup& setup) {
   try {
     auth::KeySet next =
         AsDevice(auth::LoadKeySet(setup.key_path, auth::Role::kDevice, kProgram), setup.keys->name());
-    const int64_t id = auth::KeyIdToWire(next.tagger().key_id);
+    const std::string id = auth::KeyIdToHex(next.tagger().key_id);
     std::string error;
     if (!setup.keys->Replace(std::move(next), realtime::MonotonicMicros(), &error)) {
       spdlog::error("device: reload of {} refused, keeping the current credential: {}", setup.key_path, error);
