@@ -179,8 +179,18 @@ std::string DrivenGraspName(const Scene& scene) {
 std::optional<auth::KeySet> LoadViewerKeys(const ViewerOptions& options, const Scene* driven) {
   const auth::Role role = driven != nullptr ? auth::Role::kDevice : auth::Role::kObserver;
   std::optional<auth::KeySet> keys = app::LoadKeySet(options.common, role, kProgram);
-  if (keys && driven != nullptr && keys->root() != nullptr) {
-    keys.emplace(auth::KeySet::ForRole(*keys->root(), auth::Role::kDevice, DrivenGraspName(*driven)));
+  if (driven == nullptr) return keys;
+  if (!keys) {
+    std::fprintf(stderr, "snapthread-viewer: --grasp-mode drives a grasp as its device: --key needs that "
+                         "device's credential (or watch without --grasp-mode on an observer credential)\n");
+    return keys;
+  }
+  const std::string grasp = DrivenGraspName(*driven);
+  if (keys->root() != nullptr) {
+    keys.emplace(auth::KeySet::ForRole(*keys->root(), auth::Role::kDevice, grasp));
+  } else if (keys->name() != grasp) {
+    std::fprintf(stderr, "snapthread-viewer: warning: the device credential is for '%s', the grasp driven is "
+                         "'%s': the server will refuse these poses\n", keys->name().c_str(), grasp.c_str());
   }
   return keys;
 }

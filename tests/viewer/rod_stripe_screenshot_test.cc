@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "hud_layout.h"
@@ -87,17 +88,20 @@ class RodPublisher {
       st.seq = seq;
       st.scene = "test-rod";
       st.method = "newton";
-      if (auth::Sign(&st, channels_.solver_status, epoch_, auth_seq_.Next(), key_file_.key())) {
+      if (auth::Sign(&st, channels_.solver_status, epoch_, auth_seq_.Next(), server_.tagger())) {
         lcm_.publish(channels_.solver_status, &st);
       }
       thread_shape_t s = RodShape(++seq, tau_);
-      if (auth::Sign(&s, channels_.shape, epoch_, auth_seq_.Next(), key_file_.key())) {
+      if (auth::Sign(&s, channels_.shape, epoch_, auth_seq_.Next(), server_.tagger())) {
         lcm_.publish(channels_.shape, &s);
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
   const SessionKeyFile key_file_;
+  // Signs as the server would (the viewer, on the root key, verifies its derived key).
+  const auth::KeySet server_ =
+      auth::KeySet::FromRoot(auth::SessionKey::FromBytes(key_file_.key().data(), auth::SessionKey::kBytes));
   const int64_t epoch_ = auth::NewEpoch();
   auth::AuthSequence auth_seq_;
   lcm::LCM lcm_{kLoopbackLcmUrl};

@@ -41,6 +41,10 @@ trap cleanup EXIT
 # fail, json, make_key, start_xvfb, run_session, end_session
 source "$(dirname "$0")/../support/script_support.sh"
 make_key
+# The viewers watch on an observer credential, as in the lab.
+observer="$work/observer.cred"
+"$bin/snapthread-keygen" --key "$key" --role observer --out "$observer" > "$work/keygen_observer.txt" 2>&1 \
+    || fail "snapthread-keygen --role observer failed"
 echo "soak: ${duration} s, $viewers viewers and snapthread-logger, outputs in $work"
 
 "$bin/snapthread-logger" -q -c "${session}_.*" --lcm-url "$url" -f "$work/session.lcmlog" \
@@ -49,7 +53,7 @@ logger_pid=$!; pids+=("$logger_pid")
 start_xvfb xvfb
 viewer_pids=()
 for v in $(seq $viewers); do
-  DISPLAY=$display "$bin/snapthread-viewer" --key "$key" --session "$session" --lcm-url "$url" \
+  DISPLAY=$display "$bin/snapthread-viewer" --key "$observer" --session "$session" --lcm-url "$url" \
       --duration-s $((duration + 3)) --width 320 --height 240 --max-fps 15 > "$work/viewer$v.txt" 2>&1 &
   pids+=("$!"); viewer_pids+=("$!")
 done

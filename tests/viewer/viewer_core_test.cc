@@ -7,8 +7,18 @@
 #include "messages/pose_mapping.h"
 #include "messages/subscribe.h"
 #include "snapthread/device_state_t.hpp"
+#include "snapthread/force_model_t.hpp"
+#include "snapthread/solver_status_t.hpp"
+#include "snapthread/thread_shape_t.hpp"
 
+#include <cstring>
+#include <vector>
+
+#include "auth/credential.h"
+#include "auth/key_set.h"
+#include "auth/message_mac.h"
 #include "grasp_publisher.h"
+#include "observer_check.h"
 #include "orbit_camera.h"
 #include "shape_check.h"
 #include "spline.h"
@@ -102,6 +112,85 @@ TEST(GraspMappingTest, PublisherSendsDeviceMetresOnTheSessionChannel) {
   EXPECT_EQ(sink.poses[1].seq, a.seq + 1);
   EXPECT_EQ(sink.poses[1].buttons, 0);
   EXPECT_GE(sink.poses[1].utime, a.utime);
+}
+
+// Driving with a device credential: every pose is tagged as that device (role, name) with
+// its key's MAC, which the device key verifies and another device's does not.
+TEST(GraspMappingTest, PublisherTagsPosesAsTheDevice) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  PoseSink sink;
+  messages::Subscribe<&PoseSink::On>(lcm, "GRASPTAG_DEVICE_STATE", &sink);
+  const auth::SessionKey root = auth::SessionKey::Generate();
+  const auth::KeySet device = auth::KeySet::ForRole(root, auth::Role::kDevice, "hand");
+  const auth::KeySet other = auth::KeySet::ForRole(root, auth::Role::kDevice, "left");
+  GraspPublisher publisher(&lcm, "GRASPTAG", DeviceMapping{}, &device.tagger(), [] { return int64_t{77}; });
+  ASSERT_TRUE(publisher.Publish({0.1, 0.2, 0.0}, true));
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  ASSERT_EQ(sink.poses.size(), 1u);
+  device_state_t pose = sink.poses[0];
+  EXPECT_EQ(pose.sender_role, static_cast<int8_t>(auth::Role::kDevice));
+  EXPECT_EQ(pose.sender_name, "hand");
+  EXPECT_EQ(pose.epoch, 77);
+  std::vector<uint8_t> bytes(pose.getEncodedSize());
+  pose.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  EXPECT_TRUE(auth::VerifyMac(bytes.data(), bytes.size(), "GRASPTAG_DEVICE_STATE", *device.mac_key()));
+  EXPECT_FALSE(auth::VerifyMac(bytes.data(), bytes.size(), "GRASPTAG_DEVICE_STATE", *other.mac_key()));
+}
+
+// msg tagged by `tagger` on `channel`, encoded.
+template <class Msg>
+std::vector<uint8_t> Tagged(Msg msg, const std::string& channel, const auth::Tagger& tagger) {
+  EXPECT_TRUE(auth::Sign(&msg, channel, 5, 6, tagger));
+  std::vector<uint8_t> bytes(msg.getEncodedSize());
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+template <class Msg>
+Msg Decoded(const std::vector<uint8_t>& bytes) {
+  Msg m;
+  m.decode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return m;
+}
+
+// What an observer's credential accepts: the server's signature on what the server
+// publishes; not a device's MAC, not another root's server, not an untagged shape. An
+// untagged force model is skipped (kUnsigned), a badly signed one refused.
+TEST(ObserverCheckTest, AcceptsOnlyTheSessionServersSignature) {
+  const auth::SessionKey root = auth::SessionKey::Generate();
+  const auth::KeySet server = auth::KeySet::FromRoot(auth::SessionKey::FromBytes(root.data(), auth::SessionKey::kBytes));
+  const auth::KeySet observer =
+      auth::KeySet::FromCredential(auth::IssueCredential(root, auth::Role::kObserver, "", auth::kNeverExpires));
+  const auth::KeySet device = auth::KeySet::ForRole(root, auth::Role::kDevice, "hand");
+  const auth::KeySet other = auth::KeySet::FromRoot(auth::SessionKey::Generate());
+  const auth::PublicKey& pk = observer.server_public_key();
+  auto verdict = [&](const std::vector<uint8_t>& b, const std::string& channel) {
+    return CheckObserved(b.data(), b.size(), channel, Decoded<thread_shape_t>(b), pk);
+  };
+  thread_shape_t shape{};
+  shape.num_nodes = 0;
+  EXPECT_EQ(verdict(Tagged(shape, "S_SHAPE", server.tagger()), "S_SHAPE"), ObserverVerdict::kAccepted);
+  EXPECT_EQ(verdict(Tagged(shape, "S_SHAPE", server.tagger()), "T_SHAPE"), ObserverVerdict::kRefused)
+      << "signed for another channel";
+  EXPECT_EQ(verdict(Tagged(shape, "S_SHAPE", device.tagger()), "S_SHAPE"), ObserverVerdict::kRefused);
+  EXPECT_EQ(verdict(Tagged(shape, "S_SHAPE", other.tagger()), "S_SHAPE"), ObserverVerdict::kRefused);
+  EXPECT_EQ(verdict(Tagged(shape, "S_SHAPE", auth::Tagger{}), "S_SHAPE"), ObserverVerdict::kRefused);
+  // A server signature claiming another role is refused too.
+  auth::Tagger as_device = server.tagger();
+  as_device.role = auth::Role::kDevice;
+  EXPECT_EQ(verdict(Tagged(shape, "S_SHAPE", as_device), "S_SHAPE"), ObserverVerdict::kRefused);
+
+  const force_model_t model{};
+  auto model_verdict = [&](const std::vector<uint8_t>& b) {
+    return CheckObserved(b.data(), b.size(), "S_FORCE_MODEL", Decoded<force_model_t>(b), pk);
+  };
+  EXPECT_EQ(model_verdict(Tagged(model, "S_FORCE_MODEL", server.tagger())), ObserverVerdict::kAccepted);
+  EXPECT_EQ(model_verdict(Tagged(model, "S_FORCE_MODEL", auth::Tagger{})), ObserverVerdict::kUnsigned);
+  EXPECT_EQ(model_verdict(Tagged(model, "S_FORCE_MODEL", device.tagger())), ObserverVerdict::kUnsigned)
+      << "the device's MAC only: a model between the display-rate ones";
+  EXPECT_EQ(model_verdict(Tagged(model, "S_FORCE_MODEL", other.tagger())), ObserverVerdict::kRefused);
 }
 
 TEST(ShapeCheckTest, RefusesEmptyAndGarbageBuffers) {

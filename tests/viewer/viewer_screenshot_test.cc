@@ -19,6 +19,9 @@
 #include "snapthread/device_state_t.hpp"
 #include "scene/scene.h"
 #include "orbit_camera.h"
+#include "auth/credential.h"
+#include "auth/credential_file.h"
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "snapthread/solver_status_t.hpp"
@@ -28,6 +31,7 @@
 #include "spline.h"
 #include "png_image.h"
 #include "test_support.h"
+#include "arc_session.h"
 
 namespace snapthread::viewer_test {
 namespace {
@@ -38,254 +42,15 @@ using viewer::CatmullRomCurve;
 using viewer::OrbitCamera;
 using viewer::Point3;
 
-using test_support::kLoopbackLcmUrl;
-constexpr const char* kLoopbackUrl = kLoopbackLcmUrl;
-constexpr int kWidth = 640;
-constexpr int kHeight = 480;
-constexpr int kNodes = 21;
-
-// A half circle of radius 1 from (1, 0) over (0, 1) to (-1, 0), in the z = 0 plane.
-std::vector<Point3> ArcNodes() {
-  std::vector<Point3> nodes;
-  for (int i = 0; i < kNodes; ++i) {
-    const double a = M_PI * i / (kNodes - 1);
-    nodes.emplace_back(std::cos(a), std::sin(a), 0.0);
-  }
-  return nodes;
-}
-
-thread_shape_t ArcShape(int64_t seq, int8_t status = 0) {
-  thread_shape_t s{};
-  s.utime = seq * 16000;
-  s.seq = seq;
-  s.scene = "test-arc";
-  s.model = "curve2d";
-  s.num_nodes = kNodes;
-  for (const auto& p : ArcNodes()) s.positions.push_back({p.x(), p.y(), p.z()});
-  const auto& last = s.positions.back();
-  for (int i = 0; i < 3; ++i) {
-    s.grasp[i] = last[i];
-    s.grip_direction[i] = 0.0;  // free grip: no direction arrow
-    s.force[i] = 0.0;           // no force arrow, so only the thread, clamp and grasp are drawn
-    s.force_newtons[i] = 0.0;
-  }
-  s.status = status;
-  s.snaps = 0;
-  return s;
-}
-
-// Publishes the arc every 20 ms (plus malformed packets when asked) until stopped, signed
-// like the server's (a per-test key in SNAPTHREAD_KEY_FILE for the viewer, an epoch
-// announced in a signed solver status before each shape).
-class ShapePublisher {
- public:
-  // `decorate` adds to each shape (grasps, contacts) before it is signed.
-  ShapePublisher(const std::string& session, bool with_garbage, int8_t status = 0,
-                 std::function<void(thread_shape_t*)> decorate = {})
-      : channel_(messages::Channels(session).shape),
-        status_channel_(messages::Channels(session).solver_status),
-        garbage_(with_garbage),
-        status_(status),
-        decorate_(std::move(decorate)) {}
-  ~ShapePublisher() { Stop(); }
-  bool Start() {
-    if (!lcm_.good()) return false;
-    thread_ = std::thread([this] { Loop(); });
-    return true;
-  }
-  void Stop() {
-    running_ = false;
-    if (thread_.joinable()) thread_.join();
-  }
-  int64_t garbage_sent() const { return garbage_sent_; }
-  int64_t epoch() const { return epoch_; }
-
- private:
-  void Loop() {
-    std::mt19937 rng(42);
-    int64_t seq = 0;
-    while (running_) {
-      if (garbage_) PublishGarbage(seq, &rng);
-      solver_status_t st{};
-      st.seq = seq;
-      st.scene = "test-arc";
-      st.method = "newton";
-      st.status = status_;
-      if (auth::Sign(&st, status_channel_, epoch_, auth_seq_.Next(), key_file_.key())) {
-        lcm_.publish(status_channel_, &st);
-      }
-      thread_shape_t s = ArcShape(++seq, status_);
-      if (decorate_) decorate_(&s);
-      if (auth::Sign(&s, channel_, epoch_, auth_seq_.Next(), key_file_.key())) {
-        lcm_.publish(channel_, &s);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-
-  void PublishGarbage(int64_t seq, std::mt19937* rng) {
-    thread_shape_t s = ArcShape(seq);
-    std::vector<uint8_t> buf(s.getEncodedSize());
-    s.encode(buf.data(), 0, int(buf.size()));
-    switch (seq % 5) {
-      case 0: {  // random bytes
-        std::vector<uint8_t> junk(100 + (*rng)() % 400);
-        for (auto& b : junk) b = uint8_t((*rng)());
-        lcm_.publish(channel_, junk.data(), junk.size());
-        break;
-      }
-      case 1:  // truncated mid-positions
-        lcm_.publish(channel_, buf.data(), buf.size() / 2);
-        break;
-      case 2: {  // num_nodes claims far more nodes than the buffer holds
-        // fingerprint 8, utime 8, seq 8, scene (4 + 9), model (4 + 8), then num_nodes.
-        const size_t at = 8 + 8 + 8 + 4 + s.scene.size() + 1 + 4 + s.model.size() + 1;
-        const uint8_t huge[4] = {0x7f, 0xff, 0xff, 0xff};
-        std::memcpy(&buf[at], huge, 4);
-        lcm_.publish(channel_, buf.data(), buf.size());
-        break;
-      }
-      case 3: {  // string length INT32_MIN
-        const uint8_t neg[4] = {0x80, 0, 0, 0};
-        std::memcpy(&buf[24], neg, 4);
-        lcm_.publish(channel_, buf.data(), buf.size());
-        break;
-      }
-      default: {  // a NaN node position: decodes, must be refused by validation
-        thread_shape_t bad = ArcShape(seq);
-        bad.positions[3][1] = std::nan("");
-        lcm_.publish(channel_, &bad);
-        break;
-      }
-    }
-    garbage_sent_++;
-  }
-
-  const SessionKeyFile key_file_;
-  const int64_t epoch_ = auth::NewEpoch();
-  auth::AuthSequence auth_seq_;
-  lcm::LCM lcm_{kLoopbackUrl};
-  std::string channel_;
-  std::string status_channel_;
-  bool garbage_;
-  int8_t status_;
-  std::function<void(thread_shape_t*)> decorate_;
-  std::atomic<bool> running_{true};
-  std::atomic<int64_t> garbage_sent_{0};
-  std::thread thread_;
-};
-
-struct ViewerRun {
-  ProcessResult result;
-  std::string png;
-};
-
-ViewerRun RunViewerScreenshot(const std::string& session, const std::string& dir,
-                              int after_shapes, double timeout_s) {
-  ViewerRun run;
-  run.png = dir + "/shot.png";
-  const VirtualDisplay display(dir);
-  EXPECT_TRUE(display.ready()) << "Xvfb did not start: " << display.error();
-  if (!display.ready()) return run;
-  const std::vector<std::string> argv = display.On({
-      BinDir() + "/snapthread-viewer", "--session", session, "--lcm-url", kLoopbackUrl,
-      "--screenshot", run.png, "--after-shapes", std::to_string(after_shapes), "--timeout-s",
-      std::to_string(timeout_s), "--width", std::to_string(kWidth), "--height",
-      std::to_string(kHeight)});
-  ChildProcess viewer(argv, OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
-  EXPECT_TRUE(viewer.started()) << "cannot start snapthread-viewer";
-  if (viewer.started()) run.result = viewer.Finish(timeout_s + 40.0);
-  return run;
-}
-
-bool IsBackground(const uint8_t* p) {
-  // Renderer's kBackground (0.11, 0.12, 0.15) in 8 bits, a few levels of tolerance.
-  return std::abs(p[0] - 28) <= 4 && std::abs(p[1] - 31) <= 4 && std::abs(p[2] - 38) <= 4;
-}
-
-bool InOverlay(double x, double y, double margin) {
-  const viewer::HudLayout l = viewer::MakeHudLayout(kWidth, kHeight);
-  auto inside = [&](const viewer::PixelRect& r) {
-    return x >= r.x - margin && x < r.x + r.width + margin && y >= r.y - margin &&
-           y < r.y + r.height + margin;
-  };
-  return inside(l.text) || inside(l.chart);
-}
-
-// Checks the screenshot against the projection of the arc with the viewer's camera fit.
-// The camera the viewer fits to the arc.
-OrbitCamera ArcCamera() {
-  const std::vector<Point3> nodes = ArcNodes();
-  Eigen::Vector3d lo = nodes[0], hi = nodes[0];
-  for (const auto& p : nodes) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  OrbitCamera camera;
-  camera.Fit(lo, hi, double(kWidth) / kHeight);
-  return camera;
-}
-
-// The arc's spline as `camera` projects it, in pixels.
-std::vector<Eigen::Vector2d> ArcPixelPath(const OrbitCamera& camera) {
-  std::vector<Eigen::Vector2d> path;
-  for (const auto& p : CatmullRomCurve(ArcNodes(), 8)) path.push_back(camera.ProjectToPixel(p, kWidth, kHeight));
-  return path;
-}
-
-void ExpectArcDrawn(const Image& img) {
-  ASSERT_EQ(img.width, kWidth);
-  ASSERT_EQ(img.height, kHeight);
-  const OrbitCamera camera = ArcCamera();
-  const std::vector<Eigen::Vector2d> path = ArcPixelPath(camera);
-  // 1) Along the projected path the tube is drawn (not background).
-  int on = 0, checked = 0;
-  for (const auto& q : path) {
-    if (InOverlay(q.x(), q.y(), 4)) continue;
-    const int x = int(std::lround(q.x())), y = int(std::lround(q.y()));
-    ASSERT_TRUE(x >= 0 && x < kWidth && y >= 0 && y < kHeight) << "arc projects off screen";
-    checked++;
-    on += !IsBackground(img.At(x, y));
-  }
-  ASSERT_GE(checked, 60) << "too few path samples outside the overlays";
-  EXPECT_GE(on, int(0.95 * checked)) << on << " of " << checked << " path pixels drawn";
-  // The path spans the window: the arc is 2 units wide, the fit fills ~70% of the height.
-  double min_x = 1e9, max_x = -1e9;
-  for (const auto& q : path) {
-    min_x = std::min(min_x, q.x());
-    max_x = std::max(max_x, q.x());
-  }
-  EXPECT_GT(max_x - min_x, 0.4 * kWidth);
-  // 2) Far from the path (and outside the overlays) everything is background: this includes
-  //    the inside of the arc, so a filled blob or a straight line would fail.
-  int far = 0, far_background = 0;
-  for (int y = 2; y < kHeight - 2; y += 6) {
-    for (int x = 2; x < kWidth - 2; x += 6) {
-      if (InOverlay(x, y, 2)) continue;
-      double d = 1e9;
-      for (const auto& q : path) d = std::min(d, std::hypot(q.x() - x, q.y() - y));
-      if (d < 30) continue;
-      far++;
-      far_background += IsBackground(img.At(x, y));
-    }
-  }
-  ASSERT_GT(far, 1000);
-  EXPECT_GE(far_background, int(0.995 * far)) << far - far_background << " of " << far
-                                               << " pixels far from the thread are not background";
-  // 3) A point just inside the arc's apex is background, a point on the apex is not.
-  const Eigen::Vector2d apex = camera.ProjectToPixel({0.0, 1.0, 0.0}, kWidth, kHeight);
-  const Eigen::Vector2d centre = camera.ProjectToPixel({0.0, 0.5, 0.0}, kWidth, kHeight);
-  EXPECT_FALSE(IsBackground(img.At(int(apex.x()), int(apex.y()))));
-  EXPECT_TRUE(IsBackground(img.At(int(centre.x()), int(centre.y()))));
-}
-
+// The viewer on an observer credential shows the live thread.
 TEST(ViewerScreenshotTest, ShowsTheThreadAlongTheProjectedArc) {
   const std::string session = UniqueSession("VIEWARC");
   const std::string dir = FreshTempDir("viewer-arc");
   ShapePublisher publisher(session, /*with_garbage=*/false);
+  const std::string observer = WriteCredential(dir, publisher.root(), auth::Role::kObserver);
   ASSERT_TRUE(publisher.Start()) << "LCM publisher failed on " << kLoopbackUrl
                                  << " (no multicast route? see deploy/multicast-route.sh)";
-  const ViewerRun run = RunViewerScreenshot(session, dir, 5, 30.0);
+  const ViewerRun run = RunViewerScreenshot(session, dir, 5, 30.0, observer);
   publisher.Stop();
   ASSERT_TRUE(run.result.exited) << "viewer did not exit; stderr:\n" << run.result.err;
   ASSERT_EQ(run.result.exit_code, 0) << run.result.out << run.result.err;
@@ -295,7 +60,6 @@ TEST(ViewerScreenshotTest, ShowsTheThreadAlongTheProjectedArc) {
   ASSERT_TRUE(ReadPng(run.png, &img, &error)) << error;
   ExpectArcDrawn(img);
 }
-
 TEST(ViewerScreenshotTest, MalformedShapePacketsAreDroppedAndCounted) {
   const std::string session = UniqueSession("VIEWBAD");
   const std::string dir = FreshTempDir("viewer-bad");
@@ -417,168 +181,6 @@ TEST(ViewerScreenshotTest, DrawsEveryGraspAndTheActiveContacts) {
   EXPECT_FALSE(HasColour(img, tube, viewer::kContactColor, 40));
   EXPECT_FALSE(HasColour(img, tube, viewer::GraspColor(1), 40));
 }
-
-// Review path of docs/lab-setup.md: a logged session played back with lcm-logplayer into a
-// viewer shows the logged thread.
-TEST(ViewerScreenshotTest, ReplaysALoggedSessionWithLcmLogplayer) {
-  const std::string session = UniqueSession("VIEWREPLAY");
-  const std::string dir = FreshTempDir("viewer-replay");
-  const std::string log_path = dir + "/session.lcmlog";
-  const SessionKeyFile key_file;  // the logged session's key, for the viewer too
-  {
-    lcm::LogFile log(log_path, "w");
-    ASSERT_TRUE(log.good());
-    const std::string channel = messages::Channels(session).shape;
-    const int64_t epoch = auth::NewEpoch();
-    auth::AuthSequence auth_seq;
-    for (int k = 0; k < 400; ++k) {  // 8 s of shapes at 50 Hz, a signed status before each
-      solver_status_t st{};
-      st.seq = k;
-      st.scene = "test-arc";
-      st.method = "newton";
-      ASSERT_TRUE(auth::Sign(&st, messages::Channels(session).solver_status, epoch,
-                             auth_seq.Next(), key_file.key()));
-      std::vector<uint8_t> status_buf(st.getEncodedSize());
-      st.encode(status_buf.data(), 0, int(status_buf.size()));
-      lcm::LogEvent se;
-      se.timestamp = 1700000000000000 + k * 20000 - 1;
-      se.channel = messages::Channels(session).solver_status;
-      se.datalen = int32_t(status_buf.size());
-      se.data = status_buf.data();
-      ASSERT_EQ(log.writeEvent(&se), 0);
-      thread_shape_t s = ArcShape(k);
-      ASSERT_TRUE(auth::Sign(&s, channel, epoch, auth_seq.Next(), key_file.key()));
-      std::vector<uint8_t> buf(s.getEncodedSize());
-      s.encode(buf.data(), 0, int(buf.size()));
-      lcm::LogEvent e;
-      e.timestamp = 1700000000000000 + k * 20000;
-      e.channel = channel;
-      e.datalen = int32_t(buf.size());
-      e.data = buf.data();
-      ASSERT_EQ(log.writeEvent(&e), 0);
-    }
-  }
-  // The viewer first (it must be listening: it says so once subscribed and its window is
-  // up), then the player.
-  const VirtualDisplay display(dir);
-  ASSERT_TRUE(display.ready()) << "Xvfb did not start: " << display.error();
-  const std::vector<std::string> viewer_argv = display.On({
-      BinDir() + "/snapthread-viewer", "--session", session, "--lcm-url", kLoopbackUrl,
-      "--screenshot", dir + "/shot.png", "--after-shapes", "10", "--timeout-s", "30",
-      "--width", std::to_string(kWidth), "--height", std::to_string(kHeight)});
-  ChildProcess viewer(viewer_argv, OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
-  ASSERT_TRUE(viewer.started());
-  const bool listening = WaitUntil(
-      [&] { return viewer.Err().find("listening on") != std::string::npos || !viewer.running(); }, 30.0);
-  ASSERT_TRUE(listening && viewer.running()) << "viewer did not start listening:\n"
-                                             << viewer.Out() << viewer.Err();
-  ChildProcess player({"lcm-logplayer", std::string("--lcm-url=") + kLoopbackUrl, log_path},
-                      OutputFiles(dir + "/player_out.txt", dir + "/player_err.txt", true));
-  ASSERT_TRUE(player.started()) << "cannot start lcm-logplayer (liblcm-bin)";
-  const ProcessResult v = viewer.Finish(60.0);
-  // The player would go on to the end of the log; the viewer has what it needs.
-  player.Finish(0.2);
-  ASSERT_TRUE(v.exited) << v.err;
-  ASSERT_EQ(v.exit_code, 0) << v.out << v.err;
-  Image img;
-  std::string error;
-  ASSERT_TRUE(ReadPng(dir + "/shot.png", &img, &error)) << error;
-  ExpectArcDrawn(img);
-}
-
-// Collects device_state_t from a session over udpm on its own thread.
-class PoseCollector {
- public:
-  explicit PoseCollector(const std::string& session) {
-    messages::Subscribe<&PoseCollector::On>(lcm_, messages::Channels(session).device_state, this);
-    thread_ = std::thread([this] {
-      while (running_) lcm_.handleTimeout(20);
-    });
-  }
-  ~PoseCollector() {
-    running_ = false;
-    thread_.join();
-  }
-  std::vector<device_state_t> Poses() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return poses_;
-  }
-
- private:
-  void On(const lcm::ReceiveBuffer*, const std::string&, const device_state_t* msg) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    poses_.push_back(*msg);
-  }
-  lcm::LCM lcm_{kLoopbackUrl};
-  std::atomic<bool> running_{true};
-  std::mutex mutex_;
-  std::vector<device_state_t> poses_;
-  std::thread thread_;
-};
-
-// --grasp-mode end to end: a real mouse drag (xdotool in the Xvfb display) from the grasp
-// to another pixel makes the viewer publish device states at the dragged-to point, in
-// device metres through the scene's mapping.
-TEST(ViewerScreenshotTest, GraspModeDragPublishesDeviceStates) {
-  const std::string session = UniqueSession("VIEWGRASP");
-  const std::string dir = FreshTempDir("viewer-grasp");
-  const std::string scene_path = SourceDir() + "/scenes/curve2d_snap.yaml";
-  const Scene scene = LoadScene(scene_path);
-  // Where the viewer's camera puts the arc's grasp (-1, 0, 0), and the drag target.
-  const OrbitCamera camera = ArcCamera();
-  const Eigen::Vector2d grasp_px = camera.ProjectToPixel(ArcNodes().back(), kWidth, kHeight);
-  const Eigen::Vector2d target_px(std::round(grasp_px.x() + 60), std::round(grasp_px.y() - 45));
-  Eigen::Vector3d origin, direction;
-  camera.PixelRay(target_px.x(), target_px.y(), kWidth, kHeight, &origin, &direction);
-  const Eigen::Vector3d target_model = origin - origin.z() / direction.z() * direction;  // z = 0
-  const Eigen::Vector3d expected_m = messages::ModelPointToDevice(scene.device, target_model);
-
-  ShapePublisher publisher(session, /*with_garbage=*/false);
-  ASSERT_TRUE(publisher.Start());
-  PoseCollector collector(session);
-  const std::string viewer = BinDir() + "/snapthread-viewer";
-  const std::string title = "snapthread-viewer: " + session;
-  char script[2048];
-  std::snprintf(script, sizeof script,
-                "'%s' --grasp-mode --scene '%s' --session %s --lcm-url '%s' --width %d --height %d "
-                "--duration-s 12 & vp=$!; "
-                "for i in $(seq 50); do w=$(xdotool search --name '%s' | head -1); "
-                "[ -n \"$w\" ] && break; sleep 0.2; done; sleep 1.5; "
-                "xdotool mousemove --window $w %d %d; sleep 0.3; xdotool mousedown 1; sleep 0.3; "
-                "xdotool mousemove --window $w %d %d; sleep 0.3; xdotool mousemove --window $w %d %d; "
-                "sleep 1.0; xdotool mouseup 1; sleep 0.5; kill $vp; wait $vp; exit 0",
-                viewer.c_str(), scene_path.c_str(), session.c_str(), kLoopbackUrl, kWidth, kHeight,
-                title.c_str(), int(std::lround(grasp_px.x())), int(std::lround(grasp_px.y())),
-                int(target_px.x() - 20), int(target_px.y()), int(target_px.x()), int(target_px.y()));
-  const VirtualDisplay display(dir);
-  ASSERT_TRUE(display.ready()) << "Xvfb did not start: " << display.error();
-  ChildProcess run(display.On({"bash", "-c", script}), OutputFiles(dir + "/out.txt", dir + "/err.txt", true));
-  ASSERT_TRUE(run.started());
-  const ProcessResult r = run.Finish(40.0);
-  publisher.Stop();
-  ASSERT_TRUE(r.exited) << r.err;
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  const std::vector<device_state_t> poses = collector.Poses();
-  ASSERT_GE(poses.size(), 10u) << "viewer published " << poses.size() << " poses\n" << r.out << r.err;
-  for (size_t i = 1; i < poses.size(); ++i) EXPECT_EQ(poses[i].seq, poses[i - 1].seq + 1);
-  for (const auto& p : poses) {
-    EXPECT_EQ(p.buttons, 1);  // published only while the button is held
-    EXPECT_EQ(p.device_id, "viewer-mouse");
-    // Signed with the epoch the viewer learned from the publisher's signed status.
-    EXPECT_EQ(p.epoch, publisher.epoch());
-    EXPECT_GT(p.auth_seq, 0);
-  }
-  // The pose while held at the target: the model point under the cursor, in device metres
-  // (one pixel is ~0.007 model units = 0.14 mm here).
-  const device_state_t& last = poses.back();
-  EXPECT_NEAR(last.position[0], expected_m.x(), 5e-4);
-  EXPECT_NEAR(last.position[1], expected_m.y(), 5e-4);
-  EXPECT_NEAR(last.position[2], expected_m.z(), 1e-9);  // planar model: on the plane z = 0
-  // The drag moved it: far from the grasp's own position.
-  const Eigen::Vector3d grasp_m = messages::ModelPointToDevice(scene.device, ArcNodes().back());
-  EXPECT_GT(std::hypot(last.position[0] - grasp_m.x(), last.position[1] - grasp_m.y()), 5e-3);
-}
-
 TEST(ViewerScreenshotTest, TimesOutWithAClearMessageWhenNothingArrives) {
   const std::string session = UniqueSession("VIEWNONE");
   const std::string dir = FreshTempDir("viewer-none");

@@ -19,6 +19,9 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/credential.h"
+#include "auth/credential_file.h"
+#include "auth/role.h"
 #include "png_image.h"
 #include "snapthread/thread_shape_t.hpp"
 #include "test_support.h"
@@ -122,7 +125,8 @@ class WebBrowserTest : public ::testing::Test {
                          "--session", session_, "--lcm-url", url_lcm, "--duration", "120", "--no-rt"},
                         OneLog(dir_.path() + "/device.txt", true));
     std::string url;
-    auto web = StartWeb({"--port", "0", "--session", session_, "--lcm-url", url_lcm}, "live", &url);
+    const std::string observer = Credential(auth::Role::kObserver);
+    auto web = StartWeb({"--port", "0", "--session", session_, "--lcm-url", url_lcm, "--key", observer}, "live", &url);
     ASSERT_FALSE(url.empty()) << web->Out();
 
     const std::string live = Browser(browser, "live", url, std::to_string(pages), display);
@@ -166,7 +170,7 @@ class WebBrowserTest : public ::testing::Test {
       }
     }
     ASSERT_GT(shapes, 100) << "the logger recorded too little of the session";
-    auto player = StartWeb({"--port", "0", "--log", log}, "replay", &url);
+    auto player = StartWeb({"--port", "0", "--log", log, "--key", observer}, "replay", &url);
     ASSERT_FALSE(url.empty()) << player->Out();
     const std::string replay = Browser(browser, "replay", url, "", display);
     std::printf("web_browser_test %s replay: %s\n", browser.c_str(), replay.c_str());
@@ -176,8 +180,17 @@ class WebBrowserTest : public ::testing::Test {
     ExpectTubeOnScreenshot(dir_.path() + "/replay.png", static_cast<int>(Field(replay, "status")));
   }
 
+  // A credential of `role` issued from the session's root key, written to the test's folder.
+  std::string Credential(auth::Role role, const std::string& name = "") {
+    const std::string path = dir_.path() + "/" + std::string(auth::RoleToString(role)) + ".cred";
+    auth::WriteCredentialFile(path, auth::IssueCredential(key_.key(), role, name, auth::kNeverExpires), true);
+    return path;
+  }
+
   std::string bin_, session_, scene_;
-  test_support::SessionKeyFile key_;  // exported as SNAPTHREAD_KEY_FILE to every child
+  // The root key, exported as SNAPTHREAD_KEY_FILE to every child (the server and device
+  // run on it); the bridge is given an observer credential.
+  test_support::SessionKeyFile key_;
   test_support::ScopedTempDir dir_{"web-browser"};
 };
 
@@ -191,6 +204,22 @@ TEST_F(WebBrowserTest, AFirefoxPageFollowsALiveSessionAndItsLogReplaysToTheLastF
   const test_support::VirtualDisplay display(dir_.path());
   ASSERT_TRUE(display.ready()) << "Xvfb: " << display.error();
   FollowALiveSessionThenReplayItsLog("firefox", 1, &display);
+}
+
+// A device's or an operator's credential is no observer's: the bridge exits non-zero,
+// naming the role it needs, live and in replay.
+TEST_F(WebBrowserTest, AnotherRolesCredentialIsRefusedNamingTheObserverRole) {
+  for (const auth::Role role : {auth::Role::kDevice, auth::Role::kOperator}) {
+    const std::string cred = Credential(role, "hand");
+    ChildProcess web({bin_ + "/snapthread-web", "--port", "0", "--session", session_, "--lcm-url",
+                      test_support::kLoopbackLcmUrl, "--key", cred, "--duration-s", "5"},
+                     OneLog(dir_.path() + "/web_role.txt", true));
+    const test_support::ProcessResult r = web.Finish(30);
+    ASSERT_TRUE(r.exited) << r.out;
+    EXPECT_NE(r.exit_code, 0) << r.out;
+    EXPECT_NE((r.out + r.err).find("observer"), std::string::npos) << r.out << r.err;
+    EXPECT_EQ((r.out + r.err).find(" at http://"), std::string::npos) << "it served: " << r.out;
+  }
 }
 
 TEST_F(WebBrowserTest, BeyondLoopbackARequestWithoutTheTokenGets401) {

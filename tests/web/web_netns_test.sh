@@ -49,6 +49,10 @@ trap cleanup EXIT
 # fail, json, make_key, netns_kill, netns_start
 source "$(dirname "$0")/../support/script_support.sh"
 make_key
+# The bridge serves the observers on an observer credential.
+observer="$work/observer.cred"
+"$bin/snapthread-keygen" --key "$key" --role observer --out "$observer" > "$work/keygen_observer.txt" 2>&1 \
+    || fail "snapthread-keygen --role observer failed"
 netns_start '^st_(wsrv|wobs)_[0-9]+$' "$ns_srv"
 set -e
 ip netns add "$ns_obs"
@@ -73,7 +77,7 @@ for _ in $(seq 600); do grep -q "server: session" "$work/server.txt" && break; s
 grep -q "server: session" "$work/server.txt" || fail "the server did not start"
 ip netns exec "$ns_srv" "$bin/snapthread-device" --key "$key" --backend sim-path --scene "$scene" \
     --session "$session" --lcm-url "$url" --duration 120 --no-rt > "$work/device.txt" 2>&1 &
-ip netns exec "$ns_srv" "$bin/snapthread-web" --key "$key" --bind "$subnet.1" --port 0 \
+ip netns exec "$ns_srv" "$bin/snapthread-web" --key "$observer" --bind "$subnet.1" --port 0 \
     --token-file "$token_file" --session "$session" --lcm-url "$url" > "$work/web.txt" 2>&1 &
 for _ in $(seq 300); do grep -q " at http://" "$work/web.txt" && break; sleep 0.1; done
 page=$(grep -o 'http://[^ ]*' "$work/web.txt" | head -n 1)
