@@ -1,13 +1,16 @@
 // snapthread-auth-bench: the median cost of the roles' primitives on a 200-byte message
-// (docs/security.md, "Roles: the key hierarchy"), to choose which one a message stream can
-// afford: MAC (crypto_auth, through auth/file_mac.h), Ed25519 sign and verify, AEAD seal
-// and open, a key ring lookup, a device key derivation; plus the MAC of a whole force model
-// as the device checks it today. Built with SNAPTHREAD_BUILD_EXTRAS; no test runs it.
+// (docs/security.md, "Roles: the key hierarchy"): MAC (crypto_auth, through
+// auth/file_mac.h), Ed25519 sign and verify, AEAD seal and open, a key ring lookup, a
+// device key derivation; then, per channel at its rate, what tagging and checking a whole
+// message costs (auth::Sign with the role's Tagger, VerifyMac, VerifySignature, the device
+// certificate) in µs per message and in % of one core (docs/security.md, "Costs").
+// Built with SNAPTHREAD_BUILD_EXTRAS; no test runs it.
 //
 // Each primitive runs kBatches batches of kCalls calls; the figure is the median batch's
 // time per call (the minimum in brackets), so other processes on a shared machine shift
 // the spread more than the median.
 #include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -20,11 +23,17 @@
 
 #include "auth/aead.h"
 #include "auth/file_mac.h"
+#include "auth/device_certificate.h"
 #include "auth/key_ring.h"
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/role_keys.h"
 #include "auth/signature.h"
+#include "snapthread/device_state_t.hpp"
+#include "snapthread/device_status_t.hpp"
 #include "snapthread/force_model_t.hpp"
+#include "snapthread/solver_status_t.hpp"
+#include "snapthread/thread_shape_t.hpp"
 
 namespace {
 
@@ -32,10 +41,12 @@ using namespace snapthread::auth;
 
 constexpr int kBatches = 31;
 constexpr int kCalls = 500;
+constexpr int kShapeNodes = 200;  // a shape of the rod scenes' size (nodes)
 
 int g_sink = 0;  // keeps results alive (printed at the end)
 
-void Measure(const char* name, const std::function<void()>& call) {
+// Median ns per call over kBatches batches (printed with the fastest batch).
+double Measure(const char* name, const std::function<void()>& call) {
   for (int i = 0; i < kCalls / 10; ++i) call();  // warm-up
   std::vector<double> ns;
   for (int b = 0; b < kBatches; ++b) {
@@ -46,6 +57,121 @@ void Measure(const char* name, const std::function<void()>& call) {
   }
   std::sort(ns.begin(), ns.end());
   std::printf("%-34s %9.0f ns  [min %.0f]\n", name, ns[ns.size() / 2], ns.front());
+  return ns[ns.size() / 2];
+}
+
+// One row of the per-channel table: `call` tags or checks one encoded message of
+// `bytes` bytes, `rate_hz` times a second on `side`.
+void ChannelRow(const char* channel, double rate_hz, const char* what, const char* side, std::size_t bytes,
+                const std::function<void()>& call) {
+  const std::string name = std::string(channel) + " " + what;
+  const double ns = Measure(name.c_str(), call);
+  std::printf("| %s | %g Hz | %s | %s | %zu | %.1f | %.3f |\n", channel, rate_hz, what, side, bytes, ns / 1e3,
+              ns * rate_hz / 1e9 * 100.0);
+}
+
+// The encoding of `msg` (tags in place), for the receivers' checks.
+template <class Msg>
+std::vector<uint8_t> Encoded(const Msg& msg) {
+  std::vector<uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+// The server's tagger for `device`'s force models: a MAC under the device's key, and the
+// server's signature when `with_signature`.
+Tagger ForceModelTagger(const KeySet& server, const KeySet& device, bool with_signature) {
+  Tagger t;
+  t.role = Role::kServer;
+  t.name = device.name();
+  t.expires_unix_s = device.expires_unix_s();
+  t.key_id = device.credential()->key_id;
+  t.mac_key = device.mac_key();
+  t.signer = with_signature ? server.tagger().signer : nullptr;
+  return t;
+}
+
+// Per channel at its rate: tagging on the sender, checking on the receiver.
+void ChannelCosts(const SessionKey& root) {
+  const KeySet server = KeySet::ForRole(root, Role::kServer);
+  const KeySet device = KeySet::ForRole(root, Role::kDevice, "hand");
+  const KeySet observer = KeySet::ForRole(root, Role::kObserver);
+  const SessionKey& device_key = *device.mac_key();
+  const PublicKey& server_pk = observer.server_public_key();
+  int64_t seq = 0;
+  std::printf("\n| channel | rate | work | side | bytes | µs/message | %% of a core |\n|---|---|---|---|---|---|---|\n");
+
+  snapthread::device_state_t pose{};
+  pose.device_id = "hand";
+  const char* kPose = "SNAPTHREAD_DEVICE_STATE";
+  if (!Sign(&pose, kPose, 1, ++seq, device.tagger())) std::abort();
+  std::vector<uint8_t> bytes = Encoded(pose);
+  ChannelRow("pose", 1000, "MAC sign", "device", bytes.size(),
+             [&] { g_sink += Sign(&pose, kPose, 1, ++seq, device.tagger()) ? 1 : 0; });
+  if (!Sign(&pose, kPose, 1, ++seq, device.tagger())) std::abort();
+  bytes = Encoded(pose);
+  ChannelRow("pose", 1000, "MAC verify", "server", bytes.size(),
+             [&] { g_sink += VerifyMac(bytes.data(), bytes.size(), kPose, device_key) ? 1 : 0; });
+
+  snapthread::force_model_t model{};
+  const char* kModel = "SNAPTHREAD_FORCE_MODEL";
+  const Tagger mac_only = ForceModelTagger(server, device, false);
+  const Tagger mac_and_sig = ForceModelTagger(server, device, true);
+  if (!Sign(&model, kModel, 1, ++seq, mac_and_sig)) std::abort();
+  bytes = Encoded(model);
+  ChannelRow("force model", 1000, "MAC sign", "server", bytes.size(),
+             [&] { g_sink += Sign(&model, kModel, 1, ++seq, mac_only) ? 1 : 0; });
+  ChannelRow("force model", 1000, "MAC verify", "device (off the servo thread)", bytes.size(),
+             [&] { g_sink += VerifyMac(bytes.data(), bytes.size(), kModel, device_key) ? 1 : 0; });
+  ChannelRow("force model", 60, "MAC + signature sign", "server", bytes.size(),
+             [&] { g_sink += Sign(&model, kModel, 1, ++seq, mac_and_sig) ? 1 : 0; });
+  ChannelRow("force model", 60, "signature verify", "observer", bytes.size(),
+             [&] { g_sink += VerifySignature(bytes.data(), bytes.size(), kModel, server_pk) ? 1 : 0; });
+
+  snapthread::thread_shape_t shape{};
+  shape.scene = "zeeman";
+  shape.model = "curve2d";
+  shape.num_nodes = kShapeNodes;
+  for (int i = 0; i < shape.num_nodes; ++i) shape.positions.push_back({0.01 * i, 0.0, 0.0});
+  const char* kShape = "SNAPTHREAD_SHAPE";
+  if (!Sign(&shape, kShape, 1, ++seq, server.tagger())) std::abort();
+  bytes = Encoded(shape);
+  ChannelRow("shape", 60, "signature sign", "server", bytes.size(),
+             [&] { g_sink += Sign(&shape, kShape, 1, ++seq, server.tagger()) ? 1 : 0; });
+  ChannelRow("shape", 60, "signature verify", "observer", bytes.size(),
+             [&] { g_sink += VerifySignature(bytes.data(), bytes.size(), kShape, server_pk) ? 1 : 0; });
+
+  snapthread::solver_status_t status{};
+  status.scene = "zeeman";
+  status.method = "newton";
+  status.refusals = "device/bad-mac=12 observer/no-credential=3";
+  const char* kStatus = "SNAPTHREAD_SOLVER_STATUS";
+  if (!Sign(&status, kStatus, 1, ++seq, server.tagger())) std::abort();
+  bytes = Encoded(status);
+  ChannelRow("solver status", 10, "signature sign", "server", bytes.size(),
+             [&] { g_sink += Sign(&status, kStatus, 1, ++seq, server.tagger()) ? 1 : 0; });
+  ChannelRow("solver status", 10, "signature verify", "observer, device, ctl", bytes.size(),
+             [&] { g_sink += VerifySignature(bytes.data(), bytes.size(), kStatus, server_pk) ? 1 : 0; });
+
+  snapthread::device_status_t dstatus{};
+  dstatus.device_id = "hand";
+  std::copy(device.device_public_key()->begin(), device.device_public_key()->end(), dstatus.device_public_key);
+  std::copy(device.device_certificate()->begin(), device.device_certificate()->end(), dstatus.device_certificate);
+  const char* kDeviceStatus = "SNAPTHREAD_DEVICE_STATUS";
+  const Tagger& status_tagger = *device.device_status_tagger();
+  if (!Sign(&dstatus, kDeviceStatus, 1, ++seq, status_tagger)) std::abort();
+  bytes = Encoded(dstatus);
+  ChannelRow("device status", 2, "MAC + own signature sign", "device", bytes.size(),
+             [&] { g_sink += Sign(&dstatus, kDeviceStatus, 1, ++seq, status_tagger) ? 1 : 0; });
+  PublicKey device_pk{};
+  std::copy(std::begin(dstatus.device_public_key), std::end(dstatus.device_public_key), device_pk.begin());
+  ChannelRow("device status", 2, "certificate + signature verify", "observer", bytes.size(), [&] {
+    g_sink += VerifyDeviceCertificate(server_pk, dstatus.sender_name, dstatus.key_expires, device_pk,
+                                      dstatus.device_certificate) &&
+                      VerifySignature(bytes.data(), bytes.size(), kDeviceStatus, device_pk)
+                  ? 1
+                  : 0;
+  });
 }
 
 std::string LoadAverage() {
@@ -104,16 +230,7 @@ int main() {
   });
   Measure("device key derivation", [&] { g_sink += DeriveDeviceKey(root, "left", 0).data()[0]; });
 
-  snapthread::force_model_t model{};
-  int64_t seq = 0;
-  std::vector<uint8_t> encoded;
-  Measure("force model MAC sign (today)", [&] { g_sink += Sign(&model, "FORCE_MODEL", 1, ++seq, device) ? 1 : 0; });
-  encoded.resize(static_cast<std::size_t>(model.getEncodedSize()));
-  model.encode(encoded.data(), 0, static_cast<int>(encoded.size()));
-  Measure("force model MAC verify (today)", [&] {
-    g_sink += VerifyEncoded(encoded.data(), encoded.size(), "FORCE_MODEL", device) ? 1 : 0;
-  });
-  std::printf("force model: %zu bytes encoded; load average after %s (check %d)\n", encoded.size(),
-              LoadAverage().c_str(), g_sink & 1);
+  ChannelCosts(root);
+  std::printf("load average after %s (check %d)\n", LoadAverage().c_str(), g_sink & 1);
   return 0;
 }

@@ -1,15 +1,19 @@
-// A keyless flood against a genuine session, with real processes over udpm loopback:
+// A flood of forgeries against a genuine session, with real processes over udpm loopback:
 // snapthread-server and snapthread-device (virtual-hand on the planar curve2d_snap scene)
-// run a session; then a forger (tools/bench/flood_forger.h) sends forged messages on
-// every session channel — valid encodings, MACs under a key of its own, force models
-// asking for 1000 N along z — for a few seconds, then stops. Asserted, with no rate
+// run a session on the root key; then forgers (tools/bench/flood_forger.h) of every kind
+// at once send forged messages on every session channel where their role may not speak —
+// valid encodings, tags made with no key of the session, with this session's observer,
+// another device's or an operator's credential, or with another session's root key
+// (learning the genuine epoch where they can), force models asking for 1000 N along z —
+// for a few seconds, then stop. Asserted, with no rate
 // threshold a slow machine could break (counts per second are divided by
 // SNAPTHREAD_SPEED_SCALE):
 //   * the device keeps admitting genuine models during and after the flood, and the
 //     server keeps updating;
 //   * the forged messages are refused and counted (the device's and the server's
 //     rejection counts grow during the flood, by at least a few hundred), and the
-//     forged commands change nothing (the server reports one scene throughout);
+//     forged commands change nothing (the server reports one scene throughout): 0
+//     accepted where the role may not speak;
 //   * no forged force reaches the hand: on the planar scene every genuine force has
 //     z = 0, so the rendered z-force is 0 at every traced tick, and |F| never exceeds
 //     the scene's max_force_n.
@@ -20,14 +24,18 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
+#include <memory>
 #include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "flood_forger.h"
 #include "messages/channels.h"
@@ -48,11 +56,13 @@ constexpr const char* kUrl = "udpm://239.255.76.92:7692?ttl=0";
 constexpr double kPhaseSeconds = 3.0;
 constexpr double kSceneMaxForceN = 3.0;  // scenes/curve2d_snap.yaml device.max_force_n
 
-// The genuine device's and server's statuses, as a key holder sees them: decoded, MAC
-// checked (forged statuses of the flood are skipped), latest values kept.
+// The genuine device's and server's statuses, as the root key's holder sees them: decoded,
+// checked (the device's MAC under the key of device "hand", the server's signature and
+// role; forged statuses of the flood are skipped), latest values kept.
 class StatusWatch {
  public:
-  StatusWatch(const std::string& session, const auth::SessionKey* key) : channels_(session), key_(key) {
+  StatusWatch(const std::string& session, const auth::SessionKey& root)
+      : channels_(session), device_(auth::KeySet::ForRole(root, auth::Role::kDevice, "hand")) {
     // messages::Subscribe, not lcm::LCM::subscribe's member-function overload: GCC 12's
     // sanitizer build miscompiles that call (common/messages/subscribe.h).
     messages::Subscribe<&StatusWatch::OnDevice>(lcm_, channels_.device_status, this);
@@ -72,6 +82,7 @@ class StatusWatch {
     int64_t server_statuses = 0, updates = 0, server_rejected = 0;
     double max_status_force_n = 0.0;
     std::string scenes;  // every scene name the genuine server reported, ';'-separated
+    std::string refusals;  // the server's last "role/reason=count" list
   };
   Snapshot Now() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -79,12 +90,12 @@ class StatusWatch {
   }
 
  private:
-  bool Genuine(const lcm::ReceiveBuffer* rbuf, const std::string& channel) const {
-    return auth::VerifyEncoded(rbuf->data, rbuf->data_size, channel, *key_);
-  }
   void OnDevice(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     device_status_t st;
-    if (!messages::DecodeAndValidate(rbuf, &st, nullptr) || !Genuine(rbuf, channel)) return;
+    if (!messages::DecodeAndValidate(rbuf, &st, nullptr) || st.sender_name != device_.name() ||
+        !auth::VerifyMac(rbuf->data, rbuf->data_size, channel, *device_.mac_key())) {
+      return;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     ++now_.device_statuses;
     now_.models_received = st.models_received;
@@ -93,16 +104,21 @@ class StatusWatch {
   }
   void OnServer(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     solver_status_t st;
-    if (!messages::DecodeAndValidate(rbuf, &st, nullptr) || !Genuine(rbuf, channel)) return;
+    if (!messages::DecodeAndValidate(rbuf, &st, nullptr) ||
+        st.sender_role != static_cast<int8_t>(auth::Role::kServer) ||
+        !auth::VerifySignature(rbuf->data, rbuf->data_size, channel, device_.server_public_key())) {
+      return;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     ++now_.server_statuses;
     now_.updates = st.updates;
     now_.server_rejected = st.rejected_messages;
+    now_.refusals = st.refusals;
     if (now_.scenes.find(st.scene + ";") == std::string::npos) now_.scenes += st.scene + ";";
   }
 
   messages::Channels channels_;
-  const auth::SessionKey* key_;
+  const auth::KeySet device_;
   lcm::LCM lcm_{kUrl};
   std::atomic<bool> stop_{false};
   std::thread thread_;
@@ -143,7 +159,7 @@ TEST(FloodAttackTest, GenuineSessionKeepsItsModelsAndNoForgedForceReachesTheHand
   const std::string scene = ScenePath("curve2d_snap.yaml");
   const double scale = SpeedScale();
 
-  StatusWatch watch(session, &key_file.key());
+  StatusWatch watch(session, key_file.key());
   ASSERT_TRUE(watch.good());
   ChildProcess server({bin + "/snapthread-server", "--scene", scene, "--session", session, "--lcm-url", kUrl,
                        "--duration", "200", "--summary", dir + "/server.json", "--log-level", "info"},
@@ -163,17 +179,35 @@ TEST(FloodAttackTest, GenuineSessionKeepsItsModelsAndNoForgedForceReachesTheHand
   std::this_thread::sleep_for(std::chrono::duration<double>(1.0));
   const auto before = watch.Now();
 
-  // 2. The flood.
-  flood::ForgerOptions options;
-  options.lcm_url = kUrl;
-  options.session = session;
-  options.rate_per_channel_hz = 3000.0;
-  options.forged_force_n = 1000.0;
-  flood::ForgedFlood forger(options);
-  std::string error;
-  ASSERT_TRUE(forger.Start(&error)) << error;
+  // 2. The flood: every kind of forger at once, 3000 messages/s per channel in all.
+  const flood::ForgerKind kinds[] = {flood::ForgerKind::kNoKey, flood::ForgerKind::kObserver,
+                                     flood::ForgerKind::kOtherDevice, flood::ForgerKind::kOperator,
+                                     flood::ForgerKind::kOtherSessionRoot};
+  std::vector<std::unique_ptr<flood::ForgedFlood>> forgers;
+  for (const flood::ForgerKind kind : kinds) {
+    flood::ForgerOptions options;
+    options.lcm_url = kUrl;
+    options.session = session;
+    options.rate_per_channel_hz = 3000.0 / std::size(kinds);
+    options.forged_force_n = 1000.0;
+    options.kind = kind;
+    options.root_key_path = key_file.path();
+    forgers.push_back(std::make_unique<flood::ForgedFlood>(options));
+  }
+  for (auto& forger : forgers) {
+    std::string error;
+    ASSERT_TRUE(forger->Start(&error)) << error;
+  }
   std::this_thread::sleep_for(std::chrono::duration<double>(kPhaseSeconds));
-  forger.Stop();
+  double sent = 0.0, achieved = 0.0;
+  uint64_t failures = 0;
+  for (size_t k = 0; k < forgers.size(); ++k) {
+    forgers[k]->Stop();
+    EXPECT_GT(forgers[k]->sent(), 100u) << flood::ForgerKindName(kinds[k]) << " sent almost nothing";
+    sent += static_cast<double>(forgers[k]->sent());
+    achieved += forgers[k]->AchievedRatePerChannel();
+    failures += forgers[k]->failures();
+  }
   const auto during = watch.Now();
   // Statuses come at ~2 Hz (device) and ~10 Hz (server): let the last flood second in.
   std::this_thread::sleep_for(std::chrono::duration<double>(1.0));
@@ -190,18 +224,18 @@ TEST(FloodAttackTest, GenuineSessionKeepsItsModelsAndNoForgedForceReachesTheHand
   server.Signal(SIGTERM);
   ASSERT_TRUE(server.Wait(30.0 * scale, &code)) << server.Out();
 
-  const double sent = static_cast<double>(forger.sent());
   std::printf("flood: %.0f forged messages sent (%.0f/s per channel); device models admitted %lld before, "
               "+%lld during, +%lld after; rejected +%lld during; server updates +%lld during, +%lld after, "
               "rejected +%lld during\n",
-              sent, forger.AchievedRatePerChannel(), static_cast<long long>(before.models_received),
+              sent, achieved, static_cast<long long>(before.models_received),
               static_cast<long long>(during.models_received - before.models_received),
               static_cast<long long>(after.models_received - flood_end.models_received),
               static_cast<long long>(flood_end.models_rejected - before.models_rejected),
               static_cast<long long>(during.updates - before.updates),
               static_cast<long long>(after.updates - flood_end.updates),
               static_cast<long long>(flood_end.server_rejected - before.server_rejected));
-  ASSERT_GT(sent, 1000.0) << "the forger sent almost nothing (" << forger.failures() << " publish failures)";
+  std::printf("flood: the server's refusals: %s\n", after.refusals.c_str());
+  ASSERT_GT(sent, 1000.0) << "the forgers sent almost nothing (" << failures << " publish failures)";
   const double min_models = 20.0 * kPhaseSeconds / scale;  // genuine models run at ~1 kHz
   EXPECT_GE(during.models_received - before.models_received, min_models)
       << "the device stopped admitting genuine models during the flood";

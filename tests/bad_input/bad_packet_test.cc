@@ -23,6 +23,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "command_message.h"
@@ -47,12 +48,24 @@ Bytes Encode(const T& msg) {
   return b;
 }
 
-// A signed copy of `msg`, encoded.
+// A copy of `msg` tagged by `tagger`, encoded.
 template <class T>
 Bytes Signed(T msg, const std::string& channel, int64_t epoch, auth::AuthSequence* seq,
-             const auth::SessionKey& key) {
-  EXPECT_TRUE(auth::Sign(&msg, channel, epoch, seq->Next(), key));
+             const auth::Tagger& tagger) {
+  EXPECT_TRUE(auth::Sign(&msg, channel, epoch, seq->Next(), tagger));
   return Encode(msg);
+}
+
+// How the server tags force models for `device`: a MAC under the device's key, claiming
+// the server's role and naming the device.
+auth::Tagger ForceModelTagger(const auth::KeySet& device) {
+  auth::Tagger t;
+  t.role = auth::Role::kServer;
+  t.name = device.name();
+  t.expires_unix_s = device.expires_unix_s();
+  t.key_id = device.credential()->key_id;
+  t.mac_key = device.mac_key();
+  return t;
 }
 
 Bytes Truncated(Bytes b) {
@@ -211,11 +224,15 @@ TEST(BadPacketTest, ALiveServerRefusesAndCountsEveryBadPoseAndCommand) {
   ASSERT_TRUE(test_support::WaitUntil([&] { return server.epoch() != 0; }, 10.0))
       << "no status from the server\n" << server.Log();
   const int64_t epoch = server.epoch();
-  const auth::SessionKey& k = key.key();
+  // The device of the scene's only grasp ("hand") and an operator, issued from the root key.
+  const auth::KeySet device_keys = auth::KeySet::ForRole(key.key(), auth::Role::kDevice, "hand");
+  const auth::KeySet operator_keys = auth::KeySet::ForRole(key.key(), auth::Role::kOperator, "operator");
   auth::AuthSequence seq;
-  const auto pose = [&](device_state_t p, int64_t e) { return Signed(p, ch.device_state, e, &seq, k); };
+  const auto pose = [&](device_state_t p, int64_t e) {
+    return Signed(p, ch.device_state, e, &seq, device_keys.tagger());
+  };
   const auto command = [&](int8_t what, const std::string& arg, int64_t e) {
-    return Signed(test_support::MakeCommand(what, arg), ch.command, e, &seq, k);
+    return Signed(test_support::MakeCommand(what, arg), ch.command, e, &seq, operator_keys.tagger());
   };
   const device_state_t good = Pose("badinput");
   device_state_t nan_pose = good;
@@ -233,9 +250,10 @@ TEST(BadPacketTest, ALiveServerRefusesAndCountsEveryBadPoseAndCommand) {
       {"pose NaN position", ch.device_state, [&] { return pose(nan_pose, epoch); }, "position"},
       {"pose zero quaternion", ch.device_state, [&] { return pose(zero_quaternion, epoch); }, "quaternion"},
       {"pose device_id 2 GB", ch.device_state, [&] { return HugeLength(pose(good, epoch), 24); }, "device_id"},
-      {"pose bad MAC", ch.device_state, [&] { return BadMac(pose(good, epoch)); }, "bad MAC"},
-      {"pose unsigned", ch.device_state, [&] { return Encode(good); }, "bad MAC"},
-      {"pose wrong epoch", ch.device_state, [&] { return pose(good, epoch ^ 0x5A5A); }, "foreign epoch"},
+      {"pose bad MAC", ch.device_state, [&] { return BadMac(pose(good, epoch)); }, "bad-mac"},
+      // No tag at all: the trailer's defaults claim the server's role, which sends no pose.
+      {"pose unsigned", ch.device_state, [&] { return Encode(good); }, "wrong-role"},
+      {"pose wrong epoch", ch.device_state, [&] { return pose(good, epoch ^ 0x5A5A); }, "foreign-epoch"},
       {"pose replayed", ch.device_state,
        [&] {
          replayed = pose(good, epoch);
@@ -243,12 +261,12 @@ TEST(BadPacketTest, ALiveServerRefusesAndCountsEveryBadPoseAndCommand) {
          std::this_thread::sleep_for(std::chrono::milliseconds(100));
          return replayed;
        },
-       "replayed"},
+       "replay"},
       {"command truncated", ch.command, [&] { return Truncated(command(kLoad, "zeeman", epoch)); }, "truncated"},
       {"command wrong fingerprint", ch.command, [&] { return WrongFingerprint(command(kLoad, "zeeman", epoch)); },
        "fingerprint"},
-      {"command bad MAC", ch.command, [&] { return BadMac(command(kLoad, "zeeman", epoch)); }, "bad MAC"},
-      {"command wrong epoch", ch.command, [&] { return command(kLoad, "zeeman", epoch + 1); }, "foreign epoch"},
+      {"command bad MAC", ch.command, [&] { return BadMac(command(kLoad, "zeeman", epoch)); }, "bad-mac"},
+      {"command wrong epoch", ch.command, [&] { return command(kLoad, "zeeman", epoch + 1); }, "foreign-epoch"},
       {"LOAD_SCENE /etc/passwd", ch.command, [&] { return command(kLoad, "/etc/passwd", epoch); },
        "path separator"},
       {"LOAD_SCENE /dev/zero", ch.command, [&] { return command(kLoad, "/dev/zero", epoch); }, "path separator"},
@@ -274,12 +292,18 @@ TEST(BadPacketTest, ALiveServerRefusesAndCountsEveryBadPoseAndCommand) {
 }
 
 // The device's fake server: a signed status with its epoch every 50 ms, and an answer to
-// every pose (kept, so a case can replay one) until StopAnswering: from then on the
-// cases' models are the only ones, signed with model_seq() from the test's thread.
+// every pose (kept, so a case can replay one; MAC'd under the key of device "hand", which
+// the device given the root key acts as) until StopAnswering: from then on the cases'
+// models are the only ones, tagged with model_seq() from the test's thread.
 class FakeServer {
  public:
-  FakeServer(const messages::Channels& ch, lcm::LCM* lcm, const auth::SessionKey* key)
-      : ch_(ch), lcm_(lcm), key_(key), epoch_(auth::NewEpoch()) {
+  FakeServer(const messages::Channels& ch, lcm::LCM* lcm, const auth::SessionKey& root)
+      : ch_(ch),
+        lcm_(lcm),
+        server_(auth::KeySet::ForRole(root, auth::Role::kServer)),
+        device_(auth::KeySet::ForRole(root, auth::Role::kDevice, "hand")),
+        model_tagger_(ForceModelTagger(device_)),
+        epoch_(auth::NewEpoch()) {
     messages::Subscribe<&FakeServer::OnPose>(lcm_, ch_.device_state, this);
   }
   void Tick() {
@@ -288,7 +312,7 @@ class FakeServer {
     solver_status_t st{};
     st.scene = "fake";
     st.method = "fake";
-    if (auth::Sign(&st, ch_.solver_status, epoch_, status_seq_.Next(), *key_)) {
+    if (auth::Sign(&st, ch_.solver_status, epoch_, status_seq_.Next(), server_.tagger())) {
       lcm_->publish(ch_.solver_status, &st);
     }
   }
@@ -303,6 +327,7 @@ class FakeServer {
   }
   void StopAnswering() { answering_.store(false); }
   auth::AuthSequence* model_seq() { return &model_seq_auth_; }
+  const auth::Tagger& model_tagger() const { return model_tagger_; }
 
  private:
   void OnPose(const lcm::ReceiveBuffer* rbuf, const std::string&) {
@@ -314,7 +339,7 @@ class FakeServer {
     m.device_seq = pose.seq;
     m.device_utime = pose.utime;
     for (int i = 0; i < 3; ++i) m.u0[i] = pose.position[i];
-    if (!auth::Sign(&m, ch_.force_model, epoch_, model_seq_auth_.Next(), *key_)) return;
+    if (!auth::Sign(&m, ch_.force_model, epoch_, model_seq_auth_.Next(), model_tagger_)) return;
     std::lock_guard<std::mutex> lock(mutex_);
     last_ = m;
     last_bytes_ = Encode(m);
@@ -323,7 +348,9 @@ class FakeServer {
 
   messages::Channels ch_;
   lcm::LCM* lcm_;
-  const auth::SessionKey* key_;
+  const auth::KeySet server_;
+  const auth::KeySet device_;
+  const auth::Tagger model_tagger_;
   int64_t epoch_;
   auth::AuthSequence status_seq_;
   auth::AuthSequence model_seq_auth_;
@@ -356,7 +383,7 @@ TEST(BadPacketTest, ALiveDeviceRefusesAndCountsEveryBadForceModel) {
   };
   // The fake server on its own LCM instance and thread.
   lcm::LCM server_lcm(test_support::kLoopbackLcmUrl);
-  FakeServer server(ch, &server_lcm, &key.key());
+  FakeServer server(ch, &server_lcm, key.key());
   std::atomic<bool> stop{false};
   std::thread server_thread([&] {
     while (!stop.load()) {
@@ -370,9 +397,8 @@ TEST(BadPacketTest, ALiveDeviceRefusesAndCountsEveryBadForceModel) {
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   server.StopAnswering();
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  const auth::SessionKey& k = key.key();
   const auto model = [&](force_model_t m, int64_t e) {
-    return Signed(m, ch.force_model, e, server.model_seq(), k);
+    return Signed(m, ch.force_model, e, server.model_seq(), server.model_tagger());
   };
   const auto answer = [&] { return server.LastAnswer(); };
   std::vector<PacketCase> cases = {

@@ -1,10 +1,13 @@
 // libFuzzer target: the receive-side authentication gate (common/auth, docs/security.md).
 // The input is a script read front to back: a filter set-up, then operations that feed the
-// gate genuinely signed messages (a fixed test key, so the fuzzer gets past the MAC into
-// the freshness logic), the same with one byte flipped, signed for another channel or
-// with another key, replays of admitted buffers, raw bytes as a packet, new epochs, pose
-// echoes for force models and log lines. Each operation checks what the gate must do:
-//   * a message whose bytes differ from what the key holder signed is never admitted;
+// gate genuinely tagged messages (a fixed test device key for MACs and a fixed server
+// signing key, so the fuzzer gets past the tag into the freshness logic), the same with
+// one byte flipped, tagged for another channel or with another key, messages the server
+// signs (statuses, command replies: AdmitSigned), replays of admitted buffers, raw bytes
+// as a packet, new epochs, pose echoes for force models and log lines. Each operation
+// checks what the gate must do:
+//   * a message whose bytes differ from what the key holder tagged is never admitted;
+//   * a signed message is admitted only with the server's signature and role;
 //   * a buffer admitted once is never admitted again (while the receiver's epoch stays);
 //   * the decision equals the one freshness_filter.h specifies (epoch policy, strictly
 //     increasing auth_seq), computed here by an independent model;
@@ -31,6 +34,7 @@
 #include "auth/message_mac.h"
 #include "auth/pose_echo_window.h"
 #include "auth/session_key.h"
+#include "auth/signature.h"
 #include "messages/validate.h"
 #include "sample_messages.h"
 
@@ -77,6 +81,7 @@ enum Op : uint8_t {
   kRecordPose,       // the device sends a pose (PoseEchoWindow)
   kForceModel,       // a signed force model through AdmitForceModel
   kLogLine,          // TakeLogLine
+  kServerSigned,     // a status or reply signed by the server (or claiming another role), maybe flipped
   kOpCount
 };
 
@@ -96,6 +101,20 @@ const auth::SessionKey& Key() {
 const auth::SessionKey& OtherKey() {
   static const auth::SessionKey key = (auth::InitSodium(), auth::SessionKey::FromBytes(kOtherKey, 32));
   return key;
+}
+// The server's signing key (a fixed seed: the test key's bytes).
+const auth::Signer& ServerSigner() {
+  static const auth::Signer signer = (auth::InitSodium(), auth::Signer::FromSeed(kTestKey));
+  return signer;
+}
+
+// A device "hand" MACing with `key` (the test key, or another for kWrongKey).
+auth::Tagger MacTagger(const auth::SessionKey& key) {
+  auth::Tagger t;
+  t.role = auth::Role::kDevice;
+  t.name = "hand";
+  t.mac_key = &key;
+  return t;
 }
 
 // A few epochs, so scripts hit equal ones often; 0 is "none".
@@ -217,30 +236,25 @@ struct Signed {
 };
 
 template <class Msg>
+bool SignInto(Msg* m, const char* channel, const auth::Tagger& tagger, int64_t epoch, int64_t seq, Signed* out) {
+  if (!auth::Sign(m, channel, epoch, seq, tagger)) return false;
+  out->bytes = test_support::Encode(*m);
+  out->epoch = epoch;
+  out->seq = seq;
+  return true;
+}
+template <class Msg>
 bool SignInto(Msg* m, const char* channel, const auth::SessionKey& key, int64_t epoch, int64_t seq, Signed* out) {
-  if (!auth::Sign(m, channel, epoch, seq, key)) return false;
+  if (!auth::Sign(m, channel, epoch, seq, MacTagger(key))) return false;
   out->bytes = test_support::Encode(*m);
   out->epoch = epoch;
   out->seq = seq;
   return true;
 }
 
-// What a receiver does with a packet on kChannel: exact decode (else dropped before the
-// gate, as messages::DecodeAndValidate refuses it), then Admit. *offered says whether the
-// gate saw it; the model's expectation is checked and applied.
+// Counts the gate's decision in the model; an admitted buffer is remembered for replays.
 template <class Msg>
-Reason Offer(State& st, const std::vector<uint8_t>& bytes, bool* offered) {
-  Msg decoded;
-  *offered = messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &decoded, nullptr);
-  if (!*offered) {
-    // Never handed to the gate; the MAC check must still be safe on any bytes.
-    (void)auth::VerifyEncoded(bytes.data(), bytes.size(), kChannel, Key());
-    return Reason::kBadMac;
-  }
-  const bool mac_ok = auth::VerifyEncoded(bytes.data(), bytes.size(), kChannel, Key());
-  const Reason expected = mac_ok ? st.model.Check(decoded.epoch, decoded.auth_seq) : Reason::kBadMac;
-  const Reason got = auth::Admit(bytes.data(), bytes.size(), decoded, kChannel, Key(), &st.filter);
-  REQUIRE(got == expected);
+Reason Apply(State& st, Reason got, const Msg& decoded, const std::vector<uint8_t>& bytes) {
   ++st.model.counts[static_cast<int>(got)];
   if (got == Reason::kAccepted) {
     st.model.Admit(decoded.epoch, decoded.auth_seq);
@@ -251,13 +265,49 @@ Reason Offer(State& st, const std::vector<uint8_t>& bytes, bool* offered) {
   return got;
 }
 
+// What a receiver does with a packet on kChannel: exact decode (else dropped before the
+// gate, as messages::DecodeAndValidate refuses it), then Admit. *offered says whether the
+// gate saw it; the model's expectation is checked and applied.
+template <class Msg>
+Reason Offer(State& st, const std::vector<uint8_t>& bytes, bool* offered) {
+  Msg decoded;
+  *offered = messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &decoded, nullptr);
+  if (!*offered) {
+    // Never handed to the gate; the tag checks must still be safe on any bytes.
+    (void)auth::VerifyMac(bytes.data(), bytes.size(), kChannel, Key());
+    (void)auth::VerifySignature(bytes.data(), bytes.size(), kChannel, ServerSigner().public_key());
+    return Reason::kBadMac;
+  }
+  const bool mac_ok = auth::VerifyMac(bytes.data(), bytes.size(), kChannel, Key());
+  const Reason expected = mac_ok ? st.model.Check(decoded.epoch, decoded.auth_seq) : Reason::kBadMac;
+  const Reason got = auth::Admit(bytes.data(), bytes.size(), decoded, kChannel, Key(), &st.filter);
+  REQUIRE(got == expected);
+  return Apply(st, got, decoded, bytes);
+}
+
+// What the observers, the devices and snapthread-ctl do with a message the server signs:
+// exact decode, then AdmitSigned (the server's role and signature, then freshness).
+template <class Msg>
+Reason OfferSigned(State& st, const std::vector<uint8_t>& bytes, bool* offered) {
+  Msg decoded;
+  *offered = messages::DecodeAndValidate(bytes.data(), static_cast<int>(bytes.size()), &decoded, nullptr);
+  if (!*offered) return Reason::kBadMac;
+  const bool sig_ok = decoded.sender_role == static_cast<int8_t>(auth::Role::kServer) &&
+                      auth::VerifySignature(bytes.data(), bytes.size(), kChannel, ServerSigner().public_key());
+  const Reason expected = sig_ok ? st.model.Check(decoded.epoch, decoded.auth_seq) : Reason::kBadMac;
+  const Reason got =
+      auth::AdmitSigned(bytes.data(), bytes.size(), decoded, kChannel, ServerSigner().public_key(), &st.filter);
+  REQUIRE(got == expected);
+  return Apply(st, got, decoded, bytes);
+}
+
 using OfferFn = Reason (*)(State&, const std::vector<uint8_t>&, bool*);
 
 // Signs a script-chosen message of a script-chosen type.
 bool MakeSigned(Script& in, State& st, const char* channel, const auth::SessionKey& key, Signed* out, OfferFn* offer) {
   const int64_t epoch = PickEpoch(in, st);
   const int64_t seq = PickSeq(in, st);
-  switch (in.U8() % 4) {
+  switch (in.U8() % 5) {
     case 0: {
       auto m = Fill<device_state_t>(in);
       *offer = &Offer<device_state_t>;
@@ -273,11 +323,54 @@ bool MakeSigned(Script& in, State& st, const char* channel, const auth::SessionK
       *offer = &Offer<command_t>;
       return SignInto(&m, channel, key, epoch, seq, out);
     }
-    default: {
+    case 3: {
       auto m = Fill<force_model_t>(in);
       *offer = &Offer<force_model_t>;
       return SignInto(&m, channel, key, epoch, seq, out);
     }
+    default: {
+      auto m = Fill<command_reply_t>(in);
+      *offer = &Offer<command_reply_t>;
+      return SignInto(&m, channel, key, epoch, seq, out);
+    }
+  }
+}
+
+// A status or a command reply tagged by the server's signer, or by a tagger claiming
+// another role or holding no signer; sometimes one byte flipped where the signature
+// covers it (outside signature2 and mac). Offered through AdmitSigned.
+void ServerSignedStep(Script& in, State& st) {
+  const int64_t epoch = PickEpoch(in, st);
+  const int64_t seq = PickSeq(in, st);
+  const uint8_t how = in.U8();
+  auth::Tagger tagger;
+  tagger.role = how % 8 == 1 ? auth::Role::kOperator : auth::Role::kServer;  // claims another role
+  tagger.signer = how % 8 == 2 ? nullptr : &ServerSigner();                   // 2: unsigned
+  if (how % 8 == 3) tagger.mac_key = &Key();                                  // a MAC instead
+  if (how % 8 == 3) tagger.signer = nullptr;
+  const bool reply = (how & 0x80) != 0;
+  Signed s;
+  OfferFn offer = nullptr;
+  if (reply) {
+    auto m = Fill<command_reply_t>(in);
+    offer = &OfferSigned<command_reply_t>;
+    if (!SignInto(&m, kChannel, tagger, epoch, seq, &s)) return;
+  } else {
+    auto m = Fill<solver_status_t>(in);
+    offer = &OfferSigned<solver_status_t>;
+    if (!SignInto(&m, kChannel, tagger, epoch, seq, &s)) return;
+  }
+  const bool flipped = (how & 0x40) != 0;
+  if (flipped) {
+    const size_t covered = s.bytes.size() - auth::kSignatureBytes - auth::kMacBytes;
+    s.bytes[in.U16() % covered] ^= static_cast<uint8_t>(1u + in.U8() % 255u);
+  }
+  bool offered = false;
+  const Reason got = offer(st, s.bytes, &offered);
+  if (how % 8 >= 1 && how % 8 <= 3) REQUIRE(got != Reason::kAccepted);  // not the server signing as itself
+  if (flipped) {
+    REQUIRE(!auth::VerifySignature(s.bytes.data(), s.bytes.size(), kChannel, ServerSigner().public_key()));
+    REQUIRE(got != Reason::kAccepted);
   }
 }
 
@@ -305,7 +398,7 @@ void ForceModelStep(Script& in, State& st) {
   if (flip >= 224) s.bytes[in.U16() % s.bytes.size()] ^= static_cast<uint8_t>(1u + in.U8() % 255u);
   force_model_t decoded;
   if (!messages::DecodeAndValidate(s.bytes.data(), static_cast<int>(s.bytes.size()), &decoded, nullptr)) return;
-  const bool mac_ok = auth::VerifyEncoded(s.bytes.data(), s.bytes.size(), kChannel, Key());
+  const bool mac_ok = auth::VerifyMac(s.bytes.data(), s.bytes.size(), kChannel, Key());
   const bool echoed = st.poses.Contains(decoded.epoch, decoded.device_seq, decoded.device_utime);
   // No false echo: the window only knows poses that were recorded.
   if (echoed) REQUIRE(st.recorded.count({decoded.epoch, decoded.device_seq, decoded.device_utime}) == 1);
@@ -350,7 +443,7 @@ void Step(Script& in, State& st) {
       const Reason got = offer(st, s.bytes, &offered);
       if (op != kGenuine) {
         // Any byte changed, another channel or another key: refused by the MAC.
-        REQUIRE(!auth::VerifyEncoded(s.bytes.data(), s.bytes.size(), kChannel, Key()));
+        REQUIRE(!auth::VerifyMac(s.bytes.data(), s.bytes.size(), kChannel, Key()));
         if (offered) REQUIRE(got == Reason::kBadMac);
       } else {
         REQUIRE(offered);  // a signed sample always decodes
@@ -369,6 +462,7 @@ void Step(Script& in, State& st) {
       if (!offered) got = Offer<solver_status_t>(st, bytes, &offered);
       if (!offered) got = Offer<command_t>(st, bytes, &offered);
       if (!offered) got = Offer<force_model_t>(st, bytes, &offered);
+      if (!offered) got = Offer<command_reply_t>(st, bytes, &offered);
       REQUIRE(offered);
       if (once) REQUIRE(got != Reason::kAccepted);
       break;
@@ -379,11 +473,14 @@ void Step(Script& in, State& st) {
       const uint8_t type = in.U8();
       const std::vector<uint8_t> bytes = in.Bytes(in.U16() % 4096);
       bool offered = false;
-      switch (type % 4) {
+      switch (type % 7) {
         case 0: Offer<device_state_t>(st, bytes, &offered); break;
         case 1: Offer<solver_status_t>(st, bytes, &offered); break;
         case 2: Offer<command_t>(st, bytes, &offered); break;
-        default: Offer<force_model_t>(st, bytes, &offered); break;
+        case 3: Offer<force_model_t>(st, bytes, &offered); break;
+        case 4: Offer<command_reply_t>(st, bytes, &offered); break;
+        case 5: OfferSigned<solver_status_t>(st, bytes, &offered); break;
+        default: OfferSigned<command_reply_t>(st, bytes, &offered); break;
       }
       break;
     }
@@ -407,6 +504,7 @@ void Step(Script& in, State& st) {
       break;
     }
     case kForceModel: ForceModelStep(in, st); break;
+    case kServerSigned: ServerSignedStep(in, st); break;
     case kLogLine: {
       st.now_us += in.U16();
       std::string line;
@@ -523,8 +621,38 @@ void WriteSeeds(const std::string& dir) {
     Signed s;
     if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(3, s.bytes);
   }
+  {
+    auto m = test_support::Sample<command_reply_t>();
+    Signed s;
+    if (SignInto(&m, kChannel, Key(), kEpochs[0], seq++, &s)) add_raw(4, s.bytes);
+  }
+  // What the server signs: a status and a reply.
+  auth::Tagger server;
+  server.signer = &ServerSigner();
+  {
+    auto m = test_support::Sample<solver_status_t>();
+    Signed s;
+    if (SignInto(&m, kChannel, server, kEpochs[0], seq++, &s)) add_raw(5, s.bytes);
+  }
+  {
+    auto m = test_support::Sample<command_reply_t>();
+    Signed s;
+    if (SignInto(&m, kChannel, server, kEpochs[0], seq++, &s)) add_raw(6, s.bytes);
+  }
   raw.insert(raw.end(), {kReplay, 0, kReplay, 1, kLogLine, 1, 0});
   write("raw_signed_packets", raw);
+
+  // Server-signed steps: own epoch, next seq, each way of tagging, flipped or not, status
+  // or reply: how, then utime(8), seq(8), flip position(2), xor.
+  std::vector<uint8_t> signed_steps = {1, 0};  // kAdopt
+  for (int k = 0; k < 16; ++k) {
+    const auto how = static_cast<uint8_t>((k % 4) | (k & 4 ? 0x40 : 0) | (k & 8 ? 0x80 : 0));
+    signed_steps.insert(signed_steps.end(), {kServerSigned, 0, 0, 0, how});
+    le64(&signed_steps, 1700000000000000 + k);
+    le64(&signed_steps, k);
+    signed_steps.insert(signed_steps.end(), {static_cast<uint8_t>(13 * k), 0, 1});
+  }
+  write("server_signed", signed_steps);
 }
 
 }  // namespace

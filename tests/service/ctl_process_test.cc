@@ -1,7 +1,9 @@
 // snapthread-ctl against a real snapthread-server over udpm on loopback: each subcommand
 // waits for the server's authenticated answer and exits 0 when applied, 1 with the
-// server's reason when refused, 3 when no authenticated answer came (another key, no
-// server) and 2 for bad arguments.
+// server's reason when refused, 3 when no authenticated answer came (another session's
+// key, no server) and 2 for bad arguments. It runs as the operator: on the root key
+// (operator "operator") or an operator credential; an observer's or a device's credential
+// refuses to start (exit 1), naming the operator role.
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -10,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include "app/exit_codes.h"
+#include "auth/credential.h"
+#include "auth/credential_file.h"
 #include "process_session_test.h"
 #include "session_key_file.h"
 #include "test_support.h"
@@ -55,9 +59,44 @@ class CtlProcessTest : public test_support::ProcessSessionTest {
     return ctl.Finish(60.0);
   }
 
+  // A credential for `role` issued from the session's root key, in the test's directory.
+  std::string Credential(auth::Role role, const std::string& name) {
+    const std::string path = tmp_->path() + "/" + std::string(auth::RoleToString(role)) + "_" + name + ".cred";
+    auth::WriteCredentialFile(path, auth::IssueCredential(key_file_.key(), role, name, auth::kNeverExpires),
+                              false);
+    return path;
+  }
+
   std::unique_ptr<ChildProcess> server_;
   int runs_ = 0;
 };
+
+TEST_F(CtlProcessTest, ACredentialOfAnotherRoleRefusesToStartNamingTheOperator) {
+  // No server needed: the console refuses before it listens.
+  for (const std::string& cred : {Credential(auth::Role::kObserver, ""), Credential(auth::Role::kDevice, "hand")}) {
+    const ProcessResult r = Ctl({"--key", cred, "--timeout-s", "5", "load-scene", "zeeman"});
+    EXPECT_EQ(r.exit_code, app::kExitFailure) << cred << r.out << r.err;
+    EXPECT_NE(r.err.find("operator"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("snapthread-ctl"), std::string::npos) << r.err;
+  }
+}
+
+TEST_F(CtlProcessTest, AnOperatorCredentialLoadsTheSceneAndAnObserverChangesNothing) {
+  ASSERT_NO_FATAL_FAILURE(StartServer());
+  const std::string observer = Credential(auth::Role::kObserver, "");
+  ProcessResult r = Ctl({"--key", observer, "load-scene", "zeeman"});
+  EXPECT_NE(r.exit_code, app::kExitOk) << r.out << r.err;
+  r = Ctl({"status"});
+  ASSERT_EQ(r.exit_code, app::kExitOk) << r.err;
+  EXPECT_NE(r.out.find("scene: curve2d_snap\n"), std::string::npos) << r.out;
+
+  r = Ctl({"--key", Credential(auth::Role::kOperator, "alice"), "load-scene", "zeeman"});
+  ASSERT_EQ(r.exit_code, app::kExitOk) << r.out << r.err;
+  EXPECT_NE(r.out.find("now scene 'zeeman'"), std::string::npos) << r.out;
+  r = Ctl({"status"});
+  EXPECT_NE(r.out.find("scene: zeeman\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("refusals: "), std::string::npos) << r.out;
+}
 
 TEST_F(CtlProcessTest, CommandsAreAnsweredAndStatusFollowsThem) {
   ASSERT_NO_FATAL_FAILURE(StartServer());
@@ -96,7 +135,8 @@ TEST_F(CtlProcessTest, AnotherKeyGetsNoAnswerAndSendsNothing) {
   ProcessResult before = Ctl({"status"});
   ASSERT_EQ(before.exit_code, app::kExitOk) << before.err;
   {
-    // Its statuses do not verify under another key: the console learns no epoch, sends
+    // Another session's root key (acting as its operator): the server's statuses do not
+    // verify under that session's server key, so the console learns no epoch, sends
     // nothing, and says why it timed out.
     test_support::SessionKeyFile other;
     const ProcessResult r = Ctl({"--key", other.path(), "--timeout-s", "1.5", "reset"});

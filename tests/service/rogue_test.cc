@@ -19,6 +19,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "auth/freshness_filter.h"
+#include "auth/key_set.h"
 #include "auth/message_gate.h"
 #include "auth/message_mac.h"
 #include "messages/channels.h"
@@ -42,16 +43,17 @@ double JsonNumber(const std::string& json, const std::string& key) {
   return std::strtod(json.c_str() + p + k.size(), nullptr);
 }
 
-// Watches the genuine server as a key holder would: statuses with a valid MAC and a fresh
-// sequence (the epoch adopted from them), their gaps, scene and method; force models of
-// that epoch with a valid MAC. Exclude(epoch) ignores a recorded session's epoch: its
+// Watches the genuine server as the root key's holder would: statuses signed by the server
+// with a fresh sequence (the epoch adopted from them), their gaps, scene and method; force
+// models of that epoch with a valid MAC under the key of device "hand" (the scene's only
+// grasp, which the device given the root key acts as). Exclude(epoch) ignores a recorded session's epoch: its
 // statuses and models carry valid MACs, so the rogue's replay of them would otherwise be
 // taken for the live server (a watcher started before the live server's first status
 // adopts the replayed epoch; the sanitized build's slower start showed it).
 class Watcher {
  public:
-  Watcher(const std::string& session, const auth::SessionKey* key)
-      : channels_(session), key_(key) {
+  Watcher(const std::string& session, const auth::SessionKey& root)
+      : channels_(session), device_(auth::KeySet::ForRole(root, auth::Role::kDevice, "hand")) {
     messages::Subscribe<&Watcher::OnStatus>(lcm_, channels_.solver_status, this);
     messages::Subscribe<&Watcher::OnModel>(lcm_, channels_.force_model, this);
     thread_ = std::thread([this] {
@@ -97,8 +99,8 @@ class Watcher {
     solver_status_t st;
     if (!messages::DecodeAndValidate(rbuf, &st, nullptr)) return;
     if (st.epoch == excluded_epoch_.load()) return;
-    if (auth::Admit(rbuf->data, rbuf->data_size, st, channel, *key_, &status_filter_) !=
-        auth::Reason::kAccepted) {
+    if (auth::AdmitSigned(rbuf->data, rbuf->data_size, st, channel, device_.server_public_key(),
+                          &status_filter_) != auth::Reason::kAccepted) {
       return;
     }
     std::lock_guard<std::mutex> lock(mutex_);
@@ -116,13 +118,16 @@ class Watcher {
     if (!messages::DecodeAndValidate(rbuf, &m, nullptr)) return;
     if (m.epoch == excluded_epoch_.load()) return;
     if (m.epoch != status_filter_.epoch() || status_filter_.epoch() == 0) return;
-    if (!auth::VerifyEncoded(rbuf->data, rbuf->data_size, channel, *key_)) return;
+    if (m.sender_role != static_cast<int8_t>(auth::Role::kServer) || m.sender_name != device_.name() ||
+        !auth::VerifyMac(rbuf->data, rbuf->data_size, channel, *device_.mac_key())) {
+      return;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     ++genuine_models_;
   }
 
   messages::Channels channels_;
-  const auth::SessionKey* key_;
+  const auth::KeySet device_;
   lcm::LCM lcm_{kUrl};
   auth::FreshnessFilter status_filter_{"status", auth::FreshnessFilter::EpochPolicy::kAdopt};
   std::atomic<bool> stop_{false};
@@ -158,7 +163,7 @@ TEST(RogueTest, NoKeyNoForceNoCommandsAndTheGenuineSessionStillWorks) {
   // 1. A genuine session, logged; its epoch (what the rogue replays) noted.
   int64_t logged_epoch = 0;
   {
-    Watcher recorded(session, &key_file.key());
+    Watcher recorded(session, key_file.key());
     ASSERT_TRUE(recorded.good());
     ChildProcess logger({SNAPTHREAD_LCM_LOGGER, "-q", "-c", session + "_.*",
                          std::string("--lcm-url=") + kUrl, "-f", log},
@@ -199,7 +204,7 @@ TEST(RogueTest, NoKeyNoForceNoCommandsAndTheGenuineSessionStillWorks) {
 
   // 3. A lone server under the rogue: no forged pose answered, scene and method kept,
   // status flowing; 4. then a genuine device gets its models.
-  Watcher watcher(session, &key_file.key());
+  Watcher watcher(session, key_file.key());
   ASSERT_TRUE(watcher.good());
   watcher.Exclude(logged_epoch);
   ChildProcess server(server_argv("9", dir + "/server.json"), OneLog(dir + "/server.txt"));

@@ -1,9 +1,10 @@
-// A host without the session key flooding a snapthread session: forged messages on every
-// channel of the session (<S>_DEVICE_STATE, _FORCE_MODEL, _SHAPE, _SOLVER_STATUS,
-// _DEVICE_STATUS, _COMMAND) at a fixed rate per channel, from one thread. Each is a valid
-// LCM encoding of its channel's type that passes the receivers' decode and validation, so
-// it costs them the whole receive path up to the MAC check, and carries a MAC made under
-// a key of the forger's own (docs/security.md, "Denial of service"). The forged force
+// A forger flooding a snapthread session: forged messages on every channel of the session
+// (<S>_DEVICE_STATE, _FORCE_MODEL, _SHAPE, _SOLVER_STATUS, _DEVICE_STATUS, _COMMAND) at a
+// fixed rate per channel, from one thread. Each is a valid LCM encoding of its channel's
+// type that passes the receivers' decode and validation, so it costs them the whole
+// receive path up to the tag check (docs/security.md, "Denial of service"). What the tags
+// are made with is the forger's kind (ForgerKind): no key of the session, or a credential
+// of a role that may not speak there, or another session's root key. The forged force
 // models ask for `forged_force_n` newtons along +z with a stiff K: a device that rendered
 // one would push along z, which a planar scene never does.
 //
@@ -19,6 +20,26 @@
 
 namespace snapthread::flood {
 
+// What the forger holds, and so how it tags (docs/security.md, "Roles on the wire").
+enum class ForgerKind {
+  // No key of the session: MACs under a key of its own, claiming each channel's sender.
+  kNoKey,
+  // This session's observer credential: MACs with the one secret it holds (the read key),
+  // claiming each channel's sender.
+  kObserver,
+  // Another device's credential (`forger_name`): its own key, MACs that verify. Its poses
+  // claim its own name (a grasp it does not hold); elsewhere it claims the genuine senders.
+  // It sends no DEVICE_STATUS (a device may report its own status).
+  kOtherDevice,
+  // An operator credential (`forger_name`): its own key and role on every channel but
+  // COMMAND (where an operator may speak).
+  kOperator,
+  // Another session's root key: signs as that session's server and MACs with that
+  // session's device "hand" and operator keys, claiming each channel's sender.
+  kOtherSessionRoot,
+};
+const char* ForgerKindName(ForgerKind kind);
+
 struct ForgerOptions {
   std::string lcm_url;
   std::string session;  // the genuine session whose channels are flooded
@@ -27,8 +48,17 @@ struct ForgerOptions {
   // and shapes of this many nodes.
   double forged_force_n = 1000.0;
   int forged_shape_nodes = 20;
-  // Forged epoch and auth_seq: anything; the MAC check comes first and refuses them.
+  // Forged epoch and auth_seq: anything; the tag check comes first and refuses them.
+  // Forgers holding one of this session's credentials first learn the genuine epoch from
+  // a SOLVER_STATUS signed by the server (up to `learn_epoch_s`), so that only their role
+  // can stop them; `epoch` is kept when none comes.
   int64_t epoch = 0x5eed;
+  double learn_epoch_s = 5.0;
+  ForgerKind kind = ForgerKind::kNoKey;
+  // This session's root key file: kObserver, kOtherDevice and kOperator issue their
+  // credential from it (as snapthread-keygen would on the server host).
+  std::string root_key_path;
+  std::string forger_name = "intruder";  // the credential's name (kOtherDevice, kOperator)
 };
 
 class ForgedFlood {
@@ -44,7 +74,8 @@ class ForgedFlood {
   // Stops and joins the thread (idempotent).
   void Stop();
 
-  static constexpr int kChannels = 6;
+  // Channels flooded: 6, or 5 where the kind may speak on one (see ForgerKind).
+  int channels() const { return channels_; }
   // Messages handed to LCM so far, on all channels together, and publish failures.
   uint64_t sent() const { return sent_.load(std::memory_order_relaxed); }
   uint64_t failures() const { return failures_.load(std::memory_order_relaxed); }
@@ -53,6 +84,7 @@ class ForgedFlood {
 
  private:
   void Run();
+  int channels_ = 6;
 
   ForgerOptions options_;
   std::thread thread_;
