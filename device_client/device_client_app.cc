@@ -17,6 +17,7 @@
 #include "auth/key_file.h"
 #include "auth/key_id.h"
 #include "auth/key_set.h"
+#include "auth/sealed_message.h"
 #include "auth/role.h"
 #include "device_client.h"
 #include "device_keys.h"
@@ -179,11 +180,17 @@ void ReloadDeviceKeys(const ClientSetup& setup) {
     auth::KeySet next =
         AsDevice(auth::LoadKeySet(setup.key_path, auth::Role::kDevice, kProgram), setup.keys->name());
     const std::string id = auth::KeyIdToHex(next.tagger().key_id);
+    const auth::SessionKey previous_read =
+        auth::SessionKey::FromBytes(setup.keys->current().read_key().data(), auth::SessionKey::kBytes);
+    const auth::SessionKey next_read = auth::SessionKey::FromBytes(next.read_key().data(), auth::SessionKey::kBytes);
     std::string error;
     if (!setup.keys->Replace(std::move(next), realtime::MonotonicMicros(), &error)) {
       spdlog::error("device: reload of {} refused, keeping the current credential: {}", setup.key_path, error);
       return;
     }
+    // Sealed messages: open under both read keys (the server seals with the previous one
+    // during its grace), seal with the new one.
+    auth::SetSealing(next_read, &previous_read, auth::SealingOutgoing());
     spdlog::info("device: reloaded {}: key id {}; the previous key is accepted for {:.0f} s", setup.key_path, id,
                  1e-6 * static_cast<double>(setup.keys->grace_us()));
   } catch (const std::exception& e) {
@@ -425,6 +432,7 @@ std::optional<int> ParseDeviceClientArgs(int argc, char** argv, DeviceClientOpti
       ->check(CLI::ExistingFile);
   app::CommonFlagSet common;
   common.log_level = true;
+  common.encrypt = true;
   app::AddCommonFlags(&cli, &o->common, common);
   cli.add_option("--duration", o->duration_s, "seconds to run, 0 = until SIGINT/SIGTERM")
       ->check(CLI::Range(0.0, 1e7))

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "messages/subscribe.h"
+#include "messages/publish.h"
 
 namespace snapthread::device {
 
@@ -45,11 +46,11 @@ int LcmDeviceTransport::PollSolverStatus(const StatusSink& sink) {
 }
 
 bool LcmDeviceTransport::PublishDeviceState(const device_state_t& msg) {
-  return lcm_.publish(channels_.device_state, &msg) == 0;
+  return messages::Publish(&lcm_, channels_.device_state, msg) == 0;
 }
 
 bool LcmDeviceTransport::PublishDeviceStatus(const device_status_t& msg) {
-  return lcm_.publish(channels_.device_status, &msg) == 0;
+  return messages::Publish(&lcm_, channels_.device_status, msg) == 0;
 }
 
 int LcmDeviceTransport::PollForceModels(int wait_ms, const ForceModelSink& sink) {

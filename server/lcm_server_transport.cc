@@ -2,6 +2,7 @@
 
 #include "messages/lcm_url.h"
 #include "messages/subscribe.h"
+#include "messages/publish.h"
 
 namespace snapthread::server {
 
@@ -31,19 +32,19 @@ void LcmServerTransport::Subscribe() {
 }
 
 bool LcmServerTransport::PublishForceModel(const force_model_t& msg) {
-  return lcm_->publish(channels_.force_model, &msg) == 0;
+  return messages::Publish(lcm_, channels_.force_model, msg) == 0;
 }
 
 bool LcmServerTransport::PublishShape(const thread_shape_t& msg) {
-  return lcm_->publish(channels_.shape, &msg) == 0;
+  return messages::Publish(lcm_, channels_.shape, msg) == 0;
 }
 
 bool LcmServerTransport::PublishSolverStatus(const solver_status_t& msg) {
-  return lcm_->publish(channels_.solver_status, &msg) == 0;
+  return messages::Publish(lcm_, channels_.solver_status, msg) == 0;
 }
 
 bool LcmServerTransport::PublishCommandReply(const command_reply_t& msg) {
-  return lcm_->publish(channels_.command_reply, &msg) == 0;
+  return messages::Publish(lcm_, channels_.command_reply, msg) == 0;
 }
 
 int LcmServerTransport::Receive(int wait_ms, InboundSink* sink) {

@@ -7,7 +7,7 @@ namespace {
 
 constexpr std::array<std::string_view, kRefusalCount> kNames = {
     "malformed", "wrong-role", "unknown-key", "expired",       "revoked", "grace-over",
-    "bad-mac",   "wrong-grasp", "foreign-epoch", "replay", "too-many"};
+    "bad-mac",   "wrong-grasp", "foreign-epoch", "replay", "too-many", "no-such-grasp"};
 
 std::string_view SlotName(int slot) {
   if (slot >= RefusalCounts::kRoleSlots - 1) return "unknown";

@@ -29,8 +29,9 @@ enum class RefusalReason : uint8_t {
   kForeignEpoch,  // another server session's epoch
   kReplay,        // auth_seq not above the last accepted one
   kTooMany,       // more senders or keys than the gate tracks
+  kNoSuchGrasp,   // an authenticated device's pose for a grasp the scene does not have
 };
-inline constexpr int kRefusalCount = 11;
+inline constexpr int kRefusalCount = 12;
 // "malformed", "wrong-role", ... as published.
 std::string_view RefusalName(RefusalReason refusal);
 // The refusal of a key ring verdict (not kAccepted) and of a freshness reason.

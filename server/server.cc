@@ -56,7 +56,7 @@ Server::Server(const ServerParams& params, ServerTransport* transport,
   if (!params_.IsValid(&error)) throw std::invalid_argument(error);
   keys_ = std::make_unique<ServerKeys>(key_location_.path,
                                        auth::SessionKey::FromBytes(key_.data(), auth::SessionKey::kBytes),
-                                       params_.key_grace_s);
+                                       params_.key_grace_s, params_.encrypt);
   channels_ = messages::Channels(params_.session);
   if (params_.scene_dir.empty()) params_.scene_dir = DefaultSceneDir();
   solve_loop_ = std::make_unique<SolveLoop>(params_, channels_, key_, epoch_, std::move(hooks),
@@ -104,6 +104,7 @@ void Server::ReceiveLoop() {
   while (!stop_.load()) {
     // A reload is applied here, between two receives: the ring belongs to this thread.
     if (reload_requested_.exchange(false, std::memory_order_acq_rel)) keys_->Reload(UnixSeconds());
+    keys_->Tick(UnixSeconds());
     if (transport_->Receive(kReceiveTimeoutMs, gate_.get()) < 0) {
       // A transport error (socket gone): do not spin on it.
       std::this_thread::sleep_for(std::chrono::milliseconds(10));

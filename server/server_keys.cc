@@ -12,6 +12,7 @@
 #include "auth/key_file.h"
 #include "auth/revocation_list.h"
 #include "auth/role_keys.h"
+#include "auth/sealed_message.h"
 
 namespace snapthread::server {
 namespace {
@@ -33,10 +34,11 @@ auth::SessionKey LoadRootFile(const std::string& path) {
 
 int64_t UnixSeconds() { return static_cast<int64_t>(std::time(nullptr)); }
 
-ServerKeys::ServerKeys(std::string root_path, auth::SessionKey root, double grace_s)
+ServerKeys::ServerKeys(std::string root_path, auth::SessionKey root, double grace_s, bool encrypt)
     : root_path_(std::move(root_path)),
       grace_s_(static_cast<int64_t>(std::ceil(grace_s))),
-      ring_(Copy(root)) {
+      ring_(Copy(root)),
+      encrypt_(encrypt) {
   const std::string previous_path = root_path_ + ".previous";
   if (!root_path_.empty() && Exists(previous_path)) {
     // A server restarted during a rotation: devices still on the previous root are
@@ -51,7 +53,20 @@ ServerKeys::ServerKeys(std::string root_path, auth::SessionKey root, double grac
     }
   }
   PublishSigners();
+  ApplySealing(UnixSeconds());
   LoadRevocations(false);
+}
+
+void ServerKeys::ApplySealing(int64_t now_unix_s) {
+  const bool in_grace = previous_root_.has_value() && now_unix_s < previous_until_unix_s_;
+  const auth::SessionKey read = auth::DeriveReadKey(ring_.root());
+  if (in_grace) {
+    const auth::SessionKey previous_read = auth::DeriveReadKey(*previous_root_);
+    auth::SetSealing(read, &previous_read, encrypt_, /*seal_with_previous=*/true);
+  } else {
+    auth::SetSealing(read, nullptr, encrypt_);
+  }
+  sealing_with_previous_ = in_grace;
 }
 
 void ServerKeys::PublishSigners() {
@@ -99,6 +114,7 @@ void ServerKeys::Reload(int64_t now_unix_s) {
       previous_until_unix_s_ = now_unix_s + grace_s_;
       ring_.Rotate(std::move(fresh), previous_until_unix_s_);
       PublishSigners();
+      ApplySealing(now_unix_s);
     }
   } catch (const std::exception& e) {
     spdlog::error("server: reload: {} not read, key {} stays: {}", root_path_, ring_.root().Id(), e.what());

@@ -53,7 +53,9 @@ class ServerKeys {
   // server restarted), its key is accepted for `grace_s` from now; root_path.revoked
   // (missing = none) is applied. Throws auth::KeyFileError / auth::RevocationListError
   // naming the file when one of them exists but cannot be used.
-  ServerKeys(std::string root_path, auth::SessionKey root, double grace_s);
+  // `encrypt`: seal what the server publishes (--encrypt; auth/sealed_message.h). Either
+  // way the process opens envelopes sealed under the read key of either root.
+  ServerKeys(std::string root_path, auth::SessionKey root, double grace_s, bool encrypt = false);
   ServerKeys(const ServerKeys&) = delete;
   ServerKeys& operator=(const ServerKeys&) = delete;
 
@@ -70,6 +72,11 @@ class ServerKeys {
   // from `now_unix_s`) and the revocation list (a broken list keeps the old one, logged
   // naming the file). Logs one line with both key ids and the number of revocations.
   void Reload(int64_t now_unix_s);
+  // Between two receives: when a rotation's grace has ended, the server stops sealing with
+  // the previous root's read key (receivers not reloaded by then no longer open it).
+  void Tick(int64_t now_unix_s) {
+    if (sealing_with_previous_ && now_unix_s >= previous_until_unix_s_) ApplySealing(now_unix_s);
+  }
 
   // Any thread.
   const ServerSigners& signers() const { return *signers_.load(std::memory_order_acquire); }
@@ -79,6 +86,10 @@ class ServerKeys {
  private:
   // The signers of the ring's roots, for the publisher.
   void PublishSigners();
+  // The process's sealing keys (auth::SetSealing): the current root's read key, and during
+  // a rotation's grace the previous one, which the server then seals with, so that
+  // receivers that have not reloaded yet keep opening what it publishes.
+  void ApplySealing(int64_t now_unix_s);
   // FILE.revoked (missing: none) into the ring. A broken list throws at start and, on a
   // reload (`keep_on_error`), keeps the old list with an error naming the file.
   void LoadRevocations(bool keep_on_error);
@@ -89,6 +100,8 @@ class ServerKeys {
   std::optional<auth::SessionKey> previous_root_;  // during (and after) a rotation's grace
   int64_t previous_until_unix_s_ = 0;
   size_t revocations_ = 0;
+  bool encrypt_ = false;
+  bool sealing_with_previous_ = false;
   std::vector<std::unique_ptr<DeviceKey>> device_keys_;
   std::vector<std::unique_ptr<const ServerSigners>> signer_sets_;  // every set ever published
   std::atomic<const ServerSigners*> signers_{nullptr};

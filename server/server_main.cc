@@ -110,6 +110,7 @@ void AddServerFlags(CLI::App* cli, ServerFlags* f) {
   AddSolveFlags(cli, &f->params);
   app::CommonFlagSet common;
   common.log_level = true;
+  common.encrypt = true;
   common.key_note = "; must exist (snapthread-keygen makes it) unless --create-key";
   app::AddCommonFlags(cli, &f->common, common);
   AddCommandFlags(cli, &f->params);
@@ -122,6 +123,7 @@ ServerParams Params(const ServerFlags& f) {
   params.session = f.common.session;
   params.lcm_url = f.common.lcm_url;  // resolved by the server (ServerParams::lcm_url)
   params.key_path = f.common.key_path;
+  params.encrypt = f.common.encrypt;
   params.log_level = f.common.log_level;
   params.snap_ahead = !f.no_snap_ahead;
   return params;

@@ -65,6 +65,7 @@ struct ServerParams {
   // FILE.previous, messages made under the previous root are accepted for this many
   // seconds (a session rides through a rotation), then refused as grace-over. Finite, >= 0.
   double key_grace_s = 60.0;
+  bool encrypt = false;  // --encrypt: seal what the server publishes (docs/security.md)
   // Where the server checkpoints the scene, method, grasp and state (--state-dir; "" =
   // no checkpoints). Restarted with the same directory and session it resumes on the
   // same branch (server/checkpoint.h). Made (mode 0700) when missing.

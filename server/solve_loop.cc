@@ -164,6 +164,7 @@ void SolveLoop::SolveAndPublish(const std::vector<ReceivedPose>& poses) {
   SessionUpdate update = MapPoses(*session_, poses);
   for (size_t k = 0; k < poses.size(); ++k) {
     if (update.grasp_of[k] < 0) {
+      counters_->refusals.Count(poses[k].state.sender_role, RefusalReason::kNoSuchGrasp);
       CountRejection(counters_, channels_.device_state,
                      "no grasp '" + poses[k].state.grasp + "' in scene " + session_->scene.name);
     }

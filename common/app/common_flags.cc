@@ -68,24 +68,11 @@ std::string LcmUrl(const CommonFlags& flags, int receive_buffer_bytes) {
   return messages::WithReceiveBuffer(messages::ResolveLcmUrl(flags.lcm_url), receive_buffer_bytes);
 }
 
-std::optional<auth::SessionKey> LoadSessionKey(const CommonFlags& flags, std::string_view program,
-                                               auth::KeyLocation* where) {
-  try {
-    const auth::KeyLocation location = auth::ResolveKeyPath(flags.key_path);
-    std::optional<auth::SessionKey> key(auth::LoadKey(location));
-    if (where != nullptr) *where = location;
-    return key;
-  } catch (const std::exception& e) {
-    Fail(program, kExitFailure, std::string("--key: ") + e.what());
-    return std::nullopt;
-  }
-}
-
 std::optional<auth::KeySet> LoadKeySet(const CommonFlags& flags, auth::Role needed,
                                        std::string_view program, auth::KeyLocation* where) {
   try {
     const auth::KeyLocation location = auth::ResolveKeyPath(flags.key_path);
-    std::optional<auth::KeySet> keys(auth::LoadKeySet(location.path, needed, program));
+    std::optional<auth::KeySet> keys(auth::LoadKeySet(location, needed, program));
     auth::SetSealing(keys->read_key(), nullptr, flags.encrypt);
     if (where != nullptr) *where = location;
     return keys;

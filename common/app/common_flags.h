@@ -65,12 +65,6 @@ std::optional<int> CheckCommonFlags(const CommonFlags& flags, std::string_view p
 // messages::kServiceBufferBytes).
 std::string LcmUrl(const CommonFlags& flags, int receive_buffer_bytes = messages::kReceiverBufferBytes);
 
-// The session key of --key (resolved as auth/key_file.h says, with its checks), or
-// nullopt after printing "<program>: --key: <which file, why and the fix>". `where`, if
-// given, receives the file used.
-std::optional<auth::SessionKey> LoadSessionKey(const CommonFlags& flags, std::string_view program,
-                                               auth::KeyLocation* where = nullptr);
-
 // What --key names for a program playing `needed` (auth/key_set.h: the root key, or a
 // credential of that role), or nullopt after printing "<program>: --key: <which file, why
 // and the fix>" (a credential of another role names the role needed). `where`, if given,

@@ -120,9 +120,12 @@ bool LooksLikeCredential(const std::string& path) {
 }
 
 KeySet LoadKeySet(const std::string& path, Role needed, std::string_view program) {
-  if (!LooksLikeCredential(path)) {
-    return KeySet::FromRoot(LoadKey(KeyLocation{path, "--key"}));
-  }
+  return LoadKeySet(KeyLocation{path, "--key"}, needed, program);
+}
+
+KeySet LoadKeySet(const KeyLocation& where, Role needed, std::string_view program) {
+  const std::string& path = where.path;
+  if (!LooksLikeCredential(path)) return KeySet::FromRoot(LoadKey(where));
   const std::string role_word(RoleToString(needed));
   if (needed == Role::kServer) {
     const Credential c = LoadCredential(path);

@@ -11,6 +11,7 @@
 
 #include "auth/credential.h"
 #include "auth/device_certificate.h"
+#include "auth/key_file.h"
 #include "auth/key_id.h"
 #include "auth/message_mac.h"
 #include "auth/role.h"
@@ -82,6 +83,8 @@ class KeySet {
 // unexpired; otherwise throws CredentialError naming `program`, the role it needs, what
 // the file is, and the fix. A key file error is a KeyFileError as today.
 KeySet LoadKeySet(const std::string& path, Role needed, std::string_view program);
+// The same for a resolved --key (auth/key_file.h), whose origin the messages name.
+KeySet LoadKeySet(const KeyLocation& where, Role needed, std::string_view program);
 
 // Whether the file at `path` starts like a credential (its first line); false when it
 // cannot be read (the loader then says why).

@@ -111,24 +111,12 @@ template <class Msg>
 [[nodiscard]] bool VerifySignature(const void* data, std::size_t size, std::string_view channel,
                                    const PublicKey& key);
 
-// The tagger of a holder of the root key acting alone (tests, single-host tools): MACs
-// with the root key itself. Only for code that checks with VerifyMac(root); the roles use
-// KeySet's taggers.
+// A MAC with the root key itself, as before the roles (tests of what the server refuses:
+// no role resolves such a key). Programs tag with KeySet's taggers.
 inline Tagger RootMacTagger(const SessionKey& root) {
   Tagger t;
   t.mac_key = &root;  // key_id stays zero: nothing resolves it (and RootKeyId allocates)
   return t;
-}
-
-// Compatibility for call sites not yet on roles: MAC with `key`, as before the roles.
-template <class Msg>
-[[nodiscard]] bool Sign(Msg* msg, std::string_view channel, int64_t epoch, int64_t auth_seq,
-                        const SessionKey& key) {
-  return Sign(msg, channel, epoch, auth_seq, RootMacTagger(key));
-}
-[[nodiscard]] inline bool VerifyEncoded(const void* data, std::size_t size, std::string_view channel,
-                                        const SessionKey& key) {
-  return VerifyMac(data, size, channel, key);
 }
 
 }  // namespace snapthread::auth

@@ -173,14 +173,15 @@ TEST(CommonFlagsTest, KeyFileRules) {
   test_support::SessionKeyFile file;  // a usable key, via $SNAPTHREAD_KEY_FILE
   CommonFlags flags;
   auth::KeyLocation where;
-  const auto key = LoadSessionKey(flags, "program", &where);
-  ASSERT_TRUE(key.has_value());
+  const auto keys = LoadKeySet(flags, auth::Role::kServer, "program", &where);
+  ASSERT_TRUE(keys.has_value());
   EXPECT_EQ(where.path, file.path());
-  EXPECT_EQ(key->Id(), file.key().Id());
+  ASSERT_NE(keys->root(), nullptr);
+  EXPECT_EQ(keys->root()->Id(), file.key().Id());
 
   flags.key_path = file.path() + ".missing";
   testing::internal::CaptureStderr();
-  EXPECT_FALSE(LoadSessionKey(flags, "snapthread-x").has_value());
+  EXPECT_FALSE(LoadKeySet(flags, auth::Role::kObserver, "snapthread-x").has_value());
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_NE(err.find("snapthread-x: --key: "), std::string::npos) << err;
   EXPECT_NE(err.find(flags.key_path), std::string::npos) << err;

@@ -25,6 +25,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "messages/channels.h"
@@ -118,7 +119,8 @@ class SessionListener {
     for (int i = 0; i < 3; ++i) s.position[i] = p[i];
     s.orientation[0] = 1.0;
     s.buttons = 1;
-    if (!auth::Sign(&s, channels_.device_state, Get(&epoch_), auth_seq_.Next(), key_->key())) return false;
+    const auth::KeySet device = auth::KeySet::ForRole(key_->key(), auth::Role::kDevice, "hand");
+    if (!auth::Sign(&s, channels_.device_state, Get(&epoch_), auth_seq_.Next(), device.tagger())) return false;
     if (lcm_.lcm().publish(channels_.device_state, &s) != 0) return false;
     return test_support::WaitUntil([&] { return Get(&answered_) >= s.seq; }, kWaitS, 0.0005);
   }

@@ -20,6 +20,7 @@
 #include "arrival_log.h"
 #include "lcm_thread.h"
 #include "process_session_test.h"
+#include "auth/key_set.h"
 #include "auth/message_mac.h"
 #include "auth/session_epoch.h"
 #include "messages/channels.h"
@@ -159,6 +160,7 @@ TEST_F(SignalTest, ServerProcessSurvivesLoadSceneDevZeroAndAFifo) {
   ASSERT_TRUE(test_support::WaitUntil([&] { return listener.count() >= 3; }, 30));
   const size_t from = listener.count();
   auth::AuthSequence auth_seq;
+  const auth::KeySet operator_keys = auth::KeySet::ForRole(key_file_.key(), auth::Role::kOperator, "ops");
   for (const std::string name : {"/dev/zero", "/etc/passwd", "../scenes/curve2d_snap", "fifo"}) {
     command_t c{};
     c.utime = 0;
@@ -166,7 +168,7 @@ TEST_F(SignalTest, ServerProcessSurvivesLoadSceneDevZeroAndAFifo) {
     c.argument = name;
     // Signed (with the epoch of the server's status): the scene-dir checks are under test.
     ASSERT_TRUE(auth::Sign(&c, listener.channels().command, listener.last().epoch,
-                           auth_seq.Next(), key_file_.key()));
+                           auth_seq.Next(), operator_keys.tagger()));
     ASSERT_EQ(listener.lcm().publish(listener.channels().command, &c), 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(100));  // one load at a time
   }

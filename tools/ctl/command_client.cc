@@ -4,6 +4,7 @@
 
 #include "auth/message_mac.h"
 #include "messages/subscribe.h"
+#include "messages/publish.h"
 #include "messages/validate.h"
 #include "realtime/clock.h"
 #include "snapthread/command_t.hpp"
@@ -97,7 +98,7 @@ CommandOutcome CommandClient::Send(int8_t command, const std::string& argument,
   msg.argument = argument;
   const int64_t seq = auth_seq_.Next();
   if (!auth::Sign(&msg, channels_.command, status_filter_.epoch(), seq, keys_.tagger()) ||
-      lcm_->publish(channels_.command, &msg) != 0) {
+      messages::Publish(lcm_, channels_.command, msg) != 0) {
     out.kind = CommandOutcome::Kind::kNotSent;
     return out;
   }

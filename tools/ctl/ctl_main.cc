@@ -79,7 +79,9 @@ int main(int argc, char** argv) {
   CLI::App cli{"snapthread-ctl: send a command to a running snapthread-server and print its answer"};
   cli.fallthrough();  // the common flags may follow the subcommand too
   app::CommonFlags common;
-  app::AddCommonFlags(&cli, &common);
+  app::CommonFlagSet flag_set;
+  flag_set.encrypt = true;
+  app::AddCommonFlags(&cli, &common, flag_set);
   double timeout_s = 10.0;
   cli.add_option("--timeout-s", timeout_s, "seconds to wait for the server's answer (LOAD_SCENE may take seconds)")
       ->capture_default_str()->check(CLI::PositiveNumber)->check(app::FiniteNumber());
