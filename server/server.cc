@@ -25,7 +25,7 @@ auth::SessionKey LoadServerKey(const auth::KeyLocation& where, bool create, bool
     *created = loaded.created;
     return std::move(loaded.key);
   }
-  const auth::KeySet keys = auth::LoadKeySet(where.path, auth::Role::kServer, "snapthread-server");
+  const auth::KeySet keys = auth::LoadKeySet(where, auth::Role::kServer, "snapthread-server");
   if (keys.root() == nullptr) {
     throw auth::KeyFileError(where.path + " is not the session's root key, which snapthread-server needs");
   }

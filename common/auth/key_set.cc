@@ -1,8 +1,11 @@
 #include "auth/key_set.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <ctime>
-#include <fstream>
 #include <string>
 #include <utility>
 
@@ -113,10 +116,19 @@ void KeySet::BuildTaggers() {
 }
 
 bool LooksLikeCredential(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string head(kCredentialMagic.size(), '\0');
-  if (!in.read(head.data(), static_cast<std::streamsize>(head.size()))) return false;
-  return head == kCredentialMagic;
+  // Never blocks (a FIFO, a device): only a regular file is read here; anything else is
+  // left to the loaders, which refuse it naming the file.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return false;
+  struct stat info {};
+  char head[kCredentialMagic.size()];
+  bool credential = false;
+  if (::fstat(fd, &info) == 0 && S_ISREG(info.st_mode)) {
+    credential = ::read(fd, head, sizeof head) == static_cast<ssize_t>(sizeof head) &&
+                 std::string_view(head, sizeof head) == kCredentialMagic;
+  }
+  ::close(fd);
+  return credential;
 }
 
 KeySet LoadKeySet(const std::string& path, Role needed, std::string_view program) {

@@ -1,6 +1,7 @@
-// The attack suite, the page as a target: a log is not authenticated, so whoever hands
-// an observer a log (or a key holder on the live session) chooses every string the page
-// shows. This test writes such a log with LCM's own log writer (lcm::LogFile): markup in
+// The attack suite, the page as a target: whoever holds a session's root key (or a
+// device's credential, for its status) chooses every string the page shows, live or in a
+// log handed to an observer. This test writes such a log, signed as the server and the
+// device sign, with LCM's own log writer (lcm::LogFile): markup in
 // the session name (its channels' prefix), the scene, the method, the model, the knot and
 // the device id, each payload an <img> whose src is a marker URL on the bridge and whose
 // onerror sets a marker global, a <script> and an <svg onload>; plus bytes that are not
@@ -10,15 +11,21 @@
 // Content-Security-Policy violation (nothing even tried to run).
 // On the code before this suite (innerHTML, no CSP) the page ran the payloads: see
 // docs/security.md.
+#include <algorithm>
 #include <cmath>
 #include <regex>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "auth/key_set.h"
+#include "auth/message_mac.h"
+#include "auth/session_epoch.h"
 #include "sample_messages.h"
+#include "session_key_file.h"
 #include "test_support.h"
 
 namespace snapthread::attack_test {
@@ -42,12 +49,22 @@ double Field(const std::string& json, const std::string& key) {
   return std::strtod(json.c_str() + at + key.size() + 3, nullptr);
 }
 
-// The hostile log: 8 s of a session at 30 shapes/s, statuses at 3 Hz.
-void WriteHostileLog(const std::string& path, const std::string& session) {
+// The hostile log: 8 s of a session at 30 shapes/s, statuses at 3 Hz, every message
+// tagged by a holder of `root` (the server's signature; the device's for its status).
+void WriteHostileLog(const std::string& path, const std::string& session, const auth::SessionKey& root) {
   lcm::LogFile log(path, "w");
   ASSERT_TRUE(log.good()) << path;
+  const auth::KeySet server = auth::KeySet::ForRole(root, auth::Role::kServer);
+  const auth::KeySet hand = auth::KeySet::ForRole(root, auth::Role::kDevice, "hand");
   int64_t event = 0;
-  auto write = [&](const std::string& channel, const auto& msg, int64_t t_us) {
+  auth::AuthSequence auth_seq;
+  auto write = [&](const std::string& channel, auto msg, int64_t t_us) {
+    const bool device = std::is_same_v<decltype(msg), device_status_t>;
+    if constexpr (std::is_same_v<decltype(msg), device_status_t>) {
+      std::copy(hand.device_public_key()->begin(), hand.device_public_key()->end(), msg.device_public_key);
+      std::copy(hand.device_certificate()->begin(), hand.device_certificate()->end(), msg.device_certificate);
+    }
+    ASSERT_TRUE(auth::Sign(&msg, channel, 7, auth_seq.Next(), device ? *hand.device_status_tagger() : server.tagger()));
     std::vector<uint8_t> bytes = test_support::Encode(msg);
     lcm::LogEvent e{};
     e.eventnum = event++;
@@ -92,10 +109,11 @@ TEST(WebInjection, MarkupInEveryLoggedStringIsShownAsTextAndRunsNothing) {
   test_support::ScopedTempDir dir("web-injection");
   const std::string log = dir.path() + "/hostile.lcmlog";
   const std::string session = Payload("session");
-  WriteHostileLog(log, session);
+  const test_support::SessionKeyFile root;  // the observer's side: the bridge verifies with it
+  WriteHostileLog(log, session, root.key());
   if (HasFatalFailure()) return;
 
-  ChildProcess web({test_support::BinDir() + "/snapthread-web", "--port", "0", "--log", log},
+  ChildProcess web({test_support::BinDir() + "/snapthread-web", "--port", "0", "--log", log, "--key", root.path()},
                    OneLog(dir.path() + "/web.txt", true));
   ASSERT_TRUE(web.WaitForOutput(" at http://", 30)) << web.Out();
   std::smatch m;

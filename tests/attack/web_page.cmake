@@ -12,7 +12,7 @@ if(SNAPTHREAD_BUILD_WEB)
   # The browser and the live session take both cores: each runs alone (RUN_SERIAL), as
   # tests/web's browser tests do.
   add_executable(web_injection_test web_injection_test.cc)
-  target_link_libraries(web_injection_test PRIVATE snapthread::test_support snapthread::lcmtypes
+  target_link_libraries(web_injection_test PRIVATE snapthread::test_support snapthread::auth snapthread::lcmtypes
     PkgConfig::LCM GTest::gtest GTest::gtest_main snapthread::warnings)
   target_include_directories(web_injection_test PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
   set_target_properties(web_injection_test PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)

@@ -42,7 +42,7 @@ run_session() {
       --duration $((duration + 2)) --summary "$work/server.json" > "$work/server.txt" 2>&1 &
   server_pid=$!; pids+=("$server_pid")
   sleep 0.5
-  $2 "$bin/snapthread-device" --key "$key" --backend virtual-hand --scene "$scene" --session "$session" --lcm-url "$url" \
+  $2 "$bin/snapthread-device" --key "${device_key:-$key}" --backend virtual-hand --scene "$scene" --session "$session" --lcm-url "$url" \
       --duration "$duration" --no-rt --summary "$work/device.json" > "$work/device.txt" 2>&1
   device_rc=$?
 }

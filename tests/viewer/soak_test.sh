@@ -41,10 +41,21 @@ trap cleanup EXIT
 # fail, json, make_key, start_xvfb, run_session, end_session
 source "$(dirname "$0")/../support/script_support.sh"
 make_key
-# The viewers watch on an observer credential, as in the lab.
+# The viewers watch on an observer credential and the device drives on its own, as in the lab.
 observer="$work/observer.cred"
 "$bin/snapthread-keygen" --key "$key" --role observer --out "$observer" > "$work/keygen_observer.txt" 2>&1 \
     || fail "snapthread-keygen --role observer failed"
+device_key="$work/hand.cred"
+"$bin/snapthread-keygen" --key "$key" --role device --device hand --out "$device_key" > "$work/keygen_device.txt" 2>&1 \
+    || fail "snapthread-keygen --role device failed"
+# SNAPTHREAD_SOAK_ENCRYPT=1: the server and the device seal what they publish (--encrypt,
+# through $SNAPTHREAD_ENCRYPT); the logger records envelopes and the report opens them
+# with the observer credential.
+report_key=()
+if [ "${SNAPTHREAD_SOAK_ENCRYPT:-0}" = 1 ]; then
+  export SNAPTHREAD_ENCRYPT=1
+  report_key=(--key "$observer")
+fi
 echo "soak: ${duration} s, $viewers viewers and snapthread-logger, outputs in $work"
 
 "$bin/snapthread-logger" -q -c "${session}_.*" --lcm-url "$url" -f "$work/session.lcmlog" \
@@ -78,7 +89,7 @@ echo "device: $ticks ticks in ${duration} s, tick_rate_hz $(json "$work/device.j
 [ "$ticks" -ge $((duration * 800)) ] || fail "device ran $ticks ticks, fewer than 80 % of 1 kHz"
 
 # 2
-"$bin/snapthread-report" "$work/session.lcmlog" --out "$work/report" --session "$session" \
+"$bin/snapthread-report" "$work/session.lcmlog" --out "$work/report" --session "$session" "${report_key[@]}" \
     > "$work/report.txt" 2>&1 || fail "snapthread-report failed"
 summary="$work/report/summary.txt"
 updates=$(json "$work/server.json" "['updates']")

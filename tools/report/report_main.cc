@@ -5,6 +5,7 @@
 // hostile: channel names and strings are shown escaped, only a valid session name is
 // used, and gnuplot runs without a shell.
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -16,6 +17,8 @@
 #include "app/command_line.h"
 #include "app/common_flags.h"
 #include "app/exit_codes.h"
+#include "auth/key_file.h"
+#include "auth/role.h"
 #include "gnuplot_plots.h"
 #include "log_reader.h"
 #include "session_review.h"
@@ -42,7 +45,7 @@ void AddReportFlags(CLI::App* cli, ReportOptions* o) {
   cli->add_option("--out", o->out_dir, "output directory (default: <LOGFILE>.report)");
   app::CommonFlagSet common;
   common.lcm_url = false;
-  common.key = false;
+  common.key_note = "; needed only for a sealed (--encrypt) log: an observer credential of the session";
   common.session_note = "; default: the busiest one in the log";
   o->common.session.clear();
   app::AddCommonFlags(cli, &o->common, common);
@@ -131,6 +134,10 @@ int main(int argc, char** argv) {
   if (o.out_dir.empty()) o.out_dir = o.log_path + ".report";
   if (o.common.session.empty()) {
     if (auto code = InferSessionFromLog(&o)) return *code;
+  }
+  // A sealed log opens with a credential's read key: loaded only when one is named.
+  if (!o.common.key_path.empty() || std::getenv(snapthread::auth::kKeyFileEnv) != nullptr) {
+    if (!app::LoadKeySet(o.common, snapthread::auth::Role::kObserver, kProgram)) return app::kExitFailure;
   }
   SessionReview review(o.common.session);
   LogReadStats read;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "auth/sealed_message.h"
 #include "messages/channels.h"
 #include "messages/validate.h"
 
@@ -47,10 +48,24 @@ Stats Percentiles(std::vector<double> v) {
   return s;
 }
 
+// A sealed event (--encrypt) is opened with the process's read key first (--key).
 template <class T>
 bool Decode(const lcm::LogEvent& e, T* msg, ChannelStats* c) {
   std::string why;
-  if (messages::DecodeAndValidate(e.data, e.datalen, msg, &why)) return true;
+  const void* data = e.data;
+  int size = e.datalen;
+  if (auth::IsSealed(data, static_cast<std::size_t>(size))) {
+    const auto opened = auth::OpenSealed(data, static_cast<std::size_t>(size), e.channel);
+    if (!opened) {
+      if (c->rejected++ == 0) {
+        c->first_rejection = "sealed (--encrypt) and not opened: give --key a credential of this session";
+      }
+      return false;
+    }
+    data = opened->data;
+    size = static_cast<int>(opened->size);
+  }
+  if (messages::DecodeAndValidate(data, size, msg, &why)) return true;
   if (c->rejected++ == 0) c->first_rejection = why;
   return false;
 }
