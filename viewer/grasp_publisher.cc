@@ -22,7 +22,7 @@ GraspPublisher::GraspPublisher(lcm::LCM* lcm, const std::string& session,
       epoch_(std::move(epoch)) {}
 
 bool GraspPublisher::Publish(const Eigen::Vector3d& model_position, bool held) {
-  device_state_t msg;
+  device_state_t msg{};  // every field set: the trailer too, checked by Validate below
   msg.utime = realtime::MonotonicMicros();  // device poses carry CLOCK_MONOTONIC
   msg.seq = ++seq_;
   msg.device_id = "viewer-mouse";
