@@ -81,12 +81,7 @@ std::vector<uint8_t> Encoded(const Msg& msg) {
 // The server's tagger for `device`'s force models: a MAC under the device's key, and the
 // server's signature when `with_signature`.
 Tagger ForceModelTagger(const KeySet& server, const KeySet& device, bool with_signature) {
-  Tagger t;
-  t.role = Role::kServer;
-  t.name = device.name();
-  t.expires_unix_s = device.expires_unix_s();
-  t.key_id = device.credential()->key_id;
-  t.mac_key = device.mac_key();
+  Tagger t = device.ForceModelTagger();
   t.signer = with_signature ? server.tagger().signer : nullptr;
   return t;
 }

@@ -115,6 +115,17 @@ void KeySet::BuildTaggers() {
   }
 }
 
+Tagger KeySet::ForceModelTagger() const {
+  Tagger t;
+  t.role = Role::kServer;
+  if (role_ != Role::kDevice || mac_key() == nullptr) return t;
+  t.name = credential_->name;
+  t.expires_unix_s = credential_->expires_unix_s;
+  t.key_id = credential_->key_id;
+  t.mac_key = mac_key();
+  return t;
+}
+
 bool LooksLikeCredential(const std::string& path) {
   // Never blocks (a FIFO, a device): only a regular file is read here; anything else is
   // left to the loaders, which refuse it naming the file.

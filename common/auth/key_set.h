@@ -57,6 +57,10 @@ class KeySet {
   const Tagger& tagger() const { return tagger_; }
   // A device's status: its MAC and its own signature (nullptr for other roles).
   const Tagger* device_status_tagger() const { return device_signer_ ? &status_tagger_ : nullptr; }
+  // How the server tags force models addressed to this device: a MAC under the device's
+  // key, claiming the server's role and naming the device (devices only: no MAC otherwise;
+  // tests and tools that stand in for the server).
+  Tagger ForceModelTagger() const;
   // The device's public key and the server's certificate of it (devices only).
   const PublicKey* device_public_key() const { return device_signer_ ? &device_signer_->public_key() : nullptr; }
   const DeviceCertificateBytes* device_certificate() const { return certificate_ ? &*certificate_ : nullptr; }

@@ -30,17 +30,8 @@ const std::string kModel = "T_FORCE_MODEL";
 
 using Bytes = std::vector<uint8_t>;
 
-// How the server tags a force model for `device`: a MAC under the device's key, claiming
-// the server's role and naming the device.
-Tagger ModelTagger(const KeySet& device) {
-  Tagger t;
-  t.role = Role::kServer;
-  t.name = device.name();
-  t.expires_unix_s = device.expires_unix_s();
-  t.key_id = device.credential()->key_id;
-  t.mac_key = device.mac_key();
-  return t;
-}
+// How the server tags a force model for `device`.
+Tagger ModelTagger(const KeySet& device) { return device.ForceModelTagger(); }
 
 Bytes Copy(const lcm::ReceiveBuffer* rbuf) {
   const auto* p = static_cast<const uint8_t*>(rbuf->data);

@@ -58,15 +58,7 @@ Bytes Signed(T msg, const std::string& channel, int64_t epoch, auth::AuthSequenc
 
 // How the server tags force models for `device`: a MAC under the device's key, claiming
 // the server's role and naming the device.
-auth::Tagger ForceModelTagger(const auth::KeySet& device) {
-  auth::Tagger t;
-  t.role = auth::Role::kServer;
-  t.name = device.name();
-  t.expires_unix_s = device.expires_unix_s();
-  t.key_id = device.credential()->key_id;
-  t.mac_key = device.mac_key();
-  return t;
-}
+auth::Tagger ForceModelTagger(const auth::KeySet& device) { return device.ForceModelTagger(); }
 
 Bytes Truncated(Bytes b) {
   b.resize(b.size() / 2);

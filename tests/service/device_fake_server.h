@@ -74,11 +74,7 @@ class FakeServer {
         server_keys_(auth::KeySet::ForRole(*root, auth::Role::kServer)),
         device_keys_(auth::KeySet::ForRole(*root, auth::Role::kDevice, device_name)),
         epoch_(auth::NewEpoch()) {
-    model_tagger_.role = auth::Role::kServer;
-    model_tagger_.name = device_keys_.name();
-    model_tagger_.expires_unix_s = device_keys_.expires_unix_s();
-    model_tagger_.key_id = device_keys_.tagger().key_id;
-    model_tagger_.mac_key = device_keys_.mac_key();
+    model_tagger_ = device_keys_.ForceModelTagger();
     if (!lcm_.good()) return;
     messages::Subscribe<&FakeServer::OnPose>(lcm_, channels_.device_state, this);
     thread_ = std::thread([this] {

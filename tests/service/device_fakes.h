@@ -47,15 +47,7 @@ inline std::unique_ptr<DeviceKeys> DeviceKeysFor(const auth::SessionKey& root,
 
 // How the server tags a force model for the device whose keys are `device` (no signature:
 // the server signs models at display rate only).
-inline auth::Tagger ForceModelTagger(const auth::KeySet& device) {
-  auth::Tagger t;
-  t.role = auth::Role::kServer;
-  t.name = device.name();
-  t.expires_unix_s = device.expires_unix_s();
-  t.key_id = device.tagger().key_id;
-  t.mac_key = device.mac_key();
-  return t;
-}
+inline auth::Tagger ForceModelTagger(const auth::KeySet& device) { return device.ForceModelTagger(); }
 
 class InMemoryTransport final : public DeviceTransport {
  public:
