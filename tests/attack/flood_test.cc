@@ -23,6 +23,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -36,6 +37,8 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "auth/key_set.h"
+#include "auth/role_keys.h"
+#include "auth/sealed_message.h"
 #include "auth/message_mac.h"
 #include "flood_forger.h"
 #include "messages/channels.h"
@@ -150,8 +153,21 @@ TraceForces ReadTraceForces(const std::string& path) {
   return t;
 }
 
-TEST(FloodAttackTest, GenuineSessionKeepsItsModelsAndNoForgedForceReachesTheHand) {
+// `sealed`: the server and the device run with --encrypt ($SNAPTHREAD_ENCRYPT=1, which the
+// children inherit) and this process opens their envelopes with the session's read key;
+// the forgers send in clear as before, and those holding a credential could seal too.
+void RunFloodAttack(bool sealed) {
   const SessionKeyFile key_file;  // SNAPTHREAD_KEY_FILE for both binaries
+  if (sealed) {
+    ::setenv("SNAPTHREAD_ENCRYPT", "1", 1);
+    auth::SetSealing(auth::DeriveReadKey(key_file.key()), nullptr, /*seal_outgoing=*/false);
+  }
+  struct Unseal {
+    ~Unseal() {
+      ::unsetenv("SNAPTHREAD_ENCRYPT");
+      auth::ClearSealing();
+    }
+  } unseal;
   const ScopedTempDir tmp("flood");
   const std::string dir = tmp.path();
   const std::string bin = BinDir();
@@ -267,6 +283,11 @@ TEST(FloodAttackTest, GenuineSessionKeepsItsModelsAndNoForgedForceReachesTheHand
   EXPECT_LE(after.max_status_force_n, kSceneMaxForceN + 1e-9);
   EXPECT_GT(forces.max_force_n, 0.0) << "the genuine session rendered no force at all";
 }
+
+TEST(FloodAttackTest, GenuineSessionKeepsItsModelsAndNoForgedForceReachesTheHand) { RunFloodAttack(false); }
+
+// The same attack on a sealed session (--encrypt): the seal changes nothing of the above.
+TEST(FloodAttackTest, SealedSessionKeepsItsModelsAndNoForgedForceReachesTheHand) { RunFloodAttack(true); }
 
 }  // namespace
 }  // namespace snapthread
