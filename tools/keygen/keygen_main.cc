@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
       "  snapthread-keygen --role device --device left --expires-in 30d --out left.cred\n"
       "  snapthread-keygen --role operator --name alice --out alice.cred\n"
       "  snapthread-keygen --role observer --out observer.cred\n"
-      "  snapthread-keygen --rotate          then re-issue, kill -HUP the server, copy, kill -HUP the rest\n"
+      "  snapthread-keygen --rotate          then re-issue, kill -HUP the server, copy, kill -HUP the devices\n"
       "  snapthread-keygen --revoke left     then kill -HUP the server\n"
       "docs/security.md, \"Issuing, rotating, revoking\", says what each writes and prints.");
   const auto run = [&]() -> int {

@@ -66,7 +66,8 @@ int RotateRootKey(const KeygenOptions& o) {
   std::printf("     it then accepts the previous key for its --key-grace-s (default 60 s)\n");
   std::printf("  3. within that grace, copy each credential (scp -p NAME.cred %s:.config/snapthread/) and\n",
               o.host.c_str());
-  std::printf("     kill -HUP each device and viewer (kill -HUP $(pidof snapthread-device)) so they load it\n");
+  std::printf("     kill -HUP each device (kill -HUP $(pidof snapthread-device)) so it loads it; restart each\n");
+  std::printf("     viewer, web bridge and snapthread-ctl on its new credential (they read it at start)\n");
   return 0;
 }
 
