@@ -2,6 +2,8 @@
 
 #include <atomic>
 #include <cstring>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include "auth/key_id.h"
@@ -24,9 +26,15 @@ struct SealState {
   bool seal_with_previous = false;
 };
 
-// Replaced states are kept (never freed): a reload happens a few times a session at
-// most, and a thread may still be reading the old one.
+// Replaced states are kept, not freed: a reload happens a few times a session at most,
+// and a thread may still be reading the old one. They stay reachable from this list (no
+// leak), which only SetSealing touches, under its lock.
 std::atomic<const SealState*> g_state{nullptr};
+std::mutex g_states_mutex;
+std::vector<std::unique_ptr<const SealState>>& States() {
+  static auto* states = new std::vector<std::unique_ptr<const SealState>>();  // lives to the end
+  return *states;
+}
 
 int64_t ReadKeyWireId(const SessionKey& key) { return KeyIdToWire(SecretKeyId(kReadKeyLabel, key)); }
 
@@ -76,7 +84,8 @@ bool Grow(std::vector<uint8_t>* v, std::size_t n) {
 
 void SetSealing(const SessionKey& read_key, const SessionKey* previous, bool seal_outgoing,
                 bool seal_with_previous) {
-  auto* s = new SealState{SessionKey::FromBytes(read_key.data(), SessionKey::kBytes), std::nullopt};
+  auto state = std::make_unique<SealState>(SealState{SessionKey::FromBytes(read_key.data(), SessionKey::kBytes), std::nullopt});
+  SealState* s = state.get();
   s->read_id = ReadKeyWireId(s->read);
   if (previous != nullptr) {
     s->previous.emplace(SessionKey::FromBytes(previous->data(), SessionKey::kBytes));
@@ -84,6 +93,8 @@ void SetSealing(const SessionKey& read_key, const SessionKey* previous, bool sea
   }
   s->seal_outgoing = seal_outgoing;
   s->seal_with_previous = seal_with_previous && previous != nullptr;
+  std::lock_guard<std::mutex> lock(g_states_mutex);
+  States().push_back(std::move(state));
   g_state.store(s, std::memory_order_release);
 }
 
