@@ -172,7 +172,9 @@ TEST_P(ForgerMatrixTest, NothingForgedIsAccepted) {
   // Once the last genuine model is stale (the device's timeout and fade, scaled for a slow
   // build), only forged models remain: none may make a force.
   const auto stale = std::chrono::milliseconds(static_cast<int>(400 * test_support::SpeedScale()) + 100);
-  if (d1->at - d0->at > stale) EXPECT_EQ(d1->force_norm_n, 0.0) << "a force with only forged models";
+  if (d1->at - d0->at > stale) {
+    EXPECT_EQ(d1->force_norm_n, 0.0) << "a force with only forged models";
+  }
 
   // What an observer accepted: no forgery, while it heard them and the genuine ones.
   EXPECT_GT(watch_->shapes().forged_heard, 10);
