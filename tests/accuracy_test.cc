@@ -3,6 +3,7 @@
 // the default stopping rule holds the force to its tolerance of the force scale.
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "linalg/linear_solver.h"
 #include "models/models.h"
 #include "models/registry.h"
+#include "sweep.h"
 #include "tracking/tracker.h"
 
 namespace snapthread {
@@ -166,6 +168,23 @@ TEST(Accuracy, DefaultStopsOnTheForce) {
     if (s.termination == Termination::kConverged) {
       EXPECT_LE(s.force_error, s.force_target) << "row " << i;
     }
+  }
+}
+
+// The sweep CSV ends with the certified force error of each row.
+TEST(Accuracy, SweepCsvEndsWithTheForceError) {
+  EquilibriumTracker tracker(MakeModel(Thread(10)), SolverOptions{});
+  const std::vector<SweepRow> rows = RunSweep(&tracker, Path(10, 3));
+  std::ostringstream csv;
+  WriteSweepCsv(rows, "higher-order", csv, GraspLayout{.spatial_dimension = 3}, 1, 17);
+  std::istringstream in(csv.str());
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header.substr(header.rfind(',') + 1), "force_error") << header;
+  for (const SweepRow& r : rows) {
+    ASSERT_TRUE(std::getline(in, line));
+    EXPECT_GE(r.force_error, 0.0) << "row " << r.step;
+    EXPECT_EQ(std::stod(line.substr(line.rfind(',') + 1)), r.force_error) << line;
   }
 }
 
