@@ -100,6 +100,7 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
   ZeroForceModel(&m);
   m.iterations = 0;
   m.residual = 0.0;
+  m.force_error_n = -1.0;
   m.status = force_model_t::STATUS_INVALID;
   if (in.mapping == nullptr || in.model == nullptr || in.result == nullptr) return m;
 
@@ -117,6 +118,9 @@ force_model_t BuildForceModel(const ForceModelInputs& in) {
   // Device force F_dev = N F_model; u_model = origin + s p  =>  dF_dev/dp = N s K_model.
   const double n_per_f = map.newtons_per_model_force;
   const double s = map.model_units_per_metre;
+  // The solve's certified force error (docs/accuracy.md), in newtons; -1: none.
+  const double force_error = r.summary.force_error;
+  m.force_error_n = Finite(force_error) && force_error >= 0.0 ? n_per_f * force_error : -1.0;
   for (int i = 0; i < dim; ++i) {
     m.f0[i] = n_per_f * r.force[off + i];
     for (int j = 0; j < dim; ++j) m.K[i][j] = n_per_f * s * r.stiffness(off + i, off + j);

@@ -180,8 +180,9 @@ TEST(RibbonFlipScene, FlipsOverEachWayAndConverges) {
   EXPECT_GT(std::abs(out_roll - back_roll), 10.0);
 }
 
-// The CSV of a rod scene ends with roll_deg, t_x, t_y, t_z, negative_pivots; the torque
-// is the rotation part of F (a pure roll) and roll_deg the roll in degrees.
+// The CSV of a rod scene ends with roll_deg, t_x, t_y, t_z, negative_pivots (then the
+// last column of every sweep, force_error); the torque is the rotation part of F (a pure
+// roll) and roll_deg the roll in degrees.
 TEST(RodSweepCsv, RodScenesAddRollAndTorqueColumns) {
   const Scene scene = testing::SceneFile("rod_greenhill.yaml", WithN(6));
   auto tracker = MakeTracker(scene);
@@ -196,8 +197,8 @@ TEST(RodSweepCsv, RodScenesAddRollAndTorqueColumns) {
   std::vector<double> cells;
   std::istringstream fields(last);
   for (std::string cell; std::getline(fields, cell, ',');) cells.push_back(std::atof(cell.c_str()));
-  ASSERT_GE(cells.size(), 5u);
-  const size_t c = cells.size() - 5;
+  ASSERT_GE(cells.size(), 6u);
+  const size_t c = cells.size() - 6;
   EXPECT_NEAR(cells[c], 720.0, 1e-9);
   EXPECT_NEAR(cells[c + 1], rows.back().force[3], 1e-9 * std::max(1.0, std::abs(rows.back().force[3])));
   // Other scenes keep their columns.

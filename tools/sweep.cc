@@ -61,6 +61,7 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
     row.residual = r.summary.residual;
     row.lambda_min = r.summary.lambda_min;
     row.solve_us = r.summary.solve_us;
+    row.force_error = r.summary.force_error;
     row.iterations = r.summary.iterations;
     row.gradient_evaluations = r.summary.gradient_evaluations;
     row.hessian_evaluations = r.summary.hessian_evaluations;
@@ -85,7 +86,7 @@ void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method,
     for (const char* q : {"u", "f"})
       for (const char* c : {"x", "y", "z"}) out << ',' << q << g << '_' << c;
   }
-  out << '\n';
+  out << ",force_error\n";
   const int m = layout.NumControls();
   out << std::setprecision(digits);
   for (const SweepRow& r : rows) {
@@ -105,7 +106,7 @@ void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method,
       for (const Vec* v : {&r.u, &r.force})
         for (int c = 0; c < 3; ++c) out << ',' << (c < layout.spatial_dimension ? comp(*v, g * m + c) : 0.0);
     }
-    out << '\n';
+    out << ',' << r.force_error << '\n';
   }
 }
 

@@ -26,6 +26,9 @@ struct SweepRow {
   Vec force;             // F = -E_u
   Vec state;             // the equilibrium x
   double probe = 0.0, energy = 0.0, residual = 0.0, lambda_min = 0.0, solve_us = 0.0;
+  // Certified force error of the row (SolverSummary::force_error, model force units; -1:
+  // not estimated).
+  double force_error = -1.0;
   int iterations = 0, gradient_evaluations = 0, hessian_evaluations = 0;
   int negative_pivots = 0;  // of E_xx at the equilibrium (its inertia)
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();  // GraspTorqueCapability, 0 without one
@@ -54,6 +57,8 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
 // about the grasp point, world frame) and negative_pivots (the inertia of E_xx: an unstable equilibrium has > 0).
 // A scene with several grasps keeps those columns for its first grasp and adds, at the
 // end, u2_x,u2_y,u2_z,f2_x,f2_y,f2_z for the second (u3_*, f3_* for a third, ...).
+// The last column is always force_error: the row's certified force error (max norm over
+// the controls, model force units, -1 where none could be estimated; docs/accuracy.md).
 // `digits`: significant digits of every number but solve_us (17 writes each double exactly).
 void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out,
                    const GraspLayout& layout = {}, int num_grasps = 1, int digits = 12);

@@ -31,7 +31,13 @@ int main(int argc, char** argv) {
   app.add_option("--steps", steps, "number of equal steps N (rows 0..N), or per leg with --path");
   app.add_flag("--back", back, "continue N more steps back to --from (2N+1 rows)");
   app.add_option("--method", method, SolverRegistry::Global().NamesText(" | ", " | ") + " (default: the scene's)");
-  app.add_option("--cutoff", cutoff, "stop when |E_x| < cutoff (default: the scene's)");
+  app.add_option("--cutoff", cutoff,
+                 "stop when |E_x| < cutoff, and on nothing else (default: the scene's cutoff and its "
+                 "solver.force_tolerance of the force scale, docs/accuracy.md)");
+  double force_tolerance = -1.0;
+  app.add_option("--force-tolerance", force_tolerance,
+                 "stop when the certified force error is within this fraction of the model's force scale "
+                 "(default: the scene's solver.force_tolerance, 1e-4; 0 = the cutoff alone)");
   app.add_option("--max-iterations", max_iterations, "iteration budget per step, 0 = unlimited");
   app.add_option("--time-budget-us", time_budget_us,
                  "wall-clock budget per step in microseconds, 0 = none (a snap may then spread over steps: "
@@ -60,6 +66,13 @@ int main(int argc, char** argv) {
     if (app.count("--cutoff")) {
       if (!(cutoff > 0.0)) throw std::invalid_argument("--cutoff: expected a number > 0");
       scene.solver.cutoff = cutoff;
+      // An explicit cutoff keeps its meaning: |E_x| < cutoff and nothing else.
+      scene.solver.force_tolerance = 0.0;
+    }
+    if (app.count("--force-tolerance")) {
+      if (!(force_tolerance >= 0.0) || !std::isfinite(force_tolerance))
+        throw std::invalid_argument("--force-tolerance: expected a finite number >= 0");
+      scene.solver.force_tolerance = force_tolerance;
     }
     if (app.count("--max-iterations")) {
       if (max_iterations < 0) throw std::invalid_argument("--max-iterations: expected an integer >= 0");

@@ -141,6 +141,7 @@ const Field<F> kForceModel[] = {
     With(Member<&F::fold_q>("fold_q"), &FoldOrientation),
     With(Member<&F::fold_normal_r>("fold_normal_r"), &FoldNormal),
     Member<&F::post_torque0>("post_torque0"),
+    Member<&F::force_error_n>("force_error_n"),
     Member<&F::epoch>("epoch"),  // authentication (docs/security.md)
     Member<&F::auth_seq>("auth_seq"),
     Member<&F::sender_role>("sender_role", 0, 3),

@@ -337,7 +337,7 @@ void ApplyOverrides(YAML::Node root, const std::vector<SceneOverride>& overrides
 void ReadSolver(const YAML::Node& s, const Reader& rd, Scene* sc) {
   rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "time_budget_us", "max_time_us",
                              "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor",
-                             "max_update_hz"});
+                             "max_update_hz", "force_tolerance", "force_floor_n"});
   sc->max_update_hz = rd.Number(s, "max_update_hz", "solver.max_update_hz", 0.0);
   if (!(sc->max_update_hz >= 0.0 && sc->max_update_hz <= 100000.0))
     throw SceneError(sc->file + ": solver.max_update_hz: expected a rate in [0, 100000] Hz (0 = no cap), got " +
@@ -348,6 +348,8 @@ void ReadSolver(const YAML::Node& s, const Reader& rd, Scene* sc) {
     sc->solver.method = rd.Get<std::string>(s["method"], "solver.method", "a method name");
   }
   sc->solver.cutoff = rd.Positive(s, "cutoff", "solver.cutoff", sc->solver.cutoff);
+  sc->solver.force_tolerance = rd.Number(s, "force_tolerance", "solver.force_tolerance", sc->solver.force_tolerance);
+  sc->solver.force_floor_n = rd.Number(s, "force_floor_n", "solver.force_floor_n", sc->solver.force_floor_n);
   if (s["max_iterations"]) {
     sc->solver.max_iterations = rd.Get<int>(s["max_iterations"], "solver.max_iterations", "an integer >= 0");
   }

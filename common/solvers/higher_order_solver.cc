@@ -240,7 +240,7 @@ void HigherOrderSolver::SnapAndStop(const Vec& u, Vec* x, SolverSummary* s, doub
     s->message = "snap minimiser did not converge";
   }
   *r = EvalGradient(*x, u, s);
-  if (s->termination != Termination::kLinearSolverFailed && *r < options().cutoff)
+  if (s->termination != Termination::kLinearSolverFailed && (*r < options().cutoff || s->at_round_off))
     s->termination = Termination::kConverged;
 }
 
@@ -300,12 +300,22 @@ bool HigherOrderSolver::ReductionIteration(const Vec& u, Vec* x, LinearSolverSta
     res = ReductionStep(u, x, s);
   }
   if (res == StepResult::kSnap || many_negative) {
+    // At the gradient's round-off the reduced quartic is noise: no vanished minimum.
+    if (!many_negative && AtRoundOff(*r, *x, u, s)) {
+      StopAtRoundOff(s);
+      return false;
+    }
     SnapAndStop(u, x, s, r);
     return false;
   }
   if (res == StepResult::kFailed) {
-    // The reduction could not decrease the energy: one globalised step instead.
+    // The reduction could not decrease the energy: one globalised step instead. Where
+    // none decreases it either and |E_x| is at its round-off, the state has converged.
     if (!GlobalizedStep(u, x, s)) {
+      if (AtRoundOff(*r, *x, u, s)) {
+        StopAtRoundOff(s);
+        return false;
+      }
       s->termination = Termination::kLinearSolverFailed;
       s->message = "no descent step found";
       return false;
@@ -323,6 +333,11 @@ bool HigherOrderSolver::ReductionIteration(const Vec& u, Vec* x, LinearSolverSta
   *r = EvalGradientAndHessian(*x, u, s);
   *reduction_stalls = (*r < 0.5 * r_before) ? 0 : *reduction_stalls + 1;
   if (*reduction_stalls >= 2 || *r > r_before) {
+    // Stalled at the gradient's round-off is converged (no vanished minimum to leave).
+    if (AtRoundOff(*r, *x, u, s)) {
+      StopAtRoundOff(s);
+      return false;
+    }
     SnapAndStop(u, x, s, r);
     return false;
   }
@@ -338,7 +353,7 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   bool newton_stalled = false;
   bool trial_gradient = false;  // g_trial_ holds E_x at xs_ (the Newton trial state)
   int reduction_stalls = 0;
-  while (NextIteration(r, x, &s)) {
+  while (NextIteration(r, u, x, &s)) {
     const LinearSolverStatus st = FactorAt(xr, u, &s);
     bool degenerate = true;
     double lambda0 = 0.0;
@@ -357,6 +372,12 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
         break;
       }
       if (check == NewtonCheck::kSnap) {
+        // A long Newton step from a gradient at its round-off is noise amplified along a
+        // flat valley, not a fold crossed: the state has converged as far as it can.
+        if (AtRoundOff(r, xr, u, &s)) {
+          StopAtRoundOff(&s);
+          break;
+        }
         SnapAndStop(u, &xr, &s, &r);
         break;
       }
@@ -364,6 +385,12 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
     }
     if (!degenerate) {
       newton_stalled = NewtonIteration(u, &xr, trial_gradient, &r, &s);
+      // A regular Newton step that does not halve |E_x| at its round-off: converged as
+      // far as double precision allows (not a fold: the reduction would only wander).
+      if (newton_stalled && AtRoundOff(r, xr, u, &s)) {
+        StopAtRoundOff(&s);
+        break;
+      }
       continue;
     }
     if (!ReductionIteration(u, &xr, st, &reduction_stalls, &r, &s)) break;

@@ -12,9 +12,14 @@ SolverSummary NewtonSolver::Solve(const Vec& u, Vec* x) {
   if (!BeginSolve(u, *x, &s) || ContinueSnap(u, x, &s)) return s;
   double r = EvalGradientAtStart(*x, u, &s);
   s.termination = Termination::kBudgetSpent;
-  while (NextIteration(r, x, &s)) {
+  while (NextIteration(r, u, x, &s)) {
     if (line_search_) {
       if (!GlobalizedStep(u, x, &s)) {
+        // No descent step at the gradient's round-off: converged.
+        if (AtRoundOff(r, *x, u, &s)) {
+          StopAtRoundOff(&s);
+          break;
+        }
         s.termination = Termination::kLinearSolverFailed;
         s.message = "no descent step found";
         break;

@@ -12,8 +12,18 @@ struct SolverOptions {
   // "higher-order"). A name, not an enum, so this struct needs no solver code.
   std::string method = "higher-order";
   // Stop when the internal force ||E_x||_2 < cutoff (the seed uses 1e-6, its reference
-  // runs 1e-10).
+  // runs 1e-10) and, with a force tolerance, the grasp force is certified to it.
   double cutoff = 1e-6;
+  // Stop in the units that matter (docs/accuracy.md): a solve converges only when its
+  // certified force error (SolverSummary::force_error) is at most
+  // max(force_tolerance * model.ForceScale(), force_floor_n / newtons_per_model_force).
+  // 0 = the cutoff alone (an explicit --cutoff sets it so: the cutoff keeps its meaning).
+  double force_tolerance = 1e-4;
+  // Absolute floor of that tolerance in newtons at the device (scene key
+  // solver.force_floor_n; 0 = none: every target is relative to the force scale).
+  double force_floor_n = 0.0;
+  // The scene's device.newtons_per_model_force (MakeTracker sets it), for force_floor_n.
+  double newtons_per_model_force = 1.0;
   // Iteration budget per control update; 0 means unlimited (capped at
   // kUnlimitedIterations as a safety net).
   int max_iterations = 50;

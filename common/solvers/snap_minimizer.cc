@@ -20,19 +20,40 @@ bool SolverBase::MinimizeFully(const Vec& u, Vec* x, SolverSummary* s) {
   constexpr int kMaxIterations = 400;  // the snap minimiser converges in ~10-20
   // A snap across a symmetry axis goes round the orbit: move there on the circle first.
   MoveAlongSymmetries(u, x);
+  // |E_x| that has not halved for this many steps is asked whether it is at its
+  // round-off (AtRoundOff): there the state is as stationary as double precision allows.
+  constexpr int kStallSteps = 8;
   double r = EvalGradient(*x, u, s);
+  double best = r;
+  int stalls = 0;
   snap_in_progress_ = false;
   for (int it = 0; it < kMaxIterations; ++it) {
     if (!std::isfinite(r)) return false;
+    if (r < 0.5 * best) {
+      best = r;
+      stalls = 0;
+    } else {
+      ++stalls;
+    }
+    const bool round_off = r >= options_.cutoff && stalls >= kStallSteps && AtRoundOff(r, *x, u, s);
+    if (round_off) {
+      s->at_round_off = true;
+      stalls = 0;
+    }
     // The time budget caps a snap too (DESIGN.md #4 finishes it inside its update only
     // without one): stop at an accepted state, carry on at the next update.
     if (it > 0 && r >= options_.cutoff && TimeSpent()) {
       snap_in_progress_ = true;
       return false;
     }
-    if (r < options_.cutoff) {
-      // Stationary: a minimum only if E_xx has no negative pivot.
-      if (FactorAt(*x, u, s) != LinearSolverStatus::kSuccess || ws_.factor->NegativePivots() == 0) return true;
+    // Stationary: a minimum only if E_xx has no negative pivot. With a force tolerance a
+    // minimum whose force is not certified to it yet takes more (Newton) steps below,
+    // unless |E_x| is at its round-off.
+    const bool stationary = r < options_.cutoff || round_off;
+    if (stationary && FactorAt(*x, u, s) != LinearSolverStatus::kSuccess) return true;
+    const bool saddle = stationary && ws_.factor->NegativePivots() > 0;
+    if (stationary && !saddle && (round_off || ForceCertified(*x, u))) return true;
+    if (saddle) {
       // A saddle along a symmetry orbit: its minimum is on the circle, not on a line.
       if (MoveAlongSymmetries(u, x)) {
         r = EvalGradient(*x, u, s);
@@ -69,11 +90,13 @@ bool SolverBase::MinimizeFully(const Vec& u, Vec* x, SolverSummary* s) {
     ++s->iterations;
     if (!GlobalizedStep(u, x, s)) {
       r = EvalGradient(*x, u, s);
-      return r < 1e3 * options_.cutoff;
+      if (r >= 1e3 * options_.cutoff && AtRoundOff(r, *x, u, s)) s->at_round_off = true;
+      return r < 1e3 * options_.cutoff || s->at_round_off;
     }
     r = EvalGradient(*x, u, s);
   }
-  return r < options_.cutoff;
+  if (r >= options_.cutoff && AtRoundOff(r, *x, u, s)) s->at_round_off = true;
+  return r < options_.cutoff || s->at_round_off;
 }
 
 bool SolverBase::MoveAlongSymmetries(const Vec& u, Vec* x) {

@@ -14,7 +14,11 @@ SolverBase::SolverBase(const Model& model, const SolverOptions& options)
       contact_(model.contact()),
       band_assembly_(model.band_assembly()),
       options_(options),
-      n_(model.NumStates()) {
+      n_(model.NumStates()),
+      force_target_(options.force_tolerance > 0.0
+                        ? std::max(options.force_tolerance * model.ForceScale(),
+                                   options.force_floor_n / options.newtons_per_model_force)
+                        : 0.0) {
   if (n_ <= 0) throw std::invalid_argument("solver: the model has no state variables");
   Workspace& w = ws_;
   w.h = model_.HessianPattern();
@@ -39,14 +43,20 @@ SolverBase::SolverBase(const Model& model, const SolverOptions& options)
   pattern_version_ = model_.HessianPatternVersion();
   w.eig.Resize(n_);
   w.orbits = std::make_unique<SymmetryOrbits>(model_);
-  for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch, &w.h_state, &w.g_band}) v->resize(n_);
-  w.h_u.resize(model_.NumControls());
+  for (Vec* v : {&w.g, &w.dx, &w.trial, &w.last_good, &w.dx_scratch, &w.h_state, &w.g_band, &w.factor_x,
+                 &w.err_dx, &w.err_x, &w.err_state, &w.noise_x, &w.noise_g})
+    v->resize(n_);
+  const int m = model_.NumControls();
+  for (Vec* v : {&w.h_u, &w.err_eu0, &w.err_eu1, &w.err_df}) v->resize(m);
+  w.exu.resize(n_, m);
 }
 
 void SolverBase::Reset() {
   ws_.eig.Reset();
   snap_in_progress_ = false;
   factor_valid_ = false;
+  factor_at_state_ = false;
+  err_serial_ = -1;
   lambda_ref_ = -1.0;
 }
 
@@ -62,6 +72,8 @@ bool SolverBase::BeginSolve(const Vec& u, const Vec& x, SolverSummary* s) {
   *s = SolverSummary{};
   start_ = Clock::now();
   factor_valid_ = false;
+  factor_at_state_ = false;
+  err_serial_ = -1;
   factor_before_tiny_step_ = false;
   // Lagged model data (AcceptState) may have changed E since the last solve.
   hessian_ready_ = false;
@@ -99,14 +111,14 @@ void SolverBase::TakeNewtonStep(const Vec& u, Vec* x) {
   factor_before_tiny_step_ = ws_.dx.lpNorm<Eigen::Infinity>() <= kReuseStep;
 }
 
-bool SolverBase::NextIteration(double r, Vec* x, SolverSummary* s) {
+bool SolverBase::NextIteration(double r, const Vec& u, Vec* x, SolverSummary* s) {
   if (!std::isfinite(r)) {
     *x = ws_.last_good;
     s->termination = Termination::kNonFinite;
     s->message = "non-finite gradient; state restored";
     return false;
   }
-  if (r < options_.cutoff) {
+  if (Converged(r, *x, u, s)) {
     s->termination = Termination::kConverged;
     return false;
   }
@@ -120,6 +132,11 @@ bool SolverBase::NextIteration(double r, Vec* x, SolverSummary* s) {
     best_residual_ = r;
     stalled_iterations_ = 0;
   } else if (++stalled_iterations_ >= (r < 1e3 * options_.cutoff ? 20 : 200)) {
+    // Stalled at the gradient's round-off: as converged as double precision allows.
+    if (AtRoundOff(r, *x, u, s)) {
+      StopAtRoundOff(s);
+      return false;
+    }
     s->message = "no progress in " + std::to_string(stalled_iterations_) +
                  " iterations (residual at round-off?)";
     return false;
@@ -155,6 +172,12 @@ void SolverBase::Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_sad
     s->termination = Termination::kSnapping;
     s->message = "time budget spent inside a snap; it continues at the next update";
   }
+  // Converged to round-off with the force still outside its tolerance: round-off caps
+  // the accuracy here (a very flat valley), and the row says so.
+  s->force_target = force_target_;
+  if (s->termination == Termination::kConverged && s->at_round_off && force_target_ > 0.0 &&
+      s->force_error > force_target_)
+    s->termination = Termination::kAccuracyLimited;
   // The status against the reference of the last regular state, then the reference.
   s->lambda_ref = lambda_ref_;
   s->status = DecideStatus(*s, options_.degeneracy_ratio, /*left_branch=*/false);
@@ -185,6 +208,8 @@ double SolverBase::EvalGradient(const Vec& x, const Vec& u, SolverSummary* s) {
 
 double SolverBase::EvalGradientAndHessian(const Vec& x, const Vec& u, SolverSummary* s) {
   factor_valid_ = false;  // the band below is the factorisation's storage
+  factor_at_state_ = false;
+  ++factor_serial_;
   factor_before_tiny_step_ = false;
   // A banded factorisation lends its band: the model writes E_xx there, and FactorAt()
   // factorises it in place (no compressed matrix, no copy; the compressed one is made
@@ -230,6 +255,13 @@ bool SolverBase::AtHessianState(const Vec& x) const {
 LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummary* s) {
   // E_xx from EvalGradientAtStart at this very state (bit for bit) is not evaluated again;
   // it counts as this factorisation's evaluation.
+  // A valid factorisation made at this very state (the convergence test's, Converged)
+  // serves again: nothing has been written into it since.
+  if (factor_valid_ && factor_at_state_ && x.size() == n_ &&
+      std::memcmp(x.data(), ws_.factor_x.data(), sizeof(double) * n_) == 0) {
+    factor_before_tiny_step_ = false;
+    return LinearSolverStatus::kSuccess;
+  }
   const bool at_start = (hessian_ready_ || band_ready_) && AtHessianState(x);
   const bool in_band = band_ready_ && at_start;
   const bool have_h = hessian_ready_ && at_start;
@@ -251,6 +283,9 @@ LinearSolverStatus SolverBase::FactorAt(const Vec& x, const Vec& u, SolverSummar
     st = ws_.factor->Factorize(ws_.h);
   }
   factor_valid_ = st == LinearSolverStatus::kSuccess;
+  factor_at_state_ = factor_valid_;
+  ++factor_serial_;
+  if (factor_valid_) ws_.factor_x = x;
   factor_before_tiny_step_ = false;
   return st;
 }
@@ -291,6 +326,8 @@ void SolverBase::SyncPattern() {
   w.factor->Analyze(w.h);
   alt_stale_ = true;
   factor_valid_ = false;
+  factor_at_state_ = false;
+  ++factor_serial_;
   factor_before_tiny_step_ = false;
   ++pattern_changes_;
 }
@@ -333,6 +370,8 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradi
   factor_before_tiny_step_ = false;
   if (st == LinearSolverStatus::kSuccess) {
     s->negative_pivots = ws_.factor->NegativePivots();
+    // The certified force error of the returned state (docs/accuracy.md).
+    s->force_error = ForceErrorFromFactor(x, u);
     // One warm-started step per update tracks the eigenpair (the vector converges over
     // the updates, and every iteration of the higher-order loop adds a step near a fold);
     // a cold start or a new branch needs more.
@@ -340,6 +379,7 @@ void SolverBase::Finish(const Vec& x, const Vec& u, SolverSummary* s, bool gradi
   } else {
     s->negative_pivots = -1;
     s->lambda_min = 0.0;  // singular to working precision
+    s->force_error = -1.0;
   }
   s->solve_us = std::chrono::duration<double, std::micro>(Clock::now() - start_).count();
 }

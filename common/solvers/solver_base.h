@@ -49,15 +49,43 @@ class SolverBase : public EquilibriumSolver {
   // and returns true: the method returns s at once. Otherwise false.
   bool ContinueSnap(const Vec& u, Vec* x, SolverSummary* s);
   // Loop head shared by every method: stops on a non-finite residual (restoring the last
-  // finite state), on convergence or when the budget is spent; otherwise counts the
-  // iteration, remembers the state and returns true.
-  bool NextIteration(double r, Vec* x, SolverSummary* s);
+  // finite state), on convergence (Converged), when the budget is spent or when |E_x|
+  // has stalled (at the gradient's round-off: converged, StopAtRoundOff); otherwise
+  // counts the iteration, remembers the state and returns true. The workspace gradient
+  // holds E_x(x), |E_x| = r.
+  bool NextIteration(double r, const Vec& u, Vec* x, SolverSummary* s);
   // Loop tail: restore a non-finite state, Finish(); for globalised methods leave a
   // saddle (LeaveSaddle); with finish_snap_on_spent_budget, a budget spent on an
   // indefinite E_xx finishes the snap (the followed minimum is gone, DESIGN.md #4);
   // then the status (DecideStatus) and the reference eigenvalue.
   void Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_saddles,
                 bool finish_snap_on_spent_budget = false);
+
+  // --- accuracy (accuracy.cc, docs/accuracy.md) ---------------------------------------
+  // The convergence test at x, |E_x| = r (the workspace gradient): r < cutoff and, with
+  // a force tolerance (ForceTarget() > 0), the certified force error at x within it. That
+  // factorises E_xx at x, which the iteration that follows reuses (FactorAt).
+  bool Converged(double r, const Vec& x, const Vec& u, SolverSummary* s);
+  // max(force_tolerance * ForceScale, force_floor_n / newtons_per_model_force), model
+  // force units; 0 when options.force_tolerance is 0 (the cutoff alone).
+  double ForceTarget() const { return force_target_; }
+  // Is |E_x| = r at x (workspace gradient = E_x(x)) at the gradient's round-off? Asked
+  // where |E_x| stalls or a step is implausibly long, never on every iteration. The
+  // floor is the change of E_x when every coordinate of x moves by one unit in its last
+  // place (x is known to no better), one gradient evaluation; it is recorded in
+  // s->round_off_floor.
+  bool AtRoundOff(double r, const Vec& x, const Vec& u, SolverSummary* s);
+  // Ends the solve as converged at round-off (termination kConverged, at_round_off).
+  static void StopAtRoundOff(SolverSummary* s);
+  // The certified force error at x with HessianFactor() at x (or next to it, kReuseStep)
+  // and the workspace gradient = E_x(x): dx = E_xx^-1 E_x, the Newton correction (2.18),
+  // moves the force by E_ux dx to first order (2.14-2.15); the estimate is a margin times
+  // the larger of that and the force change to x - dx (curvature of E_u), plus the
+  // force's round-off. -1 when the solve fails. Cached per factorisation and state.
+  double ForceErrorFromFactor(const Vec& x, const Vec& u);
+  // No force tolerance, or the force error at x (as ForceErrorFromFactor) within it or
+  // not estimable.
+  bool ForceCertified(const Vec& x, const Vec& u);
 
   // --- gradient ----------------------------------------------------------------------
   // E_x(x, u) into the workspace gradient; returns its norm.
@@ -136,6 +164,12 @@ class SolverBase : public EquilibriumSolver {
     Vec g_band;   // E_x from a band assembly in FactorAt (not the iterate's gradient)
     Vec h_state;  // the state h was evaluated at by EvalGradientAtStart (hessian_ready_)
     Vec h_u;      // ... and its controls
+    Vec factor_x;  // the state the valid factorisation was made at (FactorAt reuses it there)
+    // Accuracy (accuracy.cc): the Newton correction, E_xu, the corrected state, E_u at
+    // both ends, the force change, the state of the cached estimate; the round-off probe.
+    Vec err_dx, err_x, err_eu0, err_eu1, err_df, err_state;
+    Mat exu;
+    Vec noise_x, noise_g;
   };
 
   // ws_.h := E_xx at ws_.h_state when the factorisation there was assembled in band
@@ -191,6 +225,12 @@ class SolverBase : public EquilibriumSolver {
   int pattern_version_ = 0;  // the model's HessianPatternVersion() that ws_ follows
   int pattern_changes_ = 0;  // re-analyses so far (SyncPattern)
   bool alt_stale_ = false;   // alt_factor not analysed for the current pattern
+  // ws_.factor holds a valid factorisation of E_xx at ws_.factor_x (FactorAt reuses it).
+  bool factor_at_state_ = false;
+  long factor_serial_ = 0;   // counts factorisations (and band overwrites)
+  const double force_target_;  // ForceTarget()
+  long err_serial_ = -1;     // factor_serial_ of the cached force error (at ws_.err_state)
+  double err_value_ = -1.0;
   double lambda_ref_ = -1.0;     // lambda_0 at the last regular converged state
   // MinimizeFully stopped at the time budget: the snap goes on at the next update.
   bool snap_in_progress_ = false;

@@ -13,6 +13,7 @@ const char* ToString(Termination t) {
     case Termination::kNonFinite: return "non-finite";
     case Termination::kInvalidInput: return "invalid-input";
     case Termination::kSnapping: return "snapping";
+    case Termination::kAccuracyLimited: return "accuracy-limited";
   }
   return "unknown";
 }
@@ -29,7 +30,7 @@ const char* ToString(EquilibriumStatus s) {
 }
 
 bool SolverSummary::IsSolutionUsable() const {
-  const bool usable_end = termination == Termination::kConverged || termination == Termination::kBudgetSpent ||
+  const bool usable_end = IsConverged() || termination == Termination::kBudgetSpent ||
                           termination == Termination::kSnapping;
   return usable_end && std::isfinite(residual) && std::isfinite(energy);
 }
@@ -37,9 +38,10 @@ bool SolverSummary::IsSolutionUsable() const {
 std::string SolverSummary::BriefReport() const {
   char buf[256];
   std::snprintf(buf, sizeof(buf),
-                "%s (%s): %d iterations, |E_x| = %.3e, lambda_min = %.3e, %d negative pivots%s, %.1f us",
-                ToString(termination), ToString(status), iterations, residual, lambda_min,
-                negative_pivots, snapped ? ", snapped" : "", solve_us);
+                "%s (%s): %d iterations, |E_x| = %.3e%s, force error %.3e, lambda_min = %.3e, %d negative pivots%s, "
+                "%.1f us",
+                ToString(termination), ToString(status), iterations, residual, at_round_off ? " (round-off)" : "",
+                force_error, lambda_min, negative_pivots, snapped ? ", snapped" : "", solve_us);
   std::string r = buf;
   if (!message.empty()) r += " — " + message;
   return r;

@@ -7,7 +7,10 @@
 namespace snapthread {
 
 enum class Termination {
-  kConverged,           // ||E_x|| < cutoff
+  // ||E_x|| < cutoff and, with a force tolerance, the certified force error within it;
+  // or ||E_x|| stalled at the gradient's round-off with the force error within it
+  // (at_round_off): an equilibrium as exact as double precision allows.
+  kConverged,
   kBudgetSpent,         // iteration or time budget spent first
   kLinearSolverFailed,  // factorisation failed and no fallback could proceed
   kNonFinite,           // a NaN/Inf appeared; the state was restored
@@ -16,6 +19,10 @@ enum class Termination {
   // snap minimiser's last accepted (energy-decreasing) one, no equilibrium; the next
   // update carries the snap on.
   kSnapping,
+  // ||E_x|| stalled at the gradient's round-off (at_round_off) with the certified force
+  // error above the force tolerance: an equilibrium as exact as double precision allows in
+  // a valley so flat that round-off caps the force's accuracy (docs/accuracy.md). Usable.
+  kAccuracyLimited,
 };
 const char* ToString(Termination t);
 
@@ -46,9 +53,22 @@ struct SolverSummary {
   bool snapped = false;
   bool used_reduction = false;  // higher-order: the one-direction reduction was used
   double solve_us = 0.0;
+  // Certified force error of the returned state, model force units, max norm over the
+  // controls (docs/accuracy.md): the force change |E_ux E_xx^-1 E_x| of the Newton
+  // correction (2.14-2.15, 2.18) with a margin; -1 where no factorisation allowed one.
+  double force_error = -1.0;
+  // The force tolerance the solve stopped on, model force units; 0: none (the cutoff alone).
+  double force_target = 0.0;
+  // ||E_x|| stalled at the gradient's round-off: no larger than round_off_floor, the
+  // change of E_x when every coordinate of x moves by a few units in the last place.
+  bool at_round_off = false;
+  double round_off_floor = 0.0;
   std::string message;
 
-  bool IsConverged() const { return termination == Termination::kConverged; }
+  // An equilibrium to the requested accuracy or to round-off (kAccuracyLimited included).
+  bool IsConverged() const {
+    return termination == Termination::kConverged || termination == Termination::kAccuracyLimited;
+  }
   // False when the returned state is no usable state (the linear solver failed, a NaN
   // appeared, the input was invalid, the residual or energy is not finite): its force
   // must not be rendered. A spent budget is usable: the state is the last accepted one;

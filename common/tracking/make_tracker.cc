@@ -11,7 +11,10 @@ std::unique_ptr<EquilibriumTracker> MakeTracker(const Scene& scene) {
   std::unique_ptr<EquilibriumTracker> tracker;
   try {
     // The model's and the solver's messages start with the key ("params.n: ...").
-    tracker = std::make_unique<EquilibriumTracker>(MakeModel(scene.params), scene.solver);
+    // The force floor is given in newtons at the device: the solver needs the map.
+    SolverOptions options = scene.solver;
+    options.newtons_per_model_force = scene.device.newtons_per_model_force;
+    tracker = std::make_unique<EquilibriumTracker>(MakeModel(scene.params), options);
   } catch (const std::invalid_argument& e) {
     throw SceneError(scene.file + ": " + e.what());
   }

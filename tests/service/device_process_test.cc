@@ -129,15 +129,14 @@ TEST(DeviceProcessTest, SpringFadeRecoveryAndBadPackets) {
   // kernel, not the device).
   auto Pace = [] { std::this_thread::sleep_for(std::chrono::milliseconds(3)); };
   for (int i = 0; i < 40; ++i) {  // random garbage, some with the right type hash
-    std::vector<uint8_t> buf(1 + (i * 37) % 1000);
+    force_model_t ref{};
+    std::vector<uint8_t> enc(ref.getEncodedSize());
+    ref.encode(enc.data(), 0, static_cast<int>(enc.size()));
+    size_t size = 1 + (i * 37) % 1000;
+    if (i % 2 == 0 && size == enc.size()) ++size;  // never accidentally valid
+    std::vector<uint8_t> buf(size);
     for (auto& b : buf) b = static_cast<uint8_t>(byte(rng));
-    if (i % 2 == 0 && buf.size() >= 8) {
-      force_model_t ref{};
-      std::vector<uint8_t> enc(ref.getEncodedSize());
-      ref.encode(enc.data(), 0, static_cast<int>(enc.size()));
-      std::copy(enc.begin(), enc.begin() + 8, buf.begin());
-      if (buf.size() == enc.size()) buf.push_back(0);  // never accidentally valid
-    }
+    if (i % 2 == 0 && buf.size() >= 8) std::copy(enc.begin(), enc.begin() + 8, buf.begin());
     attacker.publish(channels.force_model, buf.data(), static_cast<unsigned>(buf.size()));
     ++injected;
     Pace();

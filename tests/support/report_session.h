@@ -46,6 +46,7 @@ inline force_model_t ReportModel(int seq, int64_t t0_us) {
           .has_wrench = 0, .q0 = {}, .K6 = {}, .grasp = "", .has_fold = 0, .fold_id = 0,
           .fold_point = {}, .fold_normal = {}, .fold_curvature = 0.0, .post_u0 = {}, .post_f0 = {},
           .post_K = {}, .fold_q = {}, .fold_normal_r = {}, .post_torque0 = {},
+          .force_error_n = 1e-6 * seq,
           .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
           .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }

@@ -44,6 +44,7 @@ inline force_model_t Sample(const force_model_t*) {
           .post_f0 = {0.5, 0.0, 0.0}, .post_K = {{-100.0, 0, 0}, {0, -100.0, 0}, {0, 0, -100.0}},
           .fold_q = {0.9950041652780258, 0.0, 0.0, 0.09983341664682815}, .fold_normal_r = {0.0, 0.0, 0.8},
           .post_torque0 = {0.0, -0.001, 0.002},
+          .force_error_n = 2.5e-4,
           .epoch = 0, .auth_seq = 0, .sender_role = 0, .sender_name = "", .key_expires = 0,
           .key_id = 0, .signature = {}, .signature2 = {}, .mac = {}};
 }
