@@ -57,6 +57,7 @@ ResolutionRow RunResolution(const ResolutionSweep& sweep, const std::string& met
   if (!trace.empty()) r.mean_us /= static_cast<double>(trace.size());
   r.unconverged = static_cast<int>(unconverged.size());
   r.unconverged_rows = RowRuns(unconverged);
+  if (!unconverged.empty()) r.first_unconverged = unconverged.front();
   if (sweep.name_knot && !trace.empty()) {
     Eigen::Matrix3Xd nodes;
     tracker->model().NodePositions(trace.back().state, trace.back().u, &nodes);

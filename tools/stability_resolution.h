@@ -29,6 +29,7 @@ struct ResolutionRow {
   int failed = 0;          // rows with status failed: no usable state
   int unconverged = 0;     // rows whose solve ended other than converged (failed included)
   std::string unconverged_rows;  // their numbers, runs joined: "0-8,569,619-620"
+  int first_unconverged = -1;    // -1: none
   std::string last_knot;   // the knot of the last row ("" unless the sweep names it)
   int start_continuation_steps = 0;  // of the reset at row 0 (0: the direct start)
   int max_iterations = 0;  // per row
