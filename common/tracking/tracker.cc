@@ -217,10 +217,13 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
 
 void EquilibriumTracker::FinishUnfinishedSnap(const Vec& u) {
   constexpr int kSnapRetries = 10;
+  // Far above the cutoff: a snap under way, not a solve stagnating at round-off just
+  // above an absolute cutoff (which more iterations would not help).
+  const double unfinished = 1e3 * options_.cutoff;
   for (int k = 0; k < kSnapRetries; ++k) {
     const SolverSummary& s = result_.summary;
     if (!s.snapped || s.termination != Termination::kLinearSolverFailed || options_.max_time_us > 0.0 ||
-        !std::isfinite(s.residual) || !x_.allFinite())
+        !(s.residual > unfinished && std::isfinite(s.residual)) || !x_.allFinite())
       return;
     SolverSummary more = solver_->Solve(u, &x_);
     more.iterations += s.iterations;

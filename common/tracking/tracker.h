@@ -88,7 +88,8 @@ class EquilibriumTracker {
 
  private:
   // A snap the snap minimiser left unfinished at its own iteration cap (linear-solver-
-  // failed after a snap, no time budget: the update may take what the snap needs) goes on
+  // failed after a snap with |E_x| > 1e3 cutoff, no time budget: the update may take
+  // what the snap needs) goes on
   // from its last accepted, energy-decreasing state with more solves, at most
   // kSnapRetries; the summary counts them all.
   void FinishUnfinishedSnap(const Vec& u);
