@@ -1,7 +1,9 @@
 // snapthread-stability: where methods fail. Runs the standard sweeps for each method
 // and iteration budget, compares each with a tight reference trace, prints the table
 // (chatter, snap placement, force error, cost), writes CSVs and a gnuplot chart of
-// force traces (newton against higher-order, like the seed's Figs 2.5/2.7/2.10).
+// force traces (newton against higher-order, like the seed's Figs 2.5/2.7/2.10). Then
+// the knot and rod scenes at several n: the rows each method leaves unconverged
+// (resolution.csv, stability_resolution.h).
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -14,6 +16,7 @@
 
 #include "solvers/registry.h"
 #include "stability.h"
+#include "stability_resolution.h"
 #include "tool_main.h"
 
 namespace fs = std::filesystem;
@@ -140,6 +143,37 @@ bool Figure29(const std::string& scenes_dir, const fs::path& dir, bool plot) {
   return std::system(("gnuplot '" + (dir / "fig29.gp").string() + "'").c_str()) == 0;
 }
 
+// The resolution sweeps `names` selects ("all", "none", or a comma-separated list).
+std::vector<ResolutionSweep> SelectResolution(const std::string& scenes_dir, const std::string& names) {
+  std::vector<ResolutionSweep> all = ResolutionSweeps(scenes_dir);
+  if (names == "all") return all;
+  std::vector<ResolutionSweep> keep;
+  if (names == "none") return keep;
+  for (const std::string& name : SplitList(names)) {
+    const auto it = std::find_if(all.begin(), all.end(), [&](const ResolutionSweep& r) { return r.name == name; });
+    if (it == all.end()) throw std::invalid_argument("--resolution: no sweep named '" + name + "'");
+    keep.push_back(*it);
+  }
+  return keep;
+}
+
+// The second table: each resolution sweep with each of `methods` (registered names).
+void RunResolutionTable(const std::vector<ResolutionSweep>& sweeps, const std::vector<std::string>& methods,
+                        const fs::path& out_dir) {
+  if (sweeps.empty()) return;
+  std::vector<ResolutionRow> table;
+  for (const ResolutionSweep& sw : sweeps) {
+    for (const std::string& m : methods) {
+      std::cerr << "stability: " << sw.name << " with " << m << '\n';
+      table.push_back(RunResolution(sw, m));
+    }
+  }
+  std::cout << '\n';
+  PrintResolutionTable(table, std::cout);
+  std::ofstream csv(out_dir / "resolution.csv");
+  WriteResolutionCsv(table, csv);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -151,14 +185,31 @@ int main(int argc, char** argv) {
   app.add_option("--scenes", scenes_dir, "folder with the scene files");
   app.add_option("--out", out_dir, "output folder (CSV, traces, chart)");
   app.add_option("--budgets", budgets_text, "iteration budgets per update, comma-separated (inf = unlimited)");
-  app.add_option("--sweeps", only, "only these sweeps (comma-separated names)");
+  app.add_option("--sweeps", only, "only these sweeps (comma-separated names; none: only the --resolution ones)");
   app.add_option("--substeps", substeps, "reference: fine steps per row")->check(CLI::Range(1, 1000));
   app.add_option("--plot-budget", plot_budget, "budget whose traces are charted (0 = unlimited)");
   app.add_flag("--no-plot", no_plot, "skip the gnuplot chart");
+  std::string resolution;
+  app.add_option("--resolution", resolution,
+                 "knot and rod scenes at several n (unconverged rows per method and n): all, none or names "
+                 "(default: all, none with --sweeps naming standard sweeps)");
+  std::string resolution_methods;
+  app.add_option("--resolution-methods", resolution_methods,
+                 "methods of the --resolution table, comma-separated (default: every registered one)");
   return RunTool("snapthread-stability", app, argc, argv, [&]() -> int {
     const std::vector<int> budgets = ParseInts(budgets_text, "--budgets");
+    const bool standard_only = !only.empty() && only != "none";
+    const std::vector<ResolutionSweep> resolution_sweeps =
+        SelectResolution(scenes_dir, resolution.empty() ? (standard_only ? "none" : "all") : resolution);
+    const std::vector<std::string> registered = SolverRegistry::Global().Names();
+    const std::vector<std::string> methods = resolution_methods.empty() ? registered : SplitList(resolution_methods);
+    for (const std::string& m : methods)
+      if (std::find(registered.begin(), registered.end(), m) == registered.end())
+        throw std::invalid_argument("--resolution-methods: no method named '" + m + "'");
     std::vector<StandardSweep> sweeps = StandardSweeps(scenes_dir);
-    if (!only.empty()) {
+    if (only == "none") {
+      sweeps.clear();
+    } else if (!only.empty()) {
       std::vector<StandardSweep> keep;
       std::stringstream ss(only);
       for (std::string name; std::getline(ss, name, ',');) {
@@ -206,6 +257,7 @@ int main(int argc, char** argv) {
       }
     }
     PrintStabilityTable(table, std::cout);
+    RunResolutionTable(resolution_sweeps, methods, out_dir);
     if (only.empty() && !Figure29(scenes_dir, out_dir, !no_plot)) {
       std::cerr << "stability: gnuplot failed for fig29\n";
       return 1;

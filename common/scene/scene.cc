@@ -332,12 +332,30 @@ void ApplyOverrides(YAML::Node root, const std::vector<SceneOverride>& overrides
   }
 }
 
+// solver.start_continuation: a list of the model's number parameters whose range holds 0
+// (the start solve continues them from 0 to the scene's values).
+void ReadStartContinuation(const YAML::Node& list, const ModelRegistration& model, const Reader& rd, Scene* sc) {
+  const std::string key = "solver.start_continuation";
+  if (!list.IsSequence()) rd.Fail(key, "expected a list of parameter names, got '" + Reader::Dump(list) + "'");
+  for (const auto& item : list) {
+    const std::string name = rd.Get<std::string>(item, key, "a parameter name");
+    const ParamSpec* spec = model.FindParam(name);
+    if (spec == nullptr || spec->kind != ParamKind::kNumber || !spec->InRange(0.0))
+      rd.Fail(key, "expected number parameters of " + model.name + " that may be 0, got '" + name + "'");
+    if (std::find(sc->start_continuation.begin(), sc->start_continuation.end(), name) !=
+        sc->start_continuation.end())
+      rd.Fail(key, "'" + name + "' listed twice");
+    sc->start_continuation.push_back(name);
+  }
+}
+
 // The scene's solver: block (what it says about solving; the method is checked where the
 // solver is made).
-void ReadSolver(const YAML::Node& s, const Reader& rd, Scene* sc) {
+void ReadSolver(const YAML::Node& s, const ModelRegistration& model, const Reader& rd, Scene* sc) {
   rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "time_budget_us", "max_time_us",
                              "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor",
-                             "max_update_hz", "force_tolerance", "force_floor_n"});
+                             "max_update_hz", "force_tolerance", "force_floor_n", "start_continuation"});
+  if (s["start_continuation"]) ReadStartContinuation(s["start_continuation"], model, rd, sc);
   sc->max_update_hz = rd.Number(s, "max_update_hz", "solver.max_update_hz", 0.0);
   if (!(sc->max_update_hz >= 0.0 && sc->max_update_hz <= 100000.0))
     throw SceneError(sc->file + ": solver.max_update_hz: expected a rate in [0, 100000] Hz (0 = no cap), got " +
@@ -453,7 +471,7 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
     sc.path = std::move(g.path);
   }
 
-  if (root["solver"]) ReadSolver(root["solver"], rd, &sc);
+  if (root["solver"]) ReadSolver(root["solver"], *model, rd, &sc);
   if (root["device"]) ReadDevice(root["device"], rd, &sc.device);
   if (root["targets"]) {
     const YAML::Node t = root["targets"];

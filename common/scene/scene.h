@@ -55,6 +55,12 @@ struct Scene {
   // solver.max_update_hz: the server's cap on equilibrium updates per second (issue 17;
   // 0 = none). The server's --max-update-hz overrides it.
   double max_update_hz = 0.0;
+  // solver.start_continuation: number parameters of the model (e.g. the rod's
+  // natural_curvature) that the start solve continues from 0 to their value here when
+  // the direct start from the model's initial state reaches no stable equilibrium (a
+  // rod with coil memory held straight is a saddle): MakeTracker hands the tracker that
+  // family of models (EquilibriumTracker::SetStartContinuation). Empty: no continuation.
+  std::vector<std::string> start_continuation;
   DeviceMapping device;
   // Optional targets for "model no more than a scene needs".
   double target_force_error = 0.0;  // relative to the model's force scale; 0 = none

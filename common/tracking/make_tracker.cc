@@ -24,6 +24,15 @@ std::unique_ptr<EquilibriumTracker> MakeTracker(const Scene& scene) {
                      std::to_string(tracker->model().NumControls()) + " controls");
   }
   tracker->SetSnapThreshold(0.1 * SnapLengthScale(scene.params));
+  if (!scene.start_continuation.empty()) {
+    // The family of the start continuation: the scene's model with those parameters
+    // scaled by t (t = 1 is the scene's own model).
+    tracker->SetStartContinuation([params = scene.params, names = scene.start_continuation](double t) {
+      ModelParams p = params;
+      for (const std::string& name : names) p.Set(name, t * params.Number(name));
+      return MakeModel(p);
+    });
+  }
   return tracker;
 }
 

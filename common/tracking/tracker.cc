@@ -5,6 +5,12 @@
 #include <stdexcept>
 
 namespace snapthread {
+namespace {
+
+// A start the path can begin from: converged, and a minimum (E_xx positive definite).
+bool IsStableStart(const SolverSummary& s) { return s.IsConverged() && s.negative_pivots == 0; }
+
+}  // namespace
 
 EquilibriumTracker::EquilibriumTracker(std::unique_ptr<Model> model, const SolverOptions& options)
     : model_(std::move(model)),
@@ -53,23 +59,75 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   ResetModelHistory();
   x_ = model_->InitialState(u);
   u_ = u;
+  result_.summary = SolveStart(*model_, u, &x_);
+  SolveAndStartHere();
+  // Judged after the tracking solver's own solve, which may still leave a saddle.
+  start_continuation_steps_ = 0;
+  if (start_family_ && !IsStableStart(result_.summary) && StartByContinuation(u)) {
+    solver_->Reset();
+    SolveAndStartHere();
+  }
+  return result_;
+}
+
+SolverSummary EquilibriumTracker::SolveStart(const Model& model, const Vec& u, Vec* x) const {
   // A reset must start on an equilibrium: unlimited, globalised solve.
   SolverOptions strict = options_;
   strict.max_iterations = 0;
   strict.max_time_us = 0.0;
   strict.method = "newton-ls";
-  auto start_solver = MakeSolver(*model_, strict);
-  result_.summary = start_solver->Solve(u, &x_);
+  auto start_solver = MakeSolver(model, strict);
+  SolverSummary s = start_solver->Solve(u, x);
   // The globalised solve can still stop on a saddle when the start is symmetric (a
   // straight compressed thread): leave along the negative mode until the inertia says
   // it is a minimum (no negative pivot).
-  for (int k = 0; k < 8 && result_.summary.negative_pivots > 0; ++k) {
+  for (int k = 0; k < 8 && s.negative_pivots > 0; ++k) {
     const Vec& v = start_solver->LowestEigenvector();
-    if (v.size() != x_.size()) break;
-    x_ += (0.1 * snap_threshold_ / std::max(v.lpNorm<Eigen::Infinity>(), 1e-300)) * v;
-    result_.summary = start_solver->Solve(u, &x_);
+    if (v.size() != x->size()) break;
+    *x += (0.1 * snap_threshold_ / std::max(v.lpNorm<Eigen::Infinity>(), 1e-300)) * v;
+    s = start_solver->Solve(u, x);
   }
-  return SolveAndStartHere();
+  return s;
+}
+
+bool EquilibriumTracker::StartByContinuation(const Vec& u) {
+  // Steps in t: at most kStep (doubled back up after a success), halved on a failure
+  // down to kMinStep, where the continuation gives up.
+  constexpr double kStep = 0.1, kMinStep = 1.0 / 1024;
+  std::vector<Vec> accepted;  // the equilibria along t: the lagged data follow them
+  Vec x = model_->InitialState(u), trial;
+  SolverSummary s;
+  double t = 0.0, dt = kStep;
+  int steps = 0;
+  for (bool first = true; first || t < 1.0;) {
+    const double next = first ? 0.0 : std::min(1.0, t + dt);
+    std::unique_ptr<Model> member = next < 1.0 ? start_family_(next) : nullptr;
+    Model& m = member ? *member : *model_;
+    if (HistoryCapability* h = m.history(); h != nullptr) {
+      h->ResetHistory();
+      for (const Vec& xa : accepted) h->AcceptState(xa, u);
+    }
+    trial = x;
+    s = SolveStart(m, u, &trial);
+    ++steps;
+    if (IsStableStart(s)) {
+      x = trial;
+      t = next;
+      first = false;
+      accepted.push_back(x);
+      dt = std::min(2.0 * dt, kStep);
+    } else if (first || (dt *= 0.5) < kMinStep) {
+      // Back to the direct start's lagged data (x_ is still its state).
+      ResetModelHistory();
+      AcceptModelState();
+      return false;
+    }
+  }
+  // The last step solved the tracker's own model with its lagged data at the state
+  // before; SolveAndStartHere moves them to x.
+  x_ = x;
+  start_continuation_steps_ = steps;
+  return true;
 }
 
 const TrackResult& EquilibriumTracker::SolveAndStartHere() {
@@ -141,6 +199,7 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   x_ = x_pred_;
   u_ = u;
   result_.summary = solver_->Solve(u, &x_);
+  FinishUnfinishedSnap(u);
   // A snap is a jump to another branch: the state left the predicted one by more than
   // the threshold (for every method alike, so the charts compare like with like). The
   // status is DecideStatus's, now with that fact.
@@ -154,6 +213,27 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   ComputeForces();
   AcceptModelState();
   return result_;
+}
+
+void EquilibriumTracker::FinishUnfinishedSnap(const Vec& u) {
+  constexpr int kSnapRetries = 10;
+  // Far above the cutoff: a snap under way, not a solve stagnating at round-off just
+  // above an absolute cutoff (which more iterations would not help).
+  const double unfinished = 1e3 * options_.cutoff;
+  for (int k = 0; k < kSnapRetries; ++k) {
+    const SolverSummary& s = result_.summary;
+    if (!s.snapped || s.termination != Termination::kLinearSolverFailed || options_.max_time_us > 0.0 ||
+        !(s.residual > unfinished && std::isfinite(s.residual)) || !x_.allFinite())
+      return;
+    SolverSummary more = solver_->Solve(u, &x_);
+    more.iterations += s.iterations;
+    more.gradient_evaluations += s.gradient_evaluations;
+    more.hessian_evaluations += s.hessian_evaluations;
+    more.factorizations += s.factorizations;
+    more.solve_us += s.solve_us;
+    more.snapped = true;
+    result_.summary = std::move(more);
+  }
 }
 
 void EquilibriumTracker::ResetModelHistory() {

@@ -3,6 +3,7 @@
 // one object the sweep tool, the stability suite, the benchmarks and the server share.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -35,8 +36,21 @@ class EquilibriumTracker {
   EquilibriumTracker(std::unique_ptr<Model> model, const SolverOptions& options);
 
   // Start again from the model's InitialState(u), solved to the cutoff with an
-  // unlimited budget (a reset must start on an equilibrium).
+  // unlimited budget (a reset must start on an equilibrium). Where that reaches no stable
+  // equilibrium (not converged, or a saddle it could not leave) and a start
+  // continuation is set, the start follows one along the family instead.
   const TrackResult& Reset(const Vec& u);
+
+  // Models along t in [0, 1] whose member at t = 1 is this tracker's model (the scene's
+  // solver.start_continuation: some parameters scaled by t, e.g. a rod's coil memory).
+  // Reset's fallback: natural-parameter continuation from the initial state at t = 0 to
+  // t = 1, each step the start solve from the last step's equilibrium, a step halved
+  // where it reaches no stable equilibrium; the lagged data (the rod's frames) follow
+  // the accepted states. Empty: no fallback.
+  using ModelFamily = std::function<std::unique_ptr<Model>(double t)>;
+  void SetStartContinuation(ModelFamily family) { start_family_ = std::move(family); }
+  // Number of continuation steps the last Reset took (0: the direct start was stable).
+  int start_continuation_steps() const { return start_continuation_steps_; }
   // Start again from a saved equilibrium x at controls u (a server checkpoint): the
   // model's lagged data is moved to x first (AcceptState), then x is solved again with the
   // tracking solver, warm-started at x, so the state stays on its branch and the
@@ -73,6 +87,20 @@ class EquilibriumTracker {
   void SetSnapThreshold(double t) { snap_threshold_ = t; }
 
  private:
+  // A snap the snap minimiser left unfinished at its own iteration cap (linear-solver-
+  // failed after a snap with |E_x| > 1e3 cutoff, no time budget: the update may take
+  // what the snap needs) goes on
+  // from its last accepted, energy-decreasing state with more solves, at most
+  // kSnapRetries; the summary counts them all.
+  void FinishUnfinishedSnap(const Vec& u);
+  // Reset's start solve of `model` from *x: newton-ls, unlimited, then off a saddle
+  // along its negative mode (at most 8 times).
+  SolverSummary SolveStart(const Model& model, const Vec& u, Vec* x) const;
+  // Reset's fallback (SetStartContinuation): on success x_ is the family's equilibrium
+  // at t = 1 and the model's lagged data are those of the state before (the caller
+  // solves there again, SolveAndStartHere); on failure x_ and the lagged data are the
+  // direct start's.
+  bool StartByContinuation(const Vec& u);
   // The end of Reset and Resume: solve at (x_, u_) with the tracking solver and make that
   // state the start of the path (no predictor history, force and K, lagged model data).
   const TrackResult& SolveAndStartHere();
@@ -104,6 +132,8 @@ class EquilibriumTracker {
   bool have_tangent_ = false;
   bool tangent_in_sol_ = false;  // sol_ holds E_xx^-1 E_xu (kept across SetOptions)
   double snap_threshold_ = 0.1;
+  ModelFamily start_family_;
+  int start_continuation_steps_ = 0;
   double lambda_ref_ = -1.0;
   TrackResult result_;
   // scratch
