@@ -5,6 +5,8 @@
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
+#include <utility>
 
 #include "models/grasp_torque_capability.h"
 
@@ -75,38 +77,78 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
   return rows;
 }
 
+std::vector<SweepColumn> SweepColumns(const std::vector<SweepRow>& rows, const std::string& method,
+                                      const GraspLayout& layout, int num_grasps) {
+  using Kind = SweepColumn::Kind;
+  std::vector<SweepColumn> columns;
+  const auto add = [&](std::string name, Kind kind, const auto& value, int digits = 0) {
+    SweepColumn c{.name = std::move(name), .kind = kind, .digits = digits};
+    for (const SweepRow& r : rows) {
+      if constexpr (std::is_convertible_v<decltype(value(r)), std::string>) {
+        c.texts.emplace_back(value(r));
+      } else {
+        c.numbers.push_back(static_cast<double>(value(r)));
+      }
+    }
+    columns.push_back(std::move(c));
+  };
+  const auto comp = [](const Vec& v, int i) { return i < v.size() ? v[i] : 0.0; };
+  static constexpr const char* kAxes[] = {"x", "y", "z"};
+  add("step", Kind::kInteger, [](const SweepRow& r) { return r.step; });
+  // A planar row (two controls) has 0 in its z columns.
+  for (const auto& [prefix, vec] : {std::pair{"u_", &SweepRow::u}, std::pair{"f_", &SweepRow::force}})
+    for (int c = 0; c < 3; ++c)
+      add(std::string(prefix) + kAxes[c], Kind::kReal,
+          [&](const SweepRow& r) { return c == 2 && r.u.size() == 2 ? 0.0 : comp(r.*vec, c); });
+  add("probe", Kind::kReal, [](const SweepRow& r) { return r.probe; });
+  add("energy", Kind::kReal, [](const SweepRow& r) { return r.energy; });
+  add("residual", Kind::kReal, [](const SweepRow& r) { return r.residual; });
+  add("iterations", Kind::kInteger, [](const SweepRow& r) { return r.iterations; });
+  add("method", Kind::kText, [&](const SweepRow&) { return method; });
+  add("lambda_min", Kind::kReal, [](const SweepRow& r) { return r.lambda_min; });
+  add("snapped", Kind::kInteger, [](const SweepRow& r) { return r.snapped ? 1 : 0; });
+  add("solve_us", Kind::kReal, [](const SweepRow& r) { return r.solve_us; }, 4);
+  add("status", Kind::kText, [](const SweepRow& r) { return std::string(ToString(r.status)); });
+  add("termination", Kind::kText, [](const SweepRow& r) { return std::string(ToString(r.termination)); });
+  add("gradient_evals", Kind::kInteger, [](const SweepRow& r) { return r.gradient_evaluations; });
+  add("hessian_evals", Kind::kInteger, [](const SweepRow& r) { return r.hessian_evaluations; });
+  if (layout.grip_rotation) {
+    add("roll_deg", Kind::kReal, [&](const SweepRow& r) { return comp(r.u, 3) * 180.0 / std::numbers::pi; });
+    for (int c = 0; c < 3; ++c)
+      add(std::string("t_") + kAxes[c], Kind::kReal, [c](const SweepRow& r) { return r.torque[c]; });
+    add("negative_pivots", Kind::kInteger, [](const SweepRow& r) { return r.negative_pivots; });
+  }
+  // Further grasps: u2_*, f2_*, u3_*, ... after every single-grasp column.
+  const int m = layout.NumControls();
+  for (int g = 2; g <= num_grasps; ++g) {
+    for (const auto& [q, vec] : {std::pair{"u", &SweepRow::u}, std::pair{"f", &SweepRow::force}})
+      for (int c = 0; c < 3; ++c)
+        add(q + std::to_string(g) + '_' + kAxes[c], Kind::kReal, [&](const SweepRow& r) {
+          return c < layout.spatial_dimension ? comp(r.*vec, (g - 1) * m + c) : 0.0;
+        });
+  }
+  add("force_error", Kind::kReal, [](const SweepRow& r) { return r.force_error; });
+  return columns;
+}
+
 void WriteSweepCsv(const std::vector<SweepRow>& rows, const std::string& method, std::ostream& out,
                    const GraspLayout& layout, int num_grasps, int digits) {
-  const bool rotation = layout.grip_rotation;
-  out << "step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,"
-         "solve_us,status,termination,gradient_evals,hessian_evals"
-      << (rotation ? ",roll_deg,t_x,t_y,t_z,negative_pivots" : "");
-  // Further grasps (issue 15): u2_*, f2_*, u3_*, ... after every single-grasp column.
-  for (int g = 2; g <= num_grasps; ++g) {
-    for (const char* q : {"u", "f"})
-      for (const char* c : {"x", "y", "z"}) out << ',' << q << g << '_' << c;
-  }
-  out << ",force_error\n";
-  const int m = layout.NumControls();
-  out << std::setprecision(digits);
-  for (const SweepRow& r : rows) {
-    auto comp = [](const Vec& v, int i) { return i < v.size() ? v[i] : 0.0; };
-    const bool planar = r.u.size() == 2;
-    out << r.step << ',' << comp(r.u, 0) << ',' << comp(r.u, 1) << ',' << (planar ? 0.0 : comp(r.u, 2)) << ','
-        << comp(r.force, 0) << ',' << comp(r.force, 1) << ',' << (planar ? 0.0 : comp(r.force, 2)) << ','
-        << r.probe << ',' << r.energy << ',' << r.residual << ',' << r.iterations << ',' << method
-        << ',' << r.lambda_min << ',' << (r.snapped ? 1 : 0) << ',' << std::setprecision(4) << r.solve_us
-        << std::setprecision(digits) << ',' << ToString(r.status) << ',' << ToString(r.termination) << ','
-        << r.gradient_evaluations << ',' << r.hessian_evaluations;
-    if (rotation) {
-      out << ',' << comp(r.u, 3) * 180.0 / std::numbers::pi << ',' << r.torque.x() << ',' << r.torque.y()
-          << ',' << r.torque.z() << ',' << r.negative_pivots;
+  const std::vector<SweepColumn> columns = SweepColumns(rows, method, layout, num_grasps);
+  for (size_t k = 0; k < columns.size(); ++k) out << (k > 0 ? "," : "") << columns[k].name;
+  out << '\n';
+  for (size_t i = 0; i < rows.size(); ++i) {
+    for (size_t k = 0; k < columns.size(); ++k) {
+      const SweepColumn& c = columns[k];
+      if (k > 0) out << ',';
+      if (c.kind == SweepColumn::Kind::kText) {
+        out << c.texts[i];
+      } else if (c.kind == SweepColumn::Kind::kInteger) {
+        out << static_cast<long long>(c.numbers[i]);
+      } else {
+        out << std::setprecision(c.digits > 0 ? c.digits : digits) << c.numbers[i];
+      }
     }
-    for (int g = 1; g < num_grasps; ++g) {
-      for (const Vec* v : {&r.u, &r.force})
-        for (int c = 0; c < 3; ++c) out << ',' << (c < layout.spatial_dimension ? comp(*v, g * m + c) : 0.0);
-    }
-    out << ',' << r.force_error << '\n';
+    out << '\n';
   }
 }
 

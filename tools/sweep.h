@@ -49,7 +49,23 @@ std::vector<Vec> PathControls(const Scene& scene, int steps_per_leg);
 // the path. Row 0 is the reset state.
 std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls);
 
-// The CSV of snapthread-sweep: header, then one line per row. The first columns are
+// One column of the sweep's table: its name in the CSV and one value per row, a number or
+// a text. snapthread-sweep writes the table as CSV (WriteSweepCsv); the Python module's
+// snapthread.sweep() hands the same columns over as NumPy arrays (python/).
+struct SweepColumn {
+  enum class Kind { kReal, kInteger, kText };
+  std::string name{};
+  Kind kind = Kind::kReal;
+  std::vector<double> numbers{};     // kReal, kInteger (whole numbers)
+  std::vector<std::string> texts{};  // kText
+  int digits = 0;                  // significant digits in the CSV; 0: the writer's
+};
+
+// The columns of snapthread-sweep's CSV, in its order (WriteSweepCsv says which).
+std::vector<SweepColumn> SweepColumns(const std::vector<SweepRow>& rows, const std::string& method,
+                                      const GraspLayout& layout = {}, int num_grasps = 1);
+
+// The CSV of snapthread-sweep (SweepColumns as text): header, then one line per row. The first columns are
 // step,u_x,u_y,u_z,f_x,f_y,f_z,probe,energy,residual,iterations,method,lambda_min,snapped,solve_us
 // A grasp that holds its orientation (layout.grip_rotation, the rod) adds, at the end,
 // roll_deg (the x component of the grasp's rotation vector, degrees: the roll about the
