@@ -15,6 +15,9 @@ packages=(
   clang libclang-rt-14-dev
   libceres-dev liblapack-dev
   iproute2 procps
+  # The Python module (python/, docs/python.md): pybind11 and NumPy to build it for Debian's
+  # python3; pytest and matplotlib for its tests and example.
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
   # snapthread-web: Boost.Beast (header-only) for its HTTP/WebSocket server, and Debian's
   # Chromium and Firefox ESR for its browser tests (driven by playwright-core and
   # puppeteer-core from the page's npm install; Firefox's WebGL runs on the tests' Xvfb).
