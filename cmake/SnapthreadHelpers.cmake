@@ -233,8 +233,9 @@ function(snapthread_build_aids)
   endforeach()
 endfunction()
 
-# snapthread-programs: every program (an executable outside tests/ that `all` builds), what
-# deploy/run.sh builds whether or not the build directory has the tests turned on.
+# snapthread-programs: every program (an executable outside tests/ that `all` builds) and
+# the Python module where it is built, what deploy/run.sh builds whether or not the build
+# directory has the tests turned on.
 function(snapthread_programs_target)
   _snapthread_targets_below(${PROJECT_SOURCE_DIR} _all)
   set(_programs "")
@@ -243,7 +244,7 @@ function(snapthread_programs_target)
     get_target_property(_dir ${_t} SOURCE_DIR)
     get_target_property(_excluded ${_t} EXCLUDE_FROM_ALL)
     file(RELATIVE_PATH _relative ${PROJECT_SOURCE_DIR} ${_dir})
-    if(_type STREQUAL "EXECUTABLE" AND NOT _relative MATCHES "^tests(/|$)" AND NOT _excluded)
+    if(_type MATCHES "^(EXECUTABLE|MODULE_LIBRARY)$" AND NOT _relative MATCHES "^tests(/|$)" AND NOT _excluded)
       list(APPEND _programs ${_t})
     endif()
   endforeach()
