@@ -233,18 +233,33 @@ function(snapthread_build_aids)
   endforeach()
 endfunction()
 
+# _snapthread_targets_outside_tests(OUT): the targets defined outside tests/, but the
+# build's own helper (the test programs' shared precompiled header).
+function(_snapthread_targets_outside_tests out)
+  _snapthread_targets_below(${PROJECT_SOURCE_DIR} _all)
+  set(_kept "")
+  foreach(_t IN LISTS _all)
+    get_target_property(_dir ${_t} SOURCE_DIR)
+    file(RELATIVE_PATH _relative ${PROJECT_SOURCE_DIR} ${_dir})
+    if(NOT _relative MATCHES "^tests(/|$)" AND NOT _t STREQUAL "snapthread_test_pch")
+      list(APPEND _kept ${_t})
+    endif()
+  endforeach()
+  set(${out} ${_kept} PARENT_SCOPE)
+endfunction()
+
 # snapthread-programs: every program (an executable outside tests/ that `all` builds) and
 # the Python module where it is built, what deploy/run.sh builds whether or not the build
-# directory has the tests turned on.
+# directory has the tests turned on. Also <build>/snapthread_targets.txt: every target
+# outside tests/ (libraries, programs, generated files), one per line, for docs_test
+# (docs/architecture.md names each) and exit_codes_test (the programs among them).
 function(snapthread_programs_target)
-  _snapthread_targets_below(${PROJECT_SOURCE_DIR} _all)
+  _snapthread_targets_outside_tests(_targets)
   set(_programs "")
-  foreach(_t IN LISTS _all)
+  foreach(_t IN LISTS _targets)
     get_target_property(_type ${_t} TYPE)
-    get_target_property(_dir ${_t} SOURCE_DIR)
     get_target_property(_excluded ${_t} EXCLUDE_FROM_ALL)
-    file(RELATIVE_PATH _relative ${PROJECT_SOURCE_DIR} ${_dir})
-    if(_type MATCHES "^(EXECUTABLE|MODULE_LIBRARY)$" AND NOT _relative MATCHES "^tests(/|$)" AND NOT _excluded)
+    if(_type MATCHES "^(EXECUTABLE|MODULE_LIBRARY)$" AND NOT _excluded)
       list(APPEND _programs ${_t})
     endif()
   endforeach()
@@ -252,20 +267,6 @@ function(snapthread_programs_target)
   if(_programs)
     add_dependencies(snapthread-programs ${_programs})
   endif()
-endfunction()
-
-# <build>/snapthread_targets.txt: every target defined outside tests/ (libraries, programs,
-# generated files), one per line, for docs_test: docs/architecture.md names each of them.
-function(snapthread_write_target_list)
-  _snapthread_targets_below(${PROJECT_SOURCE_DIR} _all)
-  set(_names "")
-  foreach(_t IN LISTS _all)
-    get_target_property(_dir ${_t} SOURCE_DIR)
-    file(RELATIVE_PATH _relative ${PROJECT_SOURCE_DIR} ${_dir})
-    # tests/ and the build's own helpers (the shared precompiled header, the programs list).
-    if(NOT _relative MATCHES "^tests(/|$)" AND NOT _t MATCHES "^(snapthread_test_pch|snapthread-programs)$")
-      string(APPEND _names "${_t}\n")
-    endif()
-  endforeach()
-  file(WRITE ${PROJECT_BINARY_DIR}/snapthread_targets.txt "${_names}")
+  list(JOIN _targets "\n" _names)
+  file(WRITE ${PROJECT_BINARY_DIR}/snapthread_targets.txt "${_names}\n")
 endfunction()

@@ -60,19 +60,26 @@ void WriteSceneSchemaMarkdown(std::ostream& out) {
          "with the file, the key and what was expected. Any key can be overridden on the command\n"
          "line: `--set params.n=20`, `--set solver.method=newton`.\n\n"
          "## Top level\n\n";
-  KeyTable(out, kSceneTop, "");
-  out << "## The grasp (`grasp:`, and each of `grasps:`)\n\n";
-  KeyTable(out, kSceneGrasp, "grasp.");
-  out << "Each entry of `grasps:` also takes:\n\n";
-  KeyTable(out, kSceneNamedGrasp, "grasps[i].");
-  out << "A rod's path point may be a mapping instead of `[X, Y, Z]`:\n\n";
-  KeyTable(out, kScenePathPoint, "");
-  out << "## `solver:`\n\n";
-  KeyTable(out, kSceneSolver, "solver.");
-  out << "## `device:`\n\n";
-  KeyTable(out, kSceneDevice, "device.");
-  out << "## `targets:`\n\nThe defaults hold when the block is given without the key.\n\n";
-  KeyTable(out, kSceneTargets, "targets.");
+  // Each block's table: the text before it, the block, the prefix its keys are spelt with.
+  struct Section {
+    const char* before;
+    std::string_view block;
+    const char* prefix;
+  };
+  const Section kSections[] = {
+      {"", kSceneTop, ""},
+      {"## The grasp (`grasp:`, and each of `grasps:`)\n\n", kSceneGrasp, "grasp."},
+      {"Each entry of `grasps:` also takes:\n\n", kSceneNamedGrasp, "grasps[i]."},
+      {"A rod's path point may be a mapping instead of `[X, Y, Z]`:\n\n", kScenePathPoint, ""},
+      {"## `solver:`\n\n", kSceneSolver, "solver."},
+      {"## `device:`\n\n", kSceneDevice, "device."},
+      {"## `targets:`\n\nThe defaults hold when the block is given without the key.\n\n", kSceneTargets,
+       "targets."},
+  };
+  for (const Section& s : kSections) {
+    out << s.before;
+    KeyTable(out, s.block, s.prefix);
+  }
   out << "## `params:`, per model\n\nThe registered models (`common/models/registry.cc`) and their "
          "parameters.\n\n";
   ModelTables(out);
