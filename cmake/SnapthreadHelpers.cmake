@@ -232,3 +232,41 @@ function(snapthread_build_aids)
     endif()
   endforeach()
 endfunction()
+
+# _snapthread_targets_outside_tests(OUT): the targets defined outside tests/, but the
+# build's own helper (the test programs' shared precompiled header).
+function(_snapthread_targets_outside_tests out)
+  _snapthread_targets_below(${PROJECT_SOURCE_DIR} _all)
+  set(_kept "")
+  foreach(_t IN LISTS _all)
+    get_target_property(_dir ${_t} SOURCE_DIR)
+    file(RELATIVE_PATH _relative ${PROJECT_SOURCE_DIR} ${_dir})
+    if(NOT _relative MATCHES "^tests(/|$)" AND NOT _t STREQUAL "snapthread_test_pch")
+      list(APPEND _kept ${_t})
+    endif()
+  endforeach()
+  set(${out} ${_kept} PARENT_SCOPE)
+endfunction()
+
+# snapthread-programs: every program (an executable outside tests/ that `all` builds) and
+# the Python module where it is built, what deploy/run.sh builds whether or not the build
+# directory has the tests turned on. Also <build>/snapthread_targets.txt: every target
+# outside tests/ (libraries, programs, generated files), one per line, for docs_test
+# (docs/architecture.md names each) and exit_codes_test (the programs among them).
+function(snapthread_programs_target)
+  _snapthread_targets_outside_tests(_targets)
+  set(_programs "")
+  foreach(_t IN LISTS _targets)
+    get_target_property(_type ${_t} TYPE)
+    get_target_property(_excluded ${_t} EXCLUDE_FROM_ALL)
+    if(_type MATCHES "^(EXECUTABLE|MODULE_LIBRARY)$" AND NOT _excluded)
+      list(APPEND _programs ${_t})
+    endif()
+  endforeach()
+  add_custom_target(snapthread-programs)
+  if(_programs)
+    add_dependencies(snapthread-programs ${_programs})
+  endif()
+  list(JOIN _targets "\n" _names)
+  file(WRITE ${PROJECT_BINARY_DIR}/snapthread_targets.txt "${_names}\n")
+endfunction()

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The whole test suite (what CI runs), in stages whose wall times are printed at the end,
 # also when a stage fails (docs/testing.md has the figures and what each stage holds):
-#  1. set-up (Debian packages), the Release build (-O3 -DNDEBUG, warnings as errors) in
-#     build/, then every test;
+#  1. set-up (deploy/setup.sh --tests: the programs' Debian packages and the test tools'),
+#     the Release build of programs and tests (-O3 -DNDEBUG, warnings as errors) in build/,
+#     then every test;
 #  2. a second build with AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/: -O1,
 #     line tables only, and only what ctest runs), then every test again under it (the
 #     viewer's ones without the leak check: why, below);
@@ -63,11 +64,13 @@ PrintTimes() {
 trap PrintTimes EXIT
 
 Stage "setup (packages)"
-"$here/deploy/setup.sh" --no-build
+"$here/deploy/setup.sh" --tests --no-build
 
-# The same configure and build as deploy/setup.sh's.
+# deploy/setup.sh's configure with the tests and snapthread-web turned on (a build/ that
+# deploy/run.sh configured has them off), then everything.
 Stage "Release build"
-cmake $(Generator "$here/build") -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release
+cmake $(Generator "$here/build") -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release \
+  -DSNAPTHREAD_BUILD_TESTS=ON -DSNAPTHREAD_BUILD_WEB=ON
 cmake --build "$here/build" -j"$jobs"
 
 Stage "Release tests"

@@ -35,7 +35,7 @@ namespace snapthread::device {
 
 struct DeviceClientConfig {
   std::string device_id = "device";  // device_state_t.device_id, e.g. "virtual-hand"
-  // The scene grasp this device holds (device_state_t.grasp, issue 15; "" = the scene's
+  // The scene grasp this device holds (device_state_t.grasp; "" = the scene's
   // only grasp): force models for another grasp are not for this device.
   std::string grasp;
   SafetyLimits limits;               // must be valid (SafetyLimits::IsValid)

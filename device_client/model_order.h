@@ -1,4 +1,4 @@
-// The order in which the device applies force models (issue 12 item 4). On a lossy LAN a
+// The order in which the device applies force models. On a lossy LAN a
 // model can arrive after a newer one; rendering it would take the hand back to an older
 // equilibrium (across a snap: back to the branch it just left, and forward again with
 // the next model), so one snap would be felt as several force steps. A model is applied

@@ -59,7 +59,7 @@ bool ModelReceiver::Receive(const void* data, int size, int64_t now_us) {
       return false;
     }
     if (auth_.keys != nullptr && !CheckSender(data, size, msg, now_us)) return false;
-    // Another hand's model (issue 15): it answers that device's poses, never this one's.
+    // Another hand's model: it answers that device's poses, never this one's.
     if (msg.grasp != grasp_) {
       other_grasp_.fetch_add(1);
       return false;

@@ -1,7 +1,8 @@
 // snapthread-logger: records a session into an LCM log file without losing messages under
 // load (session_logger.h); the command line follows lcm-logger's.
-// Exit codes: 0 after SIGINT / SIGTERM or --duration-s with every message written, 1 for
-// bad arguments, an LCM or file failure, or messages lost.
+// Exit codes (common/app/exit_codes.h, docs/cli.md): 0 after SIGINT / SIGTERM or
+// --duration-s with every message written; 1 for an LCM or file failure, or messages
+// lost; 2 for bad arguments.
 #include <cstdio>
 #include <ctime>
 #include <exception>
@@ -29,7 +30,7 @@ constexpr const char* kDescription =
     "--max-bytes / --rotate split and rotate files like lcm-logger's --split-mb / --rotate. "
     "Ends at SIGINT / SIGTERM or after --duration-s.";
 // snapthread-logger has always exited 1 for every failure (app/exit_codes.h).
-constexpr int kExitBadArguments = app::kExitUsageAsFailure;
+constexpr int kExitBadArguments = app::kExitUsage;
 
 struct LoggerFlags {
   logger::LoggerOptions options;

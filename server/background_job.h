@@ -1,5 +1,5 @@
 // One piece of work (a scene load) on its own thread with a time limit, polled by the
-// solve thread so it never waits for it (issue 12 item 3: the current scene keeps being
+// solve thread so it never waits for it (the current scene keeps being
 // served while a new one loads). A job past its limit is abandoned: reported once as
 // timed out, its result discarded when it ends; a thread cannot be killed, so the job
 // stays busy() until then and the destructor joins it.

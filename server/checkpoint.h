@@ -1,4 +1,4 @@
-// The server's checkpoint (issue 12 item 5): what a restarted server needs to resume on
+// The server's checkpoint: what a restarted server needs to resume on
 // the branch the hand was feeling — the scene (its text, so it reloads even when the
 // file changed or came from LOAD_SCENE), the method, the grasp u and the state x — in one
 // file written atomically.

@@ -1,4 +1,4 @@
-// Writes the server's checkpoints off the solve thread (issue 12 item 5). The solve
+// Writes the server's checkpoints off the solve thread. The solve
 // thread hands over a snapshot (a copy of the grasp and the state, the scene and the
 // method) with Offer, which only swaps it into a slot under a mutex that is never held
 // during I/O; the writer thread encodes, signs and writes the newest snapshot with

@@ -1,4 +1,4 @@
-// Snap-ahead on the solve thread (issue 17): decides when a fold is within reach of the
+// Snap-ahead on the solve thread: decides when a fold is within reach of the
 // hand, runs the FoldSearch in the background (BackgroundJob), keeps the current fold
 // prediction for the branch the tracker follows, writes it into each force model in
 // device units (force_model_t.has_fold ... fold_normal_r; the pose chart, fold_chart.h) and, when a pose says the device

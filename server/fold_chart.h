@@ -1,4 +1,4 @@
-// Snap-ahead (issue 17): a fold boundary found in the model's controls, expressed in the
+// Snap-ahead: a fold boundary found in the model's controls, expressed in the
 // pose chart the device evaluates every servo tick (force_model_t.fold_*): position p in
 // device metres and the turn r = log(R R_fold^T) of the device's orientation R from the
 // orientation at the fold (the chart of the 6-DoF model, K6). The device then needs no

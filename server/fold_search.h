@@ -1,4 +1,4 @@
-// Snap-ahead, the search (issue 17): where along the hand's motion the followed branch
+// Snap-ahead, the search: where along the hand's motion the followed branch
 // ends in a fold, the fold boundary there (point, normal, curvature in control space)
 // and the equilibrium the state snaps to past it. Runs off the solve thread on its own
 // tracker (own model and solver), so the served tracker is never touched.

@@ -1,4 +1,4 @@
-// Several grasps on one session (issue 15): each device pose moves only the controls of
+// Several grasps on one session: each device pose moves only the controls of
 // the grasp it names (device_state_t.grasp); the other grasps keep the controls of the
 // last update, so one solve answers every hand whose pose arrived.
 //

@@ -1,4 +1,4 @@
-// The knot type of the current shape (issue 15 item 6), computed a few times a second on a
+// The knot type of the current shape, computed a few times a second on a
 // background thread so the solve thread never waits for it: each tick the solve thread
 // collects a finished identification and, when the last one has ended and the period has
 // passed, hands a copy of the chain's nodes to a new one. Curves only (thread3d, rod,

@@ -1,4 +1,4 @@
-// Scenes named by a LOAD_SCENE command (issue 12 item 3). A command comes from the
+// Scenes named by a LOAD_SCENE command. A command comes from the
 // network, so it names a scene, never a path: only a regular file of at most
 // kMaxSceneFileBytes directly inside the scene directory is ever opened. Everything
 // else (a path, "..", a symlink, a device, a FIFO, a directory, a big file) is refused

@@ -45,7 +45,7 @@ struct ForceModelInputs {
   double solve_us = 0.0;
   int64_t seq = 0;
   int64_t utime = 0;                  // CLOCK_REALTIME now
-  // The grasp the model is for (issue 15): its controls u[offset, offset + count) and its
+  // The grasp the model is for: its controls u[offset, offset + count) and its
   // block of F and K (count 0: all the model's controls, the single grasp). The server's
   // predictor keeps the cross terms; the device gets its own block.
   int grasp_offset = 0;

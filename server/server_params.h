@@ -70,14 +70,14 @@ struct ServerParams {
   // no checkpoints). Restarted with the same directory and session it resumes on the
   // same branch (server/checkpoint.h). Made (mode 0700) when missing.
   std::string state_dir;
-  // At most this many equilibrium updates per second (--max-update-hz; issue 17): > 0 caps
+  // At most this many equilibrium updates per second (--max-update-hz): > 0 caps
   // the solve rate (the newest pose waits for its slot; large models, tests); 0 = the
   // scene's solver.max_update_hz (0 there too: no cap).
   double max_update_hz = 0.0;
-  // Snap-ahead (issue 17, server/fold_boundary.h): near a fold send the fold boundary and
+  // Snap-ahead (server/fold_boundary.h): near a fold send the fold boundary and
   // the post-snap model with the force model. --no-snap-ahead turns it off.
   bool snap_ahead = true;
-  // Checkpoints per second while the state changes (>= 5, issue 12); not a flag.
+  // Checkpoints per second while the state changes (>= 5); not a flag.
   double checkpoint_rate_hz = 20.0;
 
   // False with a message naming the offending field (as a command-line flag) when

@@ -1,4 +1,4 @@
-// thread_shape_t.frames for a viewer (issue 14 item 3): the material director m1 and
+// thread_shape_t.frames for a viewer: the material director m1 and
 // twist density per edge of a model with frames (FramesCapability, the rod); every other
 // model sends none.
 #pragma once

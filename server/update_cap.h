@@ -1,4 +1,4 @@
-// --max-update-hz / solver.max_update_hz (issue 17): at most R equilibrium updates per
+// --max-update-hz / solver.max_update_hz: at most R equilibrium updates per
 // second. The solve loop holds the newest pose of each grasp here until its slot; a pose
 // that arrives meanwhile supersedes the held one of its grasp (a dropped pose).
 #pragma once

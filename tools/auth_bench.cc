@@ -178,7 +178,18 @@ std::string LoadAverage() {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  // No options: --help says so (exit 0), anything else is a bad argument (exit 2, docs/cli.md).
+  if (argc > 1) {
+    const std::string arg = argv[1];
+    if (arg == "--help" || arg == "-h") {
+      std::printf("snapthread-auth-bench: the median cost of the roles' primitives (docs/security.md); "
+                  "takes no arguments\n");
+      return 0;
+    }
+    std::fprintf(stderr, "snapthread-auth-bench: unexpected argument '%s' (it takes none)\n", argv[1]);
+    return 2;
+  }
   const std::time_t now = std::time(nullptr);
   char date[32];
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));

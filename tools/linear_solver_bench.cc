@@ -172,7 +172,11 @@ int main(int argc, char** argv) {
   app.add_flag("--ring", ring, "close the chain: couple the first and last unknowns");
   app.add_flag("--thread3d", thread3d, "real thread3d Hessians; --sizes are segment counts");
   app.add_flag("--csv", csv, "print CSV instead of a table");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // --help exits 0, bad arguments 2 (docs/cli.md)
+  }
   // Checked here, naming the flag: CLI11's range checks let "nan" through, and a size of
   // -5 or 10^9 would end in bad_alloc or minutes of allocation.
   const auto bad = [](const std::string& message) {

@@ -67,7 +67,7 @@ std::vector<StandardSweep> StandardSweeps(const std::string& dir) {
                  "grip turned 0 -> 720 -> 0 degrees about z at (7, 0.5, 1), 0.5 degree steps",
                  PathControls(scene, 60), 0, M_PI / 360});
   }
-  // The rod (issue 14): Greenhill's twist buckling, the grasp rolled through the buckle;
+  // The rod: Greenhill's twist buckling, the grasp rolled through the buckle;
   // the charted component is the torque about the rod's axis (F's rotation part).
   {
     const Scene scene = LoadScene(dir + "/rod_greenhill.yaml");

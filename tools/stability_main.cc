@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "progress.h"
 #include "solvers/registry.h"
 #include "stability.h"
 #include "stability_resolution.h"
@@ -162,9 +163,11 @@ void RunResolutionTable(const std::vector<ResolutionSweep>& sweeps, const std::v
                         const fs::path& out_dir) {
   if (sweeps.empty()) return;
   std::vector<ResolutionRow> table;
+  const Progress progress("stability");
+  const int total = static_cast<int>(sweeps.size() * methods.size());
   for (const ResolutionSweep& sw : sweeps) {
     for (const std::string& m : methods) {
-      std::cerr << "stability: " << sw.name << " with " << m << '\n';
+      progress.Step(static_cast<int>(table.size()) + 1, total, sw.name + " with " + m);
       table.push_back(RunResolution(sw, m));
     }
   }
@@ -227,8 +230,11 @@ int main(int argc, char** argv) {
     std::vector<StabilityRow> table;
     std::vector<std::pair<std::string, int>> charted;
     const std::vector<std::string> chart_names = {"zeeman_folds", "cusp_folds", "curve2d_snap", "thread3d_loop"};
+    const Progress progress("stability");
+    int done = 0;
     for (const auto& sw : sweeps) {
-      std::cerr << "stability: " << sw.name << " (" << sw.controls.size() << " updates): " << sw.description << '\n';
+      progress.Step(++done, static_cast<int>(sweeps.size()),
+                    sw.name + " (" + std::to_string(sw.controls.size()) + " updates): " + sw.description);
       const Scene scene = LoadScene(sw.scene_file);
       const auto ref = ReferenceTrace(scene, sw.controls, substeps);
       std::vector<std::pair<std::string, std::vector<SweepRow>>> chart;

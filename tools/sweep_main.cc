@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "models/registry.h"
+#include "scene/scene_schema.h"
 #include "solvers/registry.h"
 #include "sweep.h"
 #include "tool_main.h"
@@ -51,6 +52,14 @@ int main(int argc, char** argv) {
   app.add_flag("--exact", exact,
                "write every number but solve_us with 17 significant digits (each double exactly: "
                "tools/same_bits/check.sh compares runs bit for bit)");
+  // docs/scenes.md, printed from the loader's schema (no scene needed: it ends the parse).
+  app.add_flag_callback(
+      "--print-scene-schema",
+      [] {
+        WriteSceneSchemaMarkdown(std::cout);
+        throw CLI::Success();
+      },
+      "print every scene key (meaning, unit, default, range) as Markdown: docs/scenes.md");
   // The models a scene may name, with their parameters (--set params.<name>=...).
   app.footer("Models (scene key `model:`):\n" + ModelHelp());
   const auto run = [&]() -> int {

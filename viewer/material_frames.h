@@ -1,4 +1,4 @@
-// The rod's material frame and twist on the drawn tube (issue 14 item 3): the message's
+// The rod's material frame and twist on the drawn tube: the message's
 // per-edge director d1 and twist density (thread_shape_t.frames) carried onto the rings
 // of the spline-smoothed tube, and the twist colour map. No OpenGL here (testable).
 #pragma once

@@ -370,7 +370,7 @@ std::string HudText(const SessionSnapshot& s, const FrameInfo& info) {
     text += line;
   }
   if (s.has_shape || s.has_status) {
-    // The knot type (issue 15): the status's, with its determinant, else the shape's; the
+    // The knot type: the status's, with its determinant, else the shape's; the
     // contacts of the shape drawn, else the status's count.
     const bool status_knot = s.has_status && !s.status.knot.empty();
     const std::string& knot = status_knot ? s.status.knot : s.shape.knot;

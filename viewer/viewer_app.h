@@ -10,8 +10,8 @@ namespace snapthread::viewer {
 // Exit codes of the process (app/exit_codes.h: the viewer keeps its documented 2).
 inline constexpr int kExitOk = app::kExitOk;
 inline constexpr int kExitSetupFailed = app::kExitFailure;  // LCM, key, window or GL context
-inline constexpr int kExitBadArguments = app::kExitUsageAsFailure;
-inline constexpr int kExitTimeout = 2;  // screenshot: not enough shapes before --timeout-s
+inline constexpr int kExitBadArguments = app::kExitUsage;
+inline constexpr int kExitTimeout = app::kExitTimeout;  // screenshot: not enough shapes before --timeout-s
 
 // Opens the window and runs until closed, --duration-s, a stop signal, or the screenshot
 // is written.

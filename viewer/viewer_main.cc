@@ -1,6 +1,7 @@
 // snapthread-viewer: watches a session (thread shape + solver status) over LCM.
-// Exit codes (viewer_app.h): 0 closed, stopped or screenshot written; 1 bad arguments or
-// set-up failed (LCM, key, window); 2 the screenshot's shapes did not arrive in time.
+// Exit codes (common/app/exit_codes.h, docs/cli.md): 0 closed, stopped or screenshot
+// written; 1 set-up failed (LCM, key, window); 2 bad arguments; 3 the screenshot's shapes
+// did not arrive in time.
 #include <CLI/CLI.hpp>
 
 #include "app/command_line.h"
@@ -29,7 +30,7 @@ void AddViewerFlags(CLI::App* app, snapthread::viewer::ViewerOptions* o) {
   app->add_option("--after-shapes", o->after_shapes, "shapes to receive before the screenshot")
       ->capture_default_str()->check(CLI::Range(1, 1000000));
   app->add_option("--timeout-s", o->timeout_s,
-                  "screenshot: fail (exit 2) if the shapes have not arrived by then")
+                  "screenshot: fail (exit 3) if the shapes have not arrived by then")
       ->capture_default_str()->check(CLI::NonNegativeNumber)->check(FiniteNumber());
   app->add_flag("--print-rates", o->print_rates,
                 "print live rates of every <SESSION>_* channel once per second (no window)");

@@ -5,13 +5,13 @@
 // start, a file could not be written, no window), and kExitUsage for bad arguments, each
 // with one line "<program>: <why>" on standard error that names the flag.
 //
-// Older programs documented a different use of 1 and 2 before this table existed, and
-// scripts rely on them, so they keep it (each program's header says which):
-// snapthread-viewer exits 2 when a screenshot's shapes did not arrive in time and 1 for
-// bad arguments; snapthread-report exits 2 when nothing of the log could be read and 1
-// for bad arguments; snapthread-web and snapthread-logger exit 1 for every failure.
-// kExitUsageAsFailure names that "bad arguments are 1" choice where such a program
-// passes its usage code.
+// A program that waits for something with a deadline exits kExitTimeout when it passed:
+// snapthread-ctl without an authenticated reply, the viewer's screenshot without its
+// shapes (docs/cli.md).
+//
+// Two programs still use 1 for bad arguments (kExitUsageAsFailure):
+// snapthread-report (which also exits 2 when nothing of the log could be read) and
+// snapthread-web; tests/bad_input pins what each does.
 #pragma once
 
 namespace snapthread::app {
@@ -19,8 +19,10 @@ namespace snapthread::app {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;
-// A program that waits for a peer's answer (snapthread-ctl) and got none in time.
-inline constexpr int kExitNoReply = 3;
+// A deadline passed: a peer's answer (snapthread-ctl) or the shapes of a screenshot
+// (snapthread-viewer) did not arrive in time.
+inline constexpr int kExitTimeout = 3;
+inline constexpr int kExitNoReply = kExitTimeout;
 // For the programs above whose bad arguments exit 1.
 inline constexpr int kExitUsageAsFailure = kExitFailure;
 

@@ -1,4 +1,4 @@
-// Self-contact as terms of a chain model (issue 15): the scene parameters of contact,
+// Self-contact as terms of a chain model: the scene parameters of contact,
 // and the barrier pairs (contact/self_contact.h) registered in the model's
 // HessianAssembly and carried from node coordinates to the model's variables.
 //
@@ -6,7 +6,7 @@
 // node: Jacobian row and Hessian over u, filled in by the model at each evaluation), or
 // fixed (the clamp).
 //
-// The E_xx pattern (issue 15 item 8): the chain's own band plus the blocks of the pairs
+// The E_xx pattern: the chain's own band plus the blocks of the pairs
 // near contact — the "set", pairs whose centrelines lie within the activation distance
 // 2r + d̂ plus a margin (kMargin of it) — as dynamic terms of the assembly
 // (hessian_assembly.h). Before E_xx is written at a state, CoverActive() checks that

@@ -1,4 +1,4 @@
-// Self-contact of the rod (issue 15): the barrier pairs of models/contact_terms.h on the
+// Self-contact of the rod: the barrier pairs of models/contact_terms.h on the
 // rod's nodes. Clamped nodes x_0, x_1 are fixed and x_{n-1}, x_n follow the grasp
 // u = (p, φ) (ControlMap rows 0..2 and 3..5); without a clamp x_0, x_1 follow the first
 // grasp u[0..5] (rows 0..2, 3..5) and x_{n-1}, x_n the second u[6..11] (rows 6..8,

@@ -1,4 +1,4 @@
-// The discrete elastic rod (issue 14; Bergou et al. 2008 [DER], 2010 [DVT]):
+// The discrete elastic rod (Bergou et al. 2008 [DER], 2010 [DVT]):
 // n edges, nodes x_0 .. x_n and one material angle θ_j per edge against a time-parallel
 // reference frame (rod_frames.h, rod_energy.h; docs/models-rod.md).
 //

@@ -1,4 +1,4 @@
-// What a viewer draws of the rod beyond its nodes (issue 14 item 3): the material
+// What a viewer draws of the rod beyond its nodes: the material
 // director m1 of each edge and the twist density. The twist at interior vertex i is
 // θ_i − θ_{i−1} + m_i with m_i the reference twist [DVT (2), (4); docs/models-rod.md],
 // the same quantity the twist energy ½ GJ (θ_i − θ_{i−1} + m_i)² / ℓ̄ uses.

@@ -356,7 +356,7 @@ class Thread3dModel final : public ChainModel<Thread3dModel>, public ContactCapa
     return (!grip_ && term.first_node >= 2 && last <= n_ - 1) ? NodeVar(term.first_node, 0) : -1;
   }
 
-  // Self-contact (issue 15; models/contact_terms.h): p_0 and y_1, z_1 fixed, x_1 and
+  // Self-contact (models/contact_terms.h): p_0 and y_1, z_1 fixed, x_1 and
   // p_2 .. p_{N-1} state variables, p_N = u. Not with a grip (the scene check says so).
   void RegisterContact() {
     contact_.Register(contact_params_, n_, rest_,

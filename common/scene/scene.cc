@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "scene/input_file.h"
+#include "scene/scene_schema.h"
 
 namespace snapthread {
 namespace {
@@ -169,7 +170,7 @@ Vec RotationWaypoint(const YAML::Node& point, const std::string& key, const Read
     return p;
   }
   if (!point.IsMap()) rd.Fail(key, "expected [X, Y, Z] or {position: [X, Y, Z], roll_deg: r}, got '" + Reader::Dump(point) + "'");
-  rd.CheckKeys(point, key, {"position", "roll_deg", "rotation_deg"});
+  rd.CheckKeys(point, key, SceneKeyNames(kScenePathPoint));
   if (!point["position"]) rd.Fail(key + ".position", "missing (expected a list of 3 numbers)");
   if (point["roll_deg"] && point["rotation_deg"]) rd.Fail(key + ".rotation_deg", "also given as roll_deg; keep one");
   p.head(3) = rd.Vector(point["position"], key + ".position", 3);
@@ -192,7 +193,7 @@ GraspRead ReadGrasp(const YAML::Node& g, const std::string& key, const GraspLayo
   const int pos_dim = layout.spatial_dimension;
   const bool grip = layout.grip_direction;
   const int m = layout.NumControls();
-  extra.insert({"start", "direction", "path"});
+  for (const std::string& k : SceneKeyNames(kSceneGrasp)) extra.insert(k);
   rd.CheckKeys(g, key, extra);
   if (!g["start"]) rd.Fail(key + ".start", "missing (expected a list of " + std::to_string(pos_dim) + " numbers)");
   Vec start = rd.Vector(g["start"], key + ".start", pos_dim);
@@ -253,7 +254,7 @@ void ReadGrasps(const YAML::Node& list, const ModelRegistration& model, const Re
     const std::string key = "grasps[" + std::to_string(i) + "]";
     const YAML::Node g = list[i];
     if (!g.IsMap()) rd.Fail(key, "expected a mapping with name, edge or node, start, path");
-    GraspRead r = ReadGrasp(g, key, sc->grasp_layout, rd, {"name", "edge", "node", "model_origin"});
+    GraspRead r = ReadGrasp(g, key, sc->grasp_layout, rd, SceneKeyNames(kSceneNamedGrasp));
     SceneGrasp sg;
     if (!g["name"]) rd.Fail(key + ".name", "missing (expected a name, e.g. left)");
     sg.name = rd.Get<std::string>(g["name"], key + ".name", "a name");
@@ -352,9 +353,7 @@ void ReadStartContinuation(const YAML::Node& list, const ModelRegistration& mode
 // The scene's solver: block (what it says about solving; the method is checked where the
 // solver is made).
 void ReadSolver(const YAML::Node& s, const ModelRegistration& model, const Reader& rd, Scene* sc) {
-  rd.CheckKeys(s, "solver", {"method", "cutoff", "max_iterations", "time_budget_us", "max_time_us",
-                             "linear_solver", "degeneracy_ratio", "max_reduction_step", "secant_predictor",
-                             "max_update_hz", "force_tolerance", "force_floor_n", "start_continuation"});
+  rd.CheckKeys(s, "solver", SceneKeyNames(kSceneSolver));
   if (s["start_continuation"]) ReadStartContinuation(s["start_continuation"], model, rd, sc);
   sc->max_update_hz = rd.Number(s, "max_update_hz", "solver.max_update_hz", 0.0);
   if (!(sc->max_update_hz >= 0.0 && sc->max_update_hz <= 100000.0))
@@ -390,8 +389,7 @@ void ReadSolver(const YAML::Node& s, const ModelRegistration& model, const Reade
 
 // The scene's device: block (the map between the model and the haptic device).
 void ReadDevice(const YAML::Node& d, const Reader& rd, DeviceMapping* device) {
-  rd.CheckKeys(d, "device", {"model_units_per_metre", "newtons_per_model_force", "max_force_n",
-                             "max_stiffness_n_per_m", "workspace_radius_m", "model_origin"});
+  rd.CheckKeys(d, "device", SceneKeyNames(kSceneDevice));
   DeviceMapping& dm = *device;
   dm.model_units_per_metre = rd.Positive(d, "model_units_per_metre", "device.model_units_per_metre", dm.model_units_per_metre);
   dm.newtons_per_model_force =
@@ -435,7 +433,7 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
   }
   if (!root || !root.IsMap()) throw SceneError(file_label + ": expected a YAML mapping at the top level");
   ApplyOverrides(root, overrides, rd);
-  rd.CheckKeys(root, "", {"name", "description", "model", "params", "grasp", "grasps", "solver", "device", "targets"});
+  rd.CheckKeys(root, "", SceneKeyNames(kSceneTop));
 
   Scene sc;
   sc.file = file_label;
@@ -475,9 +473,9 @@ Scene ParseScene(const std::string& yaml_text, const std::string& file_label,
   if (root["device"]) ReadDevice(root["device"], rd, &sc.device);
   if (root["targets"]) {
     const YAML::Node t = root["targets"];
-    rd.CheckKeys(t, "targets", {"force_error", "rate_hz"});
-    sc.target_force_error = rd.Positive(t, "force_error", "targets.force_error", 0.01);
-    sc.target_rate_hz = rd.Positive(t, "rate_hz", "targets.rate_hz", 1000.0);
+    rd.CheckKeys(t, "targets", SceneKeyNames(kSceneTargets));
+    sc.target_force_error = rd.Positive(t, "force_error", "targets.force_error", kDefaultTargetForceError);
+    sc.target_rate_hz = rd.Positive(t, "rate_hz", "targets.rate_hz", kDefaultTargetRateHz);
   }
   return sc;
 }

@@ -25,7 +25,7 @@ struct DeviceMapping {
   std::array<double, 3> model_origin = {0.0, 0.0, 0.0};
 };
 
-// One grasp of a scene (issue 15): a scene with `grasps:` names several, each holding a
+// One grasp of a scene: a scene with `grasps:` names several, each holding a
 // part of the model (the model's grasp sites, models/registry.h) and taking
 // grasp_layout.NumControls() controls of u, in the order listed. A scene with the single
 // `grasp:` has one, named "" (the only grasp, as devices and messages call it).
@@ -52,8 +52,8 @@ struct Scene {
   // backends and the tests.
   std::vector<Vec> path;
   SolverOptions solver;
-  // solver.max_update_hz: the server's cap on equilibrium updates per second (issue 17;
-  // 0 = none). The server's --max-update-hz overrides it.
+  // solver.max_update_hz: the server's cap on equilibrium updates per second
+  // (0 = none). The server's --max-update-hz overrides it.
   double max_update_hz = 0.0;
   // solver.start_continuation: number parameters of the model (e.g. the rod's
   // natural_curvature) that the start solve continues from 0 to their value here when

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "app/exit_codes.h"
 #include "messages/pose_mapping.h"
 #include "grasp_publisher.h"
 #include "hud_layout.h"
@@ -187,7 +188,7 @@ TEST(ViewerScreenshotTest, TimesOutWithAClearMessageWhenNothingArrives) {
   const SessionKeyFile key_file;
   const ViewerRun run = RunViewerScreenshot(session, dir, 1, 1.5);
   ASSERT_TRUE(run.result.exited) << run.result.err;
-  EXPECT_EQ(run.result.exit_code, 2);
+  EXPECT_EQ(run.result.exit_code, app::kExitTimeout);
   EXPECT_NE(run.result.err.find("timeout"), std::string::npos) << run.result.err;
   EXPECT_NE(run.result.err.find(session + "_SHAPE"), std::string::npos) << run.result.err;
 }

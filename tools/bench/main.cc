@@ -18,6 +18,7 @@
 #include "bench.h"
 #include "flood.h"
 #include "path.h"
+#include "progress.h"
 #include "solvers/registry.h"
 #include "tool_main.h"
 
@@ -25,6 +26,12 @@ namespace fs = std::filesystem;
 using namespace snapthread;
 
 namespace {
+
+// Each benchmark's progress lines, on a terminal only (docs/cli.md).
+const Progress& BenchProgress() {
+  static const Progress progress("snapthread-bench");
+  return progress;
+}
 
 std::vector<int> ParseBudgets(const std::string& s) {
   return ParseList<int>(s, "--budgets", "is not an iteration budget (integer >= 1, or inf)",
@@ -146,7 +153,7 @@ int RunAdvise(const BenchFlags& f, const std::string& machine) {
   o.reference_n = f.reference_n;
   o.target_force_error = f.target_force_error;
   o.target_rate_hz = f.target_rate_hz;
-  const Advice a = Advise(scene, o, &std::cerr);
+  const Advice a = Advise(scene, o, BenchProgress().Stream());
   std::cout << "advise " << f.advise << " (" << machine << ")\n";
   PrintAdvice(a, std::cout);
   return a.found ? 0 : 3;
@@ -176,7 +183,7 @@ void RunAccuracyChart(const BenchFlags& f, BenchOutput* out) {
   AccuracyOptions o;
   ApplyGridFlags(f, 3, &o);
   if (!f.sweeps_text.empty()) o.sweeps = SplitList(f.sweeps_text);
-  const auto rows = RunAccuracyBench(f.scenes_dir, o, &std::cerr);
+  const auto rows = RunAccuracyBench(f.scenes_dir, o, BenchProgress().Stream());
   std::ofstream csv(fs::path(f.out_dir) / "accuracy.csv");
   WriteAccuracyCsv(rows, csv);
   std::ostringstream table;
@@ -221,7 +228,7 @@ void RunScalingChart(const BenchFlags& f, BenchOutput* out) {
   if (!f.backends_text.empty()) o.backends = SplitList(f.backends_text);
   if (f.repetitions > 0) o.repetitions = f.repetitions;
   o.fixed_length = f.fixed_length;
-  const auto rows = RunScalingBench(f.scenes_dir, o, &std::cerr);
+  const auto rows = RunScalingBench(f.scenes_dir, o, BenchProgress().Stream());
   const auto fits = FitScaling(rows);
   std::ofstream csv(fs::path(f.out_dir) / "scaling.csv");
   WriteScalingCsv(rows, csv);
@@ -247,7 +254,7 @@ void RunPathChart(const BenchFlags& f, BenchOutput* out) {
   if (!f.path_ns_text.empty()) o.ns = ParseCounts(f.path_ns_text, "--path-ns");
   if (f.path_steps > 0) o.steps = f.path_steps;
   if (f.no_ceres) o.ceres = false;
-  const auto rows = RunPathBench(f.scenes_dir, o, &std::cerr);
+  const auto rows = RunPathBench(f.scenes_dir, o, BenchProgress().Stream());
   std::ostringstream table;
   table << "== path: thread3d (n - 0.5, 0.5, 0) -> (n - 0.5, 0.8, 0.2), " << o.steps << " steps, " << o.method
         << "/" << o.backend << ", cutoff " << o.cutoff
@@ -285,7 +292,7 @@ void RunServiceChart(const BenchFlags& f, BenchOutput* out) {
   ApplySessionFlags(f, "service", &o);
   if (f.quick) o.scenes = {"curve2d_snap"};
   if (!f.service_scenes.empty()) o.scenes = SplitList(f.service_scenes);
-  const auto runs = RunServiceBench(o, &std::cerr);
+  const auto runs = RunServiceBench(o, BenchProgress().Stream());
   std::ofstream csv(fs::path(f.out_dir) / "service.csv");
   WriteServiceCsv(runs, csv);
   std::ostringstream table;
@@ -304,7 +311,7 @@ void RunFloodChart(const BenchFlags& f, BenchOutput* out) {
   o.scene = f.flood_scene;
   o.rate_per_channel_hz = f.flood_rate;
   o.realtime = f.flood_rt;
-  const auto runs = RunFloodBench(o, &std::cerr);
+  const auto runs = RunFloodBench(o, BenchProgress().Stream());
   std::ofstream csv(fs::path(f.out_dir) / "flood.csv");
   WriteFloodCsv(runs, csv);
   std::ostringstream table;
@@ -330,12 +337,18 @@ int RunCharts(const BenchFlags& f, const std::string& machine) {
   out.out_abs = fs::absolute(f.out_dir).string();
   out.summary.open(fs::path(f.out_dir) / "summary.txt");
   out.summary << "snapthread-bench " << (f.quick ? "--quick " : "") << "on " << machine << "\n\n";
-  if (want("accuracy")) RunAccuracyChart(f, &out);
-  if (want("rod")) RunRodChart(f, &out);
-  if (want("scaling")) RunScalingChart(f, &out);
-  if (want("path")) RunPathChart(f, &out);
-  if (want("service")) RunServiceChart(f, &out);
-  if (want("flood")) RunFloodChart(f, &out);
+  using Chart = void (*)(const BenchFlags&, BenchOutput*);
+  const std::pair<const char*, Chart> kOrder[] = {{"accuracy", RunAccuracyChart}, {"rod", RunRodChart},
+                                                   {"scaling", RunScalingChart},   {"path", RunPathChart},
+                                                   {"service", RunServiceChart},   {"flood", RunFloodChart}};
+  const int total_charts = static_cast<int>(std::count_if(std::begin(kOrder), std::end(kOrder),
+                                                          [&](const auto& c) { return want(c.first); }));
+  int done = 0;
+  for (const auto& [name, run] : kOrder) {
+    if (!want(name)) continue;
+    BenchProgress().Step(++done, total_charts, name);
+    run(f, &out);
+  }
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   out.summary << "total " << total << " s\n";
   std::cerr << "snapthread-bench: done in " << total << " s; results in " << f.out_dir << '\n';

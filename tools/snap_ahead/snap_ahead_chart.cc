@@ -1,6 +1,6 @@
 // snapthread-snap-ahead-chart: the snap position error (in servo ticks of travel) against
-// the server's update rate, with and without snap-ahead, for the given scenes (issue 17,
-// docs/snap-ahead.md). One CSV row per scene, rate, mode and snap; the sessions run on a
+// the server's update rate, with and without snap-ahead, for the given scenes
+// (docs/snap-ahead.md). One CSV row per scene, rate, mode and snap; the sessions run on a
 // fake clock (snap_session.h), so the numbers do not depend on the machine's load.
 #include <cmath>
 #include <cstdio>
@@ -56,7 +56,7 @@ void WriteTrace(const std::string& prefix, const std::string& scene, double rate
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"snapthread-snap-ahead-chart: snap position error vs server rate (issue 17)"};
+  CLI::App app{"snapthread-snap-ahead-chart: snap position error vs server rate"};
   std::vector<std::string> scenes;
   std::vector<double> rates = {1000.0, 300.0, 100.0, 30.0};
   std::string out_path;
@@ -70,12 +70,16 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}));
   app.add_option("--trace", trace_prefix,
                  "also write each session's ticks to PREFIX_<scene>_<rate>_<snap-ahead 1/0>.csv");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // --help exits 0, bad arguments 2 (docs/cli.md)
+  }
   spdlog::set_level(spdlog::level::from_str(log_level));
   std::FILE* out = std::fopen(out_path.c_str(), "w");
   if (out == nullptr) {
     std::fprintf(stderr, "snapthread-snap-ahead-chart: --out: cannot write %s\n", out_path.c_str());
-    return 2;
+    return 1;
   }
   std::fprintf(out, "scene,rate_hz,snap_ahead,snap,fold_s,error_ticks,jump_n,jump_nm,jumps,folds\n");
   for (const std::string& file : scenes) {

@@ -1,4 +1,4 @@
-// A whole snap-ahead session in one process on a fake clock (issue 17): the real
+// A whole snap-ahead session in one process on a fake clock: the real
 // DeviceClient (servo tick, safety, SnapAhead) on the sim-path backend, and a server made
 // of the server's own parts (MakeTracker, pose mapping, BuildForceModel, FoldBoundary)
 // that solves the newest pose at most `server_hz` times a second. Deterministic: the
