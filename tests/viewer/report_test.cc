@@ -146,6 +146,10 @@ TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
                          "device_seq_regressions 1"),
             std::string::npos) << summary;
   EXPECT_NE(summary.find("snaps: 1 "), std::string::npos) << summary;
+  // The certified force error of the models (1e-6 N x seq, for the scene's only grasp).
+  EXPECT_NE(summary.find("force_error_n (certified) grasp -: p50 "), std::string::npos) << summary;
+  EXPECT_NE(Line(summary, "force_error_n (certified) grasp -: ").find(" max 0.0002 N; none on 0 of 197 models"),
+            std::string::npos) << summary;
   EXPECT_NE(summary.find("shapes count 1"), std::string::npos) << summary;
   EXPECT_NE(summary.find("clamps: force 4 "), std::string::npos) << summary;
   EXPECT_NE(summary.find("methods: newton, higher-order"), std::string::npos) << summary;
@@ -169,7 +173,8 @@ TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
   ASSERT_EQ(knot_rows.size(), 21u);
   EXPECT_EQ(knot_rows[0], "t_s,knot,knot_determinant,contacts");
   EXPECT_EQ(knot_rows[20], "0.19902,trefoil,3,4");
-  for (const char* png : {"force.png", "solver.png", "device.png", "latency_hist.png", "knot.png"}) {
+  for (const char* png :
+       {"force.png", "force_error.png", "solver.png", "device.png", "latency_hist.png", "knot.png"}) {
     SCOPED_TRACE(png);
     ExpectNonTrivialPng(dir + "/out/" + png);
   }

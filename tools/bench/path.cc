@@ -177,6 +177,7 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
     auto tracker = MakeTracker(scene);
     tracker->Reset(controls[0]);
     std::vector<Vec> states{tracker->state()}, forces{tracker->last().force};
+    std::vector<double> estimates{tracker->last().summary.force_error};
     std::vector<double> us;
     long iterations = 0;
     for (size_t i = 1; i < controls.size(); ++i) {
@@ -187,6 +188,7 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
       row.snaps += r.snapped ? 1 : 0;
       states.push_back(tracker->state());
       forces.push_back(r.force);
+      estimates.push_back(r.summary.force_error);
     }
     row.update_us = Summarize(us);
     row.iterations_per_update = us.empty() ? 0.0 : static_cast<double>(iterations) / us.size();
@@ -233,6 +235,16 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
                 << "; E, E_x, E_xx into the band " << row.assembly_us.median << " us, its factorisation "
                 << row.factor_us.median << " us, a solve " << row.solve_us.median << " us)\n"
                 << std::defaultfloat << std::flush;
+    if (o.accuracy) {
+      row.accuracy = MeasurePathAccuracy(scene, controls, forces, estimates, o);
+      const PathAccuracy& a = row.accuracy;
+      if (progress)
+        *progress << "bench path: n=" << n << " accuracy against the cutoff-" << o.reference_cutoff
+                  << " reference (" << a.reference_s << " s, " << a.reference_not_converged
+                  << " rows not converged): force error max " << a.error_max << ", median " << a.error_median
+                  << "; certified max " << a.estimate_max << ", median " << a.estimate_median << "; coverage "
+                  << 100.0 * a.coverage << " %, median estimate/true " << a.ratio_median << '\n' << std::flush;
+    }
     if (!o.ceres) {
       row.ceres.note = "not run (--no-ceres)";
     } else if (!CeresBuilt()) {
@@ -250,7 +262,9 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
          "floor_us_median,lapack_us_median,backend_us_median,floor_ratio,ceres_us_median,ceres_iterations_per_update,"
          "ceres_force_error_max,ceres_state_distance_max,ceres_rows_other_equilibrium,ceres_rows_saddle,"
          "ceres_rows_not_converged,ceres_start_on_saddle,assembly_us_median,factor_us_median,solve_us_median,"
-         "ceres_equal_us_median,project_force_error_max,project_force_error_median\n";
+         "ceres_equal_us_median,project_force_error_max,project_force_error_median,force_error_max,"
+         "force_error_median,estimate_max,estimate_median,coverage,estimate_ratio_median,rows_over_target,"
+         "reference_not_converged\n";
   out << std::setprecision(6);
   for (const auto& r : rows) {
     const auto& c = r.ceres;
@@ -262,11 +276,14 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
         << c.rows_not_converged << ',' << (c.start_on_saddle ? 1 : 0) << ',' << r.assembly_us.median << ','
         << r.factor_us.median << ',' << r.solve_us.median << ','
         << (r.ceres_equal >= 0 ? r.ceres_ladder[r.ceres_equal].update_us.median : 0.0) << ','
-        << r.project_force_error_max << ',' << r.project_force_error_median << '\n';
+        << r.project_force_error_max << ',' << r.project_force_error_median << ',' << r.accuracy.error_max << ','
+        << r.accuracy.error_median << ',' << r.accuracy.estimate_max << ',' << r.accuracy.estimate_median << ','
+        << r.accuracy.coverage << ',' << r.accuracy.ratio_median << ',' << r.accuracy.rows_over_target << ','
+        << r.accuracy.reference_not_converged << '\n';
   }
 }
 
-void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out) {
+void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out, double force_target) {
   char buf[320];
   std::snprintf(buf, sizeof buf, "%6s %8s %4s %11s %8s %10s %10s %10s %8s\n", "n", "unknowns", "b", "us/update",
                 "it/upd", "floor us", "LAPACK us", "banded us", "upd/flr");
@@ -278,33 +295,7 @@ void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out) {
                   r.FloorRatio());
     out << buf;
   }
-  auto find = [&](int n) -> const PathRow* {
-    for (const auto& r : rows)
-      if (r.n == n) return &r;
-    return nullptr;
-  };
-  const PathRow* r10 = find(10);
-  const PathRow* r100 = find(100);
-  const PathRow* r1000 = find(1000);
-  out << "issue-13 targets (medians of this run):\n";
-  if (r10) {
-    std::snprintf(buf, sizeof buf, "  n = 10: %.2f us per update (target <= 5) -> %s\n", r10->update_us.median,
-                  r10->update_us.median <= 5.0 ? "met" : "NOT met");
-    out << buf;
-  }
-  if (r1000) {
-    std::snprintf(buf, sizeof buf,
-                  "  n = 1000: update / plain banded LDL^T floor = %.2f (target <= 1.5) -> %s; / LAPACK floor = %s\n",
-                  r1000->FloorRatio(), r1000->FloorRatio() <= 1.5 ? "met" : "NOT met",
-                  r1000->lapack_us.count > 0 ? Sci(r1000->update_us.median / r1000->lapack_us.median, 3).c_str() : "-");
-    out << buf;
-  }
-  if (r100 && r1000 && r100->update_us.median > 0) {
-    const double exponent = std::log10(r1000->update_us.median / r100->update_us.median);
-    std::snprintf(buf, sizeof buf, "  growth exponent n = 100 -> 1000: %.3f (target <= 1.02) -> %s\n", exponent,
-                  exponent <= 1.02 ? "met" : "NOT met");
-    out << buf;
-  }
+  PrintPathTargets(rows, force_target, out);
   bool any_ceres = false;
   for (const auto& r : rows) any_ceres = any_ceres || r.ceres.ran;
   if (!any_ceres) {
