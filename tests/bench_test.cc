@@ -412,6 +412,11 @@ TEST(BenchPath, AccuracyComparesEveryRowWithTheReference) {
   EXPECT_DOUBLE_EQ(a.coverage, 0.75);          // rows 1, 2, 4 covered; row 3 has none
   EXPECT_NEAR(a.ratio_median, 3.0, 1e-9);      // 4 and 2 (row 4: both 0, no ratio)
   EXPECT_EQ(a.rows_over_target, 1);
+  // With the reference's own certified errors, rows whose difference is within them are
+  // not resolved: row 4 (0 <= anything) and row 1 (1e-3 <= 3e-3 / 2).
+  const PathAccuracy b = CompareWithReference(forces, estimates, reference, 2.0, 1.5e-3, {0.0, 3e-3, 0.0, 0.0, 0.0});
+  EXPECT_EQ(b.rows_resolved, 2);
+  EXPECT_DOUBLE_EQ(b.coverage_resolved, 0.5);  // row 2 covered, row 3 has no estimate
 }
 
 // On a short n = 10 path at the default settings, the reference (cutoff 1e-11, no force

@@ -243,7 +243,9 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
                   << " reference (" << a.reference_s << " s, " << a.reference_not_converged
                   << " rows not converged): force error max " << a.error_max << ", median " << a.error_median
                   << "; certified max " << a.estimate_max << ", median " << a.estimate_median << "; coverage "
-                  << 100.0 * a.coverage << " %, median estimate/true " << a.ratio_median << '\n' << std::flush;
+                  << 100.0 * a.coverage << " % (" << 100.0 * a.coverage_resolved << " % of the " << a.rows_resolved
+                  << " rows resolved by the reference), median estimate/true " << a.ratio_median << '\n'
+                  << std::flush;
     }
     if (!o.ceres) {
       row.ceres.note = "not run (--no-ceres)";
@@ -264,7 +266,7 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
          "ceres_rows_not_converged,ceres_start_on_saddle,assembly_us_median,factor_us_median,solve_us_median,"
          "ceres_equal_us_median,project_force_error_max,project_force_error_median,force_error_max,"
          "force_error_median,estimate_max,estimate_median,coverage,estimate_ratio_median,rows_over_target,"
-         "reference_not_converged\n";
+         "reference_not_converged,coverage_resolved,rows_resolved\n";
   out << std::setprecision(6);
   for (const auto& r : rows) {
     const auto& c = r.ceres;
@@ -279,7 +281,8 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
         << r.project_force_error_max << ',' << r.project_force_error_median << ',' << r.accuracy.error_max << ','
         << r.accuracy.error_median << ',' << r.accuracy.estimate_max << ',' << r.accuracy.estimate_median << ','
         << r.accuracy.coverage << ',' << r.accuracy.ratio_median << ',' << r.accuracy.rows_over_target << ','
-        << r.accuracy.reference_not_converged << '\n';
+        << r.accuracy.reference_not_converged << ',' << r.accuracy.coverage_resolved << ','
+        << r.accuracy.rows_resolved << '\n';
   }
 }
 

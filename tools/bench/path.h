@@ -53,13 +53,19 @@ struct PathAccuracy {
   double estimate_max = 0.0, estimate_median = 0.0;  // certified (SolverSummary::force_error) / ForceScale
   int rows_without_estimate = 0;       // force_error -1 (counted as not covering)
   double coverage = 0.0;               // fraction of rows with estimate >= true error
+  // The same over the rows whose true error exceeds the reference's own certified error
+  // (elsewhere the difference is the reference's round-off, not the row's error); -1: none.
+  double coverage_resolved = -1.0;
+  int rows_resolved = 0;
   double ratio_median = 0.0;           // median estimate / true over rows with both > 0
   int rows_over_target = 0;            // true error > PathOptions::force_target
 };
 // The statistics of PathAccuracy from the per-row forces, certified estimates (model
 // units, -1 = none) and reference forces (rows 1..end; row 0, the reset, is left out).
+// reference_estimates: the reference rows' certified errors (model units; empty: unknown).
 PathAccuracy CompareWithReference(const std::vector<Vec>& forces, const std::vector<double>& estimates,
-                                  const std::vector<Vec>& reference_forces, double force_scale, double force_target);
+                                  const std::vector<Vec>& reference_forces, double force_scale, double force_target,
+                                  const std::vector<double>& reference_estimates = {});
 // Runs the reference sweep of `scene` along `controls` and compares (CompareWithReference).
 PathAccuracy MeasurePathAccuracy(const Scene& scene, const std::vector<Vec>& controls, const std::vector<Vec>& forces,
                                  const std::vector<double>& estimates, const PathOptions& options);
