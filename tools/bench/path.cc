@@ -96,6 +96,7 @@ Scene Thread3dPathScene(const Scene& base, int n, const PathOptions& o) {
   s.solver.method = o.method;
   s.solver.linear_solver = o.backend;
   s.solver.cutoff = o.cutoff;
+  if (o.force_tolerance >= 0.0) s.solver.force_tolerance = o.force_tolerance;
   return s;
 }
 
@@ -165,6 +166,48 @@ CeresPathResult RunCeresPath(const Scene&, const std::vector<Vec>&, const std::v
 }
 #endif
 
+// The floor (plain banded LDL^T, LAPACK, the project's backend) on the Hessian at the
+// tracker's last equilibrium, and the update's pieces at that state, into *row.
+void TimeFloorAndPieces(const EquilibriumTracker& tracker, const PathOptions& o, PathRow* out) {
+  PathRow& row = *out;
+  const Model& model = tracker.model();
+  SparseMatrix h = model.HessianPattern();
+  model.Hessian(tracker.state(), tracker.control(), &h);
+  row.unknowns = model.NumStates();
+  row.bandwidth = model.HessianBandwidth();
+  row.floor_us = TimePlainBandedFloor(h, row.bandwidth, o.floor_samples);
+  row.lapack_us = TimeLapackFloor(h, row.bandwidth, o.floor_samples);
+  {
+    std::string error;
+    auto backend = MakeLinearSolver("banded", row.unknowns, row.bandwidth, &error);
+    backend->Analyze(h);
+    Vec rhs = Vec::Ones(row.unknowns), x(row.unknowns);
+    row.backend_us = TimeSamples(o.floor_samples, [&] {
+      backend->Factorize(h);
+      backend->Solve(rhs, &x);
+    });
+    // The update's pieces, at the same state.
+    int b = -1;
+    double* band = backend->AssemblyBand(&b);
+    Vec g(row.unknowns);
+    double e = 0.0;
+    const BandAssemblyCapability* assembly = model.band_assembly();
+    if (band != nullptr && assembly != nullptr &&
+        assembly->EnergyGradientAndBandHessian(tracker.state(), tracker.control(), &g, band, b, &e)) {
+      row.assembly_us = TimeSamples(o.floor_samples, [&] {
+        assembly->EnergyGradientAndBandHessian(tracker.state(), tracker.control(), &g, band, b, &e);
+      });
+      row.factor_us = TimeSamples(o.floor_samples, [&] {
+        assembly->EnergyGradientAndBandHessian(tracker.state(), tracker.control(), &g, band, b, &e);
+        backend->FactorizeAssembled();
+      });
+      // FactorizeAssembled() alone: the pair less the assembly.
+      row.factor_us.median = std::max(0.0, row.factor_us.median - row.assembly_us.median);
+      row.solve_us = TimeSamples(o.floor_samples, [&] { backend->Solve(rhs, &x); });
+    }
+  }
+}
+
 std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptions& o, std::ostream* progress) {
   const Scene base = LoadScene(scenes_dir + "/thread3d_loop.yaml");
   std::vector<PathRow> rows;
@@ -192,61 +235,14 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
     }
     row.update_us = Summarize(us);
     row.iterations_per_update = us.empty() ? 0.0 : static_cast<double>(iterations) / us.size();
-    // The floor on the Hessian at the path's last equilibrium.
-    const Model& model = tracker->model();
-    SparseMatrix h = model.HessianPattern();
-    model.Hessian(tracker->state(), tracker->control(), &h);
-    row.unknowns = model.NumStates();
-    row.bandwidth = model.HessianBandwidth();
-    row.floor_us = TimePlainBandedFloor(h, row.bandwidth, o.floor_samples);
-    row.lapack_us = TimeLapackFloor(h, row.bandwidth, o.floor_samples);
-    {
-      std::string error;
-      auto backend = MakeLinearSolver("banded", row.unknowns, row.bandwidth, &error);
-      backend->Analyze(h);
-      Vec rhs = Vec::Ones(row.unknowns), x(row.unknowns);
-      row.backend_us = TimeSamples(o.floor_samples, [&] {
-        backend->Factorize(h);
-        backend->Solve(rhs, &x);
-      });
-      // The update's pieces, at the same state.
-      int b = -1;
-      double* band = backend->AssemblyBand(&b);
-      Vec g(row.unknowns);
-      double e = 0.0;
-      const BandAssemblyCapability* assembly = model.band_assembly();
-      if (band != nullptr && assembly != nullptr &&
-          assembly->EnergyGradientAndBandHessian(tracker->state(), tracker->control(), &g, band, b, &e)) {
-        row.assembly_us = TimeSamples(o.floor_samples, [&] {
-          assembly->EnergyGradientAndBandHessian(tracker->state(), tracker->control(), &g, band, b, &e);
-        });
-        row.factor_us = TimeSamples(o.floor_samples, [&] {
-          assembly->EnergyGradientAndBandHessian(tracker->state(), tracker->control(), &g, band, b, &e);
-          backend->FactorizeAssembled();
-        });
-        // FactorizeAssembled() alone: the pair less the assembly.
-        row.factor_us.median = std::max(0.0, row.factor_us.median - row.assembly_us.median);
-        row.solve_us = TimeSamples(o.floor_samples, [&] { backend->Solve(rhs, &x); });
-      }
-    }
+    TimeFloorAndPieces(*tracker, o, &row);
     if (progress)
       *progress << "bench path: n=" << n << ": " << std::fixed << std::setprecision(2) << row.update_us.median
                 << " us/update (floor " << row.floor_us.median << " us, ratio " << row.FloorRatio()
                 << "; E, E_x, E_xx into the band " << row.assembly_us.median << " us, its factorisation "
                 << row.factor_us.median << " us, a solve " << row.solve_us.median << " us)\n"
                 << std::defaultfloat << std::flush;
-    if (o.accuracy) {
-      row.accuracy = MeasurePathAccuracy(scene, controls, forces, estimates, o);
-      const PathAccuracy& a = row.accuracy;
-      if (progress)
-        *progress << "bench path: n=" << n << " accuracy against the cutoff-" << o.reference_cutoff
-                  << " reference (" << a.reference_s << " s, " << a.reference_not_converged
-                  << " rows not converged): force error max " << a.error_max << ", median " << a.error_median
-                  << "; certified max " << a.estimate_max << ", median " << a.estimate_median << "; coverage "
-                  << 100.0 * a.coverage << " % (" << 100.0 * a.coverage_resolved << " % of the " << a.rows_resolved
-                  << " rows resolved by the reference), median estimate/true " << a.ratio_median << '\n'
-                  << std::flush;
-    }
+    if (o.accuracy) row.accuracy = MeasurePathAccuracy(scene, controls, forces, estimates, o, progress);
     if (!o.ceres) {
       row.ceres.note = "not run (--no-ceres)";
     } else if (!CeresBuilt()) {
@@ -266,7 +262,7 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
          "ceres_rows_not_converged,ceres_start_on_saddle,assembly_us_median,factor_us_median,solve_us_median,"
          "ceres_equal_us_median,project_force_error_max,project_force_error_median,force_error_max,"
          "force_error_median,estimate_max,estimate_median,coverage,estimate_ratio_median,rows_over_target,"
-         "reference_not_converged,coverage_resolved,rows_resolved\n";
+         "reference_not_converged,coverage_resolved,rows_resolved,reference_estimate_max,reference_estimate_median\n";
   out << std::setprecision(6);
   for (const auto& r : rows) {
     const auto& c = r.ceres;
@@ -282,7 +278,8 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
         << r.accuracy.error_median << ',' << r.accuracy.estimate_max << ',' << r.accuracy.estimate_median << ','
         << r.accuracy.coverage << ',' << r.accuracy.ratio_median << ',' << r.accuracy.rows_over_target << ','
         << r.accuracy.reference_not_converged << ',' << r.accuracy.coverage_resolved << ','
-        << r.accuracy.rows_resolved << '\n';
+        << r.accuracy.rows_resolved << ',' << r.accuracy.reference_estimate_max << ','
+        << r.accuracy.reference_estimate_median << '\n';
   }
 }
 

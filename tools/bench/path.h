@@ -23,6 +23,8 @@ struct PathOptions {
   std::string method = "higher-order";
   std::string backend = "auto";
   double cutoff = 1e-6;
+  // solver.force_tolerance of the timed run; < 0: the default (SolverOptions, 1e-4).
+  double force_tolerance = -1.0;
   bool ceres = true;
   int floor_samples = 301;  // timed factor + solve pairs per floor
   // Equal force accuracy (issue 13's "10x faster than Ceres at equal force accuracy"):
@@ -59,6 +61,8 @@ struct PathAccuracy {
   int rows_resolved = 0;
   double ratio_median = 0.0;           // median estimate / true over rows with both > 0
   int rows_over_target = 0;            // true error > PathOptions::force_target
+  // The reference's own certified error / ForceScale over rows 1..steps: how exact the truth is.
+  double reference_estimate_max = 0.0, reference_estimate_median = 0.0;
 };
 // The statistics of PathAccuracy from the per-row forces, certified estimates (model
 // units, -1 = none) and reference forces (rows 1..end; row 0, the reset, is left out).
@@ -66,9 +70,11 @@ struct PathAccuracy {
 PathAccuracy CompareWithReference(const std::vector<Vec>& forces, const std::vector<double>& estimates,
                                   const std::vector<Vec>& reference_forces, double force_scale, double force_target,
                                   const std::vector<double>& reference_estimates = {});
-// Runs the reference sweep of `scene` along `controls` and compares (CompareWithReference).
+// Runs the reference sweep of `scene` along `controls` and compares (CompareWithReference);
+// one line of progress when `progress` is set.
 PathAccuracy MeasurePathAccuracy(const Scene& scene, const std::vector<Vec>& controls, const std::vector<Vec>& forces,
-                                 const std::vector<double>& estimates, const PathOptions& options);
+                                 const std::vector<double>& estimates, const PathOptions& options,
+                                 std::ostream* progress = nullptr);
 
 // One Ceres run: a trust-region strategy and linear solver (CeresSolverNames) and the
 // ||E_x||_2 cutoff that stops each row.
