@@ -394,6 +394,58 @@ TEST(BenchPath, PlainBandedFloorSolvesTheThreadHessian) {
   EXPECT_LT((h * solution - rhs).norm() / rhs.norm(), 1e-9);
 }
 
+// The accuracy columns: coverage counts rows whose estimate is at least the true error
+// (a row without an estimate, -1, never covers), row 0 (the reset) is left out, and the
+// errors are relative to the force scale.
+TEST(BenchPath, AccuracyComparesEveryRowWithTheReference) {
+  auto f = [](double v) { return Vec::Constant(3, v); };
+  const std::vector<Vec> reference = {f(0.0), f(1.0), f(1.0), f(1.0), f(1.0)};
+  const std::vector<Vec> forces = {f(9.0), f(1.0 + 2e-3), f(1.0 - 4e-3), f(1.0 + 1e-3), f(1.0)};
+  const std::vector<double> estimates = {0.0, 8e-3, 8e-3, -1.0, 0.0};
+  const PathAccuracy a = CompareWithReference(forces, estimates, reference, 2.0, 1.5e-3);
+  ASSERT_TRUE(a.ran);
+  EXPECT_EQ(a.rows, 4);
+  EXPECT_NEAR(a.error_max, 2e-3, 1e-15);       // row 2: 4e-3 / 2 (row 0's 9 is the reset)
+  EXPECT_NEAR(a.error_median, 7.5e-4, 1e-15);  // of 1e-3, 2e-3, 5e-4, 0
+  EXPECT_NEAR(a.estimate_max, 4e-3, 1e-15);
+  EXPECT_EQ(a.rows_without_estimate, 1);
+  EXPECT_DOUBLE_EQ(a.coverage, 0.75);          // rows 1, 2, 4 covered; row 3 has none
+  EXPECT_NEAR(a.ratio_median, 3.0, 1e-9);      // 4 and 2 (row 4: both 0, no ratio)
+  EXPECT_EQ(a.rows_over_target, 1);
+  // With the reference's own certified errors, rows whose difference is within them are
+  // not resolved: row 4 (0 <= anything) and row 1 (1e-3 <= 3e-3 / 2).
+  const PathAccuracy b = CompareWithReference(forces, estimates, reference, 2.0, 1.5e-3, {0.0, 3e-3, 0.0, 0.0, 0.0});
+  EXPECT_EQ(b.rows_resolved, 2);
+  EXPECT_DOUBLE_EQ(b.coverage_resolved, 0.5);  // row 2 covered, row 3 has no estimate
+}
+
+// On a short n = 10 path at the default settings, the reference (cutoff 1e-11, no force
+// tolerance, no iteration limit) ends converged on every row, every row's force is within
+// the target, and the certified estimate covers it.
+TEST(BenchPath, DefaultSettingsMeetTheAccuracyTargetOnAShortPath) {
+  const Scene base = LoadScene(std::string(SNAPTHREAD_TEST_SOURCE_DIR) + "/scenes/thread3d_loop.yaml");
+  const PathOptions o;
+  const Scene scene = Thread3dPathScene(base, 10, o);
+  const std::vector<Vec> controls = Thread3dPathControls(scene, 40);
+  auto tracker = MakeTracker(scene);
+  tracker->Reset(controls[0]);
+  std::vector<Vec> forces{tracker->last().force};
+  std::vector<double> estimates{tracker->last().summary.force_error};
+  for (size_t i = 1; i < controls.size(); ++i) {
+    const TrackResult& r = tracker->Update(controls[i]);
+    forces.push_back(r.force);
+    estimates.push_back(r.summary.force_error);
+  }
+  const PathAccuracy a = MeasurePathAccuracy(scene, controls, forces, estimates, o);
+  ASSERT_TRUE(a.ran);
+  EXPECT_EQ(a.rows, 40);
+  EXPECT_EQ(a.reference_not_converged, 0);
+  EXPECT_EQ(a.rows_over_target, 0) << a.error_max;
+  EXPECT_EQ(a.rows_without_estimate, 0);
+  EXPECT_GE(a.coverage, 0.95) << a.coverage;
+  EXPECT_GT(a.estimate_median, 0.0);
+}
+
 #ifdef SNAPTHREAD_HAVE_CERES
 // Ceres' residuals carry the same energy as the model: 1/2 sum r^2 + shift = E(x, u)
 // to round-off, at straight, bent and random states (and with a reference bend B).

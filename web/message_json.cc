@@ -75,6 +75,8 @@ std::string ForceModelJson(const force_model_t& m) {
   w.Int("device_utime", m.device_utime).Int("server_receive_utime", m.server_receive_utime);
   w.Int("status", m.status).Int("solve_us", m.solve_us).Int("iterations", m.iterations);
   w.Number("residual", m.residual);
+  // The certified force error of f0 in newtons; -1: none could be made (the page shows "none").
+  w.Number("force_error_n", m.force_error_n);
   w.Number("f_n", std::sqrt(m.f0[0] * m.f0[0] + m.f0[1] * m.f0[1] + m.f0[2] * m.f0[2]));
   Vec3(&w, "f0", m.f0);
   Vec3(&w, "u0", m.u0);

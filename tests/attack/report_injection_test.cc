@@ -44,7 +44,7 @@ namespace fs = std::filesystem;
 
 constexpr int kModels = 200;       // genuine force models
 constexpr int kHostileModels = 600;  // more than the whole genuine session (445 messages)
-const char* const kPlots[] = {"force.png", "knot.png", "solver.png", "device.png",
+const char* const kPlots[] = {"force.png", "force_error.png", "knot.png", "solver.png", "device.png",
                               "latency_hist.png"};
 
 // A port of its own, away from the shared group's traffic and the logger tests' ports.
@@ -271,7 +271,7 @@ TEST_P(ReportInjectionTest, RunsNoCommandDrawsTheGenuineSessionAndEscapesTheName
   // The genuine session is the one reviewed, with every plot.
   const std::string summary = ReadFile(dir + "/out/summary.txt");
   EXPECT_NE(summary.find("\nsession: LAB1\n"), std::string::npos) << summary;
-  EXPECT_NE(summary.find("plots: force.png knot.png solver.png device.png latency_hist.png\n"),
+  EXPECT_NE(summary.find("plots: force.png force_error.png knot.png solver.png device.png latency_hist.png\n"),
             std::string::npos) << summary;
   std::ifstream csv(dir + "/out/force.csv");
   int rows = -1;

@@ -146,6 +146,10 @@ TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
                          "device_seq_regressions 1"),
             std::string::npos) << summary;
   EXPECT_NE(summary.find("snaps: 1 "), std::string::npos) << summary;
+  // The certified force error of the models (1e-6 N x seq, for the scene's only grasp).
+  EXPECT_NE(summary.find("force_error_n (certified) grasp -: p50 "), std::string::npos) << summary;
+  EXPECT_NE(Line(summary, "force_error_n (certified) grasp -: ").find(" max 0.0002 N; none on 0 of 197 models"),
+            std::string::npos) << summary;
   EXPECT_NE(summary.find("shapes count 1"), std::string::npos) << summary;
   EXPECT_NE(summary.find("clamps: force 4 "), std::string::npos) << summary;
   EXPECT_NE(summary.find("methods: newton, higher-order"), std::string::npos) << summary;
@@ -169,10 +173,46 @@ TEST(ReportTest, SummaryCountsGapsForceSnapsAndPlots) {
   ASSERT_EQ(knot_rows.size(), 21u);
   EXPECT_EQ(knot_rows[0], "t_s,knot,knot_determinant,contacts");
   EXPECT_EQ(knot_rows[20], "0.19902,trefoil,3,4");
-  for (const char* png : {"force.png", "solver.png", "device.png", "latency_hist.png", "knot.png"}) {
+  for (const char* png :
+       {"force.png", "force_error.png", "solver.png", "device.png", "latency_hist.png", "knot.png"}) {
     SCOPED_TRACE(png);
     ExpectNonTrivialPng(dir + "/out/" + png);
   }
+}
+
+// The certified force error per grasp: a grasp whose models carry none (-1) is shown as
+// "none", in the summary and in force.csv, and its rows are not drawn.
+TEST(ReportTest, ForceErrorPerGraspShowsNoneWhereTheServerMadeNoEstimate) {
+  const std::string dir = FreshTempDir("report-force-error");
+  const std::string path = dir + "/session.lcmlog";
+  {
+    LogWriter log(path);
+    ASSERT_TRUE(log.good());
+    for (int k = 1; k <= 20; ++k) {
+      force_model_t left = Model(k), right = Model(k);
+      left.grasp = "left";
+      right.grasp = "right";
+      right.force_error_n = -1.0;
+      log.Write("RPT_FORCE_MODEL", kT0 + k * 1000, left);
+      log.Write("RPT_FORCE_MODEL", kT0 + k * 1000 + 1, right);
+    }
+  }
+  const ProcessResult r = RunReport(path, dir + "/out");
+  ASSERT_TRUE(r.exited);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string summary = ReadFile(dir + "/out/summary.txt");
+  EXPECT_NE(summary.find("force_error_n (certified) grasp left: p50 "), std::string::npos) << summary;
+  EXPECT_NE(Line(summary, "force_error_n (certified) grasp left: ").find(" max 2e-05 N; none on 0 of 20 models"),
+            std::string::npos) << summary;
+  EXPECT_NE(summary.find("force_error_n (certified) grasp right: none; none on 20 of 20 models\n"),
+            std::string::npos) << summary;
+  std::ifstream csv(dir + "/out/force.csv");
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(csv, line);) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 41u);
+  EXPECT_EQ(rows[0], "t_s,fx_n,fy_n,fz_n,f_norm_n,status,seq,grasp_index,force_error_n");
+  EXPECT_EQ(rows[2].substr(rows[2].rfind(',', rows[2].rfind(',') - 1)), ",1,none") << rows[2];
+  ExpectNonTrivialPng(dir + "/out/force_error.png");
 }
 
 // A damaged log still gives a report (exit 0), marked partial with a warning.

@@ -138,6 +138,19 @@ async function live(browser, pages) {
   }
   for (const p of opened) await p.waitFor(() => Number(document.body.dataset.shapesReceived || 0) > 10);
   await sleep(WARM_UP_S * 1000);
+  // The status panel shows the last force model's certified force error as text: wait for a
+  // value in newtons (a live solve makes one), then read what the page shows.
+  const forceErrorCell = () => {
+    for (const tr of document.querySelectorAll('#status tr')) {
+      const cells = tr.querySelectorAll('td');
+      if (cells.length === 2 && cells[0].textContent === 'force error (certified)') return cells[1].textContent;
+    }
+    return null;
+  };
+  for (const p of opened) {
+    await p.waitFor(`(${forceErrorCell.toString()})()?.endsWith(' N') === true`);
+  }
+  const forceErrorTexts = await Promise.all(opened.map(({ page }) => page.evaluate(forceErrorCell)));
   const cpuBefore = browserCpu();
   const wallBefore = Date.now();
   const before = await Promise.all(opened.map(({ page }) => counters(page)));
@@ -167,6 +180,7 @@ async function live(browser, pages) {
       shapes: after[i].shapes, frames: after[i].frames, status, screenshot: shot,
       // The page's last ping to the bridge and back: the ack window's round trip.
       round_trip_ms: after[i].round_trip_ms,
+      force_error_text: forceErrorTexts[i],
     });
   }
   return { pages: result, browser_cpu: cpu, load };

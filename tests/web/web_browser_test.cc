@@ -142,6 +142,13 @@ class WebBrowserTest : public ::testing::Test {
       // (and the browser's share of a loaded machine): a speed threshold, like theirs.
       EXPECT_GE(Field(live, "frames_per_s", at), 10.0 / test_support::SpeedScale());
       EXPECT_NE(live.find("\"webgl\":\"WebGL 2.0", at), std::string::npos) << "no WebGL 2 context";
+      // The status panel shows the force models' certified force error as text (browser_check
+      // waited until it showed one in newtons): a value in N, or "none" for a model without one.
+      std::smatch shown;
+      const std::string from_here = live.substr(at);
+      ASSERT_TRUE(std::regex_search(from_here, shown, std::regex(R"re("force_error_text":"([^"]*)")re")))
+          << "no certified force error on the page";
+      EXPECT_TRUE(std::regex_match(shown[1].str(), std::regex(R"(\d\.\d\de[-+]\d+ N|none)"))) << shown[1];
       ExpectTubeOnScreenshot(dir_.path() + "/page" + std::to_string(page) + ".png",
                              static_cast<int>(Field(live, "status", at)));
     }

@@ -57,6 +57,11 @@ TEST(MessageJson, ForceModelCarriesTheChartedValues) {
   EXPECT_NE(json.find(R"("solve_us":250)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("residual":1e-09)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("f_n":1.8708286933869707)"), std::string::npos) << json;  // |(-0.5,-1,-1.5)|
+  EXPECT_NE(json.find(R"("force_error_n":0.00025)"), std::string::npos) << json;
+  force_model_t none = test_support::Sample<force_model_t>();
+  none.force_error_n = -1.0;  // no estimate: the page shows "none"
+  const std::string without = ForceModelJson(none);
+  EXPECT_NE(without.find(R"("force_error_n":-1)"), std::string::npos) << without;
   const std::string device = DeviceStatusJson(test_support::Sample<device_status_t>());
   EXPECT_NE(device.find(R"("round_trip_us_p99":1200)"), std::string::npos) << device;
   const std::string solver = SolverStatusJson(test_support::Sample<solver_status_t>());

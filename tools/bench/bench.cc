@@ -72,7 +72,7 @@ TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int r
     const int m = tracker->model().NumControls();
     // Preallocated so the timed loop only copies a few numbers per update.
     Mat force(m, rows);
-    std::vector<double> probe(rows), residual(rows), lambda(rows), solve_us(rows), energy(rows);
+    std::vector<double> probe(rows), residual(rows), lambda(rows), solve_us(rows), energy(rows), certified(rows);
     std::vector<int> iters(rows), grads(rows), hess(rows);
     std::vector<char> snapped(rows, 0);
     std::vector<EquilibriumStatus> status(rows);
@@ -84,6 +84,7 @@ TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int r
       residual[i] = r.summary.residual;
       lambda[i] = r.summary.lambda_min;
       solve_us[i] = r.summary.solve_us;
+      certified[i] = r.summary.force_error;
       iters[i] = r.summary.iterations;
       grads[i] = r.summary.gradient_evaluations;
       hess[i] = r.summary.hessian_evaluations;
@@ -117,6 +118,7 @@ TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int r
         r.residual = residual[i];
         r.lambda_min = lambda[i];
         r.solve_us = solve_us[i];
+        r.force_error = certified[i];
         r.iterations = iters[i];
         r.gradient_evaluations = grads[i];
         r.hessian_evaluations = hess[i];

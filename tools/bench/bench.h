@@ -104,6 +104,16 @@ struct AccuracyRow {
   // snap of the trace or the reference: the accuracy of following a branch, without the
   // few rows where a snap one update early or late dominates the rms.
   double force_error_rel_rms_regular = 0.0;
+  // The solve's stopping rule: the cutoff ladder stops on ||E_x|| < cutoff alone (force
+  // tolerance 0: an explicit cutoff keeps its meaning); the default-settings point stops on
+  // the certified force error, force_tolerance of the force scale, with the scene's cutoff
+  // as a ceiling and its iteration budget.
+  double force_tolerance = 0.0;
+  bool default_settings = false;
+  // The certified force error (SweepRow::force_error, docs/accuracy.md) / force scale over
+  // the rows that carry one: rms and max; rows without one (-1) counted.
+  double certified_rel_rms = 0.0, certified_rel_max = 0.0;
+  int rows_without_estimate = 0;
   double RelativeForceErrorRms() const { return stability.force_error_rms / force_scale; }
 };
 constexpr int kSnapMargin = 2;

@@ -78,6 +78,7 @@ struct BenchFlags {
   std::vector<std::string> sets;
   bool quick = false, no_plot = false, fixed_length = false, no_ceres = false, flood_rt = false;
   int repetitions = 0, reference_n = 0, path_steps = 0;
+  double path_force_tolerance = -1.0;
   double service_duration = 0.0, target_force_error = 0.0, target_rate_hz = 0.0, flood_rate = 10000.0;
   std::string flood_scene = "curve2d_snap";
 };
@@ -100,6 +101,9 @@ void AddChartFlags(CLI::App& cli, BenchFlags& f) {
   cli.add_option("--backends", f.backends_text, "scaling: linear solvers (default auto,banded,cholmod,dense)");
   cli.add_option("--path-ns", f.path_ns_text, "path: segment counts (default 10,100,1000)");
   cli.add_flag("--no-ceres", f.no_ceres, "path: skip the Ceres run (profiling the project's update alone)");
+  cli.add_option("--path-force-tolerance", f.path_force_tolerance,
+                 "path: solver.force_tolerance of the timed run (default: the default, 1e-4; 0 = the cutoff alone)")
+      ->check(CLI::NonNegativeNumber)->check(app::FiniteNumber());
   cli.add_option("--path-steps", f.path_steps, "path: control steps per n (default 1000, quick 200)")
       ->check(CLI::Range(1, 1000000));
   cli.add_option("--service-scenes", f.service_scenes, "service: scene names (default curve2d_snap,thread3d_loop)");
@@ -254,10 +258,12 @@ void RunPathChart(const BenchFlags& f, BenchOutput* out) {
   if (!f.path_ns_text.empty()) o.ns = ParseCounts(f.path_ns_text, "--path-ns");
   if (f.path_steps > 0) o.steps = f.path_steps;
   if (f.no_ceres) o.ceres = false;
+  if (f.path_force_tolerance >= 0.0) o.force_tolerance = f.path_force_tolerance;
   const auto rows = RunPathBench(f.scenes_dir, o, BenchProgress().Stream());
   std::ostringstream table;
   table << "== path: thread3d (n - 0.5, 0.5, 0) -> (n - 0.5, 0.8, 0.2), " << o.steps << " steps, " << o.method
-        << "/" << o.backend << ", cutoff " << o.cutoff
+        << "/" << o.backend << ", cutoff " << o.cutoff << ", force tolerance "
+        << (o.force_tolerance >= 0.0 ? o.force_tolerance : SolverOptions{}.force_tolerance)
         << "; medians over the updates; floor = plain banded LDL^T factor + solve of the last row's E_xx\n";
   PrintPathTable(rows, table);
   out->Table(table);

@@ -96,6 +96,7 @@ Scene Thread3dPathScene(const Scene& base, int n, const PathOptions& o) {
   s.solver.method = o.method;
   s.solver.linear_solver = o.backend;
   s.solver.cutoff = o.cutoff;
+  if (o.force_tolerance >= 0.0) s.solver.force_tolerance = o.force_tolerance;
   return s;
 }
 
@@ -165,6 +166,48 @@ CeresPathResult RunCeresPath(const Scene&, const std::vector<Vec>&, const std::v
 }
 #endif
 
+// The floor (plain banded LDL^T, LAPACK, the project's backend) on the Hessian at the
+// tracker's last equilibrium, and the update's pieces at that state, into *row.
+void TimeFloorAndPieces(const EquilibriumTracker& tracker, const PathOptions& o, PathRow* out) {
+  PathRow& row = *out;
+  const Model& model = tracker.model();
+  SparseMatrix h = model.HessianPattern();
+  model.Hessian(tracker.state(), tracker.control(), &h);
+  row.unknowns = model.NumStates();
+  row.bandwidth = model.HessianBandwidth();
+  row.floor_us = TimePlainBandedFloor(h, row.bandwidth, o.floor_samples);
+  row.lapack_us = TimeLapackFloor(h, row.bandwidth, o.floor_samples);
+  {
+    std::string error;
+    auto backend = MakeLinearSolver("banded", row.unknowns, row.bandwidth, &error);
+    backend->Analyze(h);
+    Vec rhs = Vec::Ones(row.unknowns), x(row.unknowns);
+    row.backend_us = TimeSamples(o.floor_samples, [&] {
+      backend->Factorize(h);
+      backend->Solve(rhs, &x);
+    });
+    // The update's pieces, at the same state.
+    int b = -1;
+    double* band = backend->AssemblyBand(&b);
+    Vec g(row.unknowns);
+    double e = 0.0;
+    const BandAssemblyCapability* assembly = model.band_assembly();
+    if (band != nullptr && assembly != nullptr &&
+        assembly->EnergyGradientAndBandHessian(tracker.state(), tracker.control(), &g, band, b, &e)) {
+      row.assembly_us = TimeSamples(o.floor_samples, [&] {
+        assembly->EnergyGradientAndBandHessian(tracker.state(), tracker.control(), &g, band, b, &e);
+      });
+      row.factor_us = TimeSamples(o.floor_samples, [&] {
+        assembly->EnergyGradientAndBandHessian(tracker.state(), tracker.control(), &g, band, b, &e);
+        backend->FactorizeAssembled();
+      });
+      // FactorizeAssembled() alone: the pair less the assembly.
+      row.factor_us.median = std::max(0.0, row.factor_us.median - row.assembly_us.median);
+      row.solve_us = TimeSamples(o.floor_samples, [&] { backend->Solve(rhs, &x); });
+    }
+  }
+}
+
 std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptions& o, std::ostream* progress) {
   const Scene base = LoadScene(scenes_dir + "/thread3d_loop.yaml");
   std::vector<PathRow> rows;
@@ -177,6 +220,7 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
     auto tracker = MakeTracker(scene);
     tracker->Reset(controls[0]);
     std::vector<Vec> states{tracker->state()}, forces{tracker->last().force};
+    std::vector<double> estimates{tracker->last().summary.force_error};
     std::vector<double> us;
     long iterations = 0;
     for (size_t i = 1; i < controls.size(); ++i) {
@@ -187,52 +231,18 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
       row.snaps += r.snapped ? 1 : 0;
       states.push_back(tracker->state());
       forces.push_back(r.force);
+      estimates.push_back(r.summary.force_error);
     }
     row.update_us = Summarize(us);
     row.iterations_per_update = us.empty() ? 0.0 : static_cast<double>(iterations) / us.size();
-    // The floor on the Hessian at the path's last equilibrium.
-    const Model& model = tracker->model();
-    SparseMatrix h = model.HessianPattern();
-    model.Hessian(tracker->state(), tracker->control(), &h);
-    row.unknowns = model.NumStates();
-    row.bandwidth = model.HessianBandwidth();
-    row.floor_us = TimePlainBandedFloor(h, row.bandwidth, o.floor_samples);
-    row.lapack_us = TimeLapackFloor(h, row.bandwidth, o.floor_samples);
-    {
-      std::string error;
-      auto backend = MakeLinearSolver("banded", row.unknowns, row.bandwidth, &error);
-      backend->Analyze(h);
-      Vec rhs = Vec::Ones(row.unknowns), x(row.unknowns);
-      row.backend_us = TimeSamples(o.floor_samples, [&] {
-        backend->Factorize(h);
-        backend->Solve(rhs, &x);
-      });
-      // The update's pieces, at the same state.
-      int b = -1;
-      double* band = backend->AssemblyBand(&b);
-      Vec g(row.unknowns);
-      double e = 0.0;
-      const BandAssemblyCapability* assembly = model.band_assembly();
-      if (band != nullptr && assembly != nullptr &&
-          assembly->EnergyGradientAndBandHessian(tracker->state(), tracker->control(), &g, band, b, &e)) {
-        row.assembly_us = TimeSamples(o.floor_samples, [&] {
-          assembly->EnergyGradientAndBandHessian(tracker->state(), tracker->control(), &g, band, b, &e);
-        });
-        row.factor_us = TimeSamples(o.floor_samples, [&] {
-          assembly->EnergyGradientAndBandHessian(tracker->state(), tracker->control(), &g, band, b, &e);
-          backend->FactorizeAssembled();
-        });
-        // FactorizeAssembled() alone: the pair less the assembly.
-        row.factor_us.median = std::max(0.0, row.factor_us.median - row.assembly_us.median);
-        row.solve_us = TimeSamples(o.floor_samples, [&] { backend->Solve(rhs, &x); });
-      }
-    }
+    TimeFloorAndPieces(*tracker, o, &row);
     if (progress)
       *progress << "bench path: n=" << n << ": " << std::fixed << std::setprecision(2) << row.update_us.median
                 << " us/update (floor " << row.floor_us.median << " us, ratio " << row.FloorRatio()
                 << "; E, E_x, E_xx into the band " << row.assembly_us.median << " us, its factorisation "
                 << row.factor_us.median << " us, a solve " << row.solve_us.median << " us)\n"
                 << std::defaultfloat << std::flush;
+    if (o.accuracy) row.accuracy = MeasurePathAccuracy(scene, controls, forces, estimates, o, progress);
     if (!o.ceres) {
       row.ceres.note = "not run (--no-ceres)";
     } else if (!CeresBuilt()) {
@@ -250,7 +260,9 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
          "floor_us_median,lapack_us_median,backend_us_median,floor_ratio,ceres_us_median,ceres_iterations_per_update,"
          "ceres_force_error_max,ceres_state_distance_max,ceres_rows_other_equilibrium,ceres_rows_saddle,"
          "ceres_rows_not_converged,ceres_start_on_saddle,assembly_us_median,factor_us_median,solve_us_median,"
-         "ceres_equal_us_median,project_force_error_max,project_force_error_median\n";
+         "ceres_equal_us_median,project_force_error_max,project_force_error_median,force_error_max,"
+         "force_error_median,estimate_max,estimate_median,coverage,estimate_ratio_median,rows_over_target,"
+         "reference_not_converged,coverage_resolved,rows_resolved,reference_estimate_max,reference_estimate_median\n";
   out << std::setprecision(6);
   for (const auto& r : rows) {
     const auto& c = r.ceres;
@@ -262,11 +274,16 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
         << c.rows_not_converged << ',' << (c.start_on_saddle ? 1 : 0) << ',' << r.assembly_us.median << ','
         << r.factor_us.median << ',' << r.solve_us.median << ','
         << (r.ceres_equal >= 0 ? r.ceres_ladder[r.ceres_equal].update_us.median : 0.0) << ','
-        << r.project_force_error_max << ',' << r.project_force_error_median << '\n';
+        << r.project_force_error_max << ',' << r.project_force_error_median << ',' << r.accuracy.error_max << ','
+        << r.accuracy.error_median << ',' << r.accuracy.estimate_max << ',' << r.accuracy.estimate_median << ','
+        << r.accuracy.coverage << ',' << r.accuracy.ratio_median << ',' << r.accuracy.rows_over_target << ','
+        << r.accuracy.reference_not_converged << ',' << r.accuracy.coverage_resolved << ','
+        << r.accuracy.rows_resolved << ',' << r.accuracy.reference_estimate_max << ','
+        << r.accuracy.reference_estimate_median << '\n';
   }
 }
 
-void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out) {
+void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out, double force_target) {
   char buf[320];
   std::snprintf(buf, sizeof buf, "%6s %8s %4s %11s %8s %10s %10s %10s %8s\n", "n", "unknowns", "b", "us/update",
                 "it/upd", "floor us", "LAPACK us", "banded us", "upd/flr");
@@ -278,33 +295,7 @@ void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out) {
                   r.FloorRatio());
     out << buf;
   }
-  auto find = [&](int n) -> const PathRow* {
-    for (const auto& r : rows)
-      if (r.n == n) return &r;
-    return nullptr;
-  };
-  const PathRow* r10 = find(10);
-  const PathRow* r100 = find(100);
-  const PathRow* r1000 = find(1000);
-  out << "issue-13 targets (medians of this run):\n";
-  if (r10) {
-    std::snprintf(buf, sizeof buf, "  n = 10: %.2f us per update (target <= 5) -> %s\n", r10->update_us.median,
-                  r10->update_us.median <= 5.0 ? "met" : "NOT met");
-    out << buf;
-  }
-  if (r1000) {
-    std::snprintf(buf, sizeof buf,
-                  "  n = 1000: update / plain banded LDL^T floor = %.2f (target <= 1.5) -> %s; / LAPACK floor = %s\n",
-                  r1000->FloorRatio(), r1000->FloorRatio() <= 1.5 ? "met" : "NOT met",
-                  r1000->lapack_us.count > 0 ? Sci(r1000->update_us.median / r1000->lapack_us.median, 3).c_str() : "-");
-    out << buf;
-  }
-  if (r100 && r1000 && r100->update_us.median > 0) {
-    const double exponent = std::log10(r1000->update_us.median / r100->update_us.median);
-    std::snprintf(buf, sizeof buf, "  growth exponent n = 100 -> 1000: %.3f (target <= 1.02) -> %s\n", exponent,
-                  exponent <= 1.02 ? "met" : "NOT met");
-    out << buf;
-  }
+  PrintPathTargets(rows, force_target, out);
   bool any_ceres = false;
   for (const auto& r : rows) any_ceres = any_ceres || r.ceres.ran;
   if (!any_ceres) {

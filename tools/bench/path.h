@@ -23,6 +23,8 @@ struct PathOptions {
   std::string method = "higher-order";
   std::string backend = "auto";
   double cutoff = 1e-6;
+  // solver.force_tolerance of the timed run; < 0: the default (SolverOptions, 1e-4).
+  double force_tolerance = -1.0;
   bool ceres = true;
   int floor_samples = 301;  // timed factor + solve pairs per floor
   // Equal force accuracy (issue 13's "10x faster than Ceres at equal force accuracy"):
@@ -32,7 +34,47 @@ struct PathOptions {
   // against the reference (max and median over the rows) is <= the project's.
   int ceres_ladder = 6;
   double ceres_time_limit_s = 60.0;  // per Ceres setting and n (a cut-off path is not "equal")
+  // The accuracy at the timed settings (path_accuracy.cc): every row's force against a
+  // reference, the same path at reference_cutoff with no force tolerance and no iteration
+  // limit (each row ends converged at round-off), and the certified estimate against it.
+  bool accuracy = true;
+  double reference_cutoff = 1e-11;
+  // The accuracy targets: every row's force error <= force_target of the force scale.
+  double force_target = 1e-3;
 };
+
+// The project's forces on the path against the round-off-polished reference, relative to
+// the model's ForceScale(), over rows 1..steps.
+struct PathAccuracy {
+  bool ran = false;
+  int rows = 0;                        // rows compared
+  double reference_s = 0.0;            // wall time of the reference sweep
+  int reference_not_converged = 0;     // reference rows not ending `converged`
+  double reference_iterations_per_update = 0.0;
+  double error_max = 0.0, error_median = 0.0;        // true: |F - F_ref|_inf / ForceScale
+  double estimate_max = 0.0, estimate_median = 0.0;  // certified (SolverSummary::force_error) / ForceScale
+  int rows_without_estimate = 0;       // force_error -1 (counted as not covering)
+  double coverage = 0.0;               // fraction of rows with estimate >= true error
+  // The same over the rows whose true error exceeds the reference's own certified error
+  // (elsewhere the difference is the reference's round-off, not the row's error); -1: none.
+  double coverage_resolved = -1.0;
+  int rows_resolved = 0;
+  double ratio_median = 0.0;           // median estimate / true over rows with both > 0
+  int rows_over_target = 0;            // true error > PathOptions::force_target
+  // The reference's own certified error / ForceScale over rows 1..steps: how exact the truth is.
+  double reference_estimate_max = 0.0, reference_estimate_median = 0.0;
+};
+// The statistics of PathAccuracy from the per-row forces, certified estimates (model
+// units, -1 = none) and reference forces (rows 1..end; row 0, the reset, is left out).
+// reference_estimates: the reference rows' certified errors (model units; empty: unknown).
+PathAccuracy CompareWithReference(const std::vector<Vec>& forces, const std::vector<double>& estimates,
+                                  const std::vector<Vec>& reference_forces, double force_scale, double force_target,
+                                  const std::vector<double>& reference_estimates = {});
+// Runs the reference sweep of `scene` along `controls` and compares (CompareWithReference);
+// one line of progress when `progress` is set.
+PathAccuracy MeasurePathAccuracy(const Scene& scene, const std::vector<Vec>& controls, const std::vector<Vec>& forces,
+                                 const std::vector<double>& estimates, const PathOptions& options,
+                                 std::ostream* progress = nullptr);
 
 // One Ceres run: a trust-region strategy and linear solver (CeresSolverNames) and the
 // ||E_x||_2 cutoff that stops each row.
@@ -90,6 +132,7 @@ struct PathRow {
   double project_force_error_max = 0.0, project_force_error_median = 0.0;
   std::vector<CeresPathResult> ceres_ladder;
   int ceres_equal = -1;
+  PathAccuracy accuracy;  // at the timed settings, against the cutoff-1e-11 reference
   double FloorRatio() const { return floor_us.median > 0 ? update_us.median / floor_us.median : 0.0; }
 };
 
@@ -109,7 +152,11 @@ bool PlainBandedSolve(const SparseMatrix& h, int bandwidth, const Vec& rhs, Vec*
 
 std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptions& options, std::ostream* progress);
 void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out);
-void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out);
+void PrintPathTable(const std::vector<PathRow>& rows, std::ostream& out, double force_target = 1e-3);
+// The accuracy table (PathAccuracy per n, next to the speed) and every target of the run
+// (speed at n = 10, 100, 1000, growth exponent, every row's force error <= force_target,
+// the estimate's coverage), each met or not.
+void PrintPathTargets(const std::vector<PathRow>& rows, double force_target, std::ostream& out);
 // Median us per update against n: the project, Ceres, the plain floor and LAPACK.
 std::string PathGnuplot(const std::vector<PathRow>& rows, const std::string& csv_dir, const std::string& png);
 

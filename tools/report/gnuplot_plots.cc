@@ -50,6 +50,25 @@ bool RunGnuplot(const std::string& dir, const std::string& name, const std::stri
 // A data file of the output directory, by its fixed name.
 std::string Csv(const std::string& name) { return "'" + name + "'"; }
 
+// force_error.png: the certified force error (force_model_t.force_error_n) over time, one
+// series per grasp (by index: summary.txt names them; no grasp name reaches the script).
+// Models without an estimate ("none" in force.csv) are not drawn.
+void PlotForceError(const SessionReview& r, const std::string& dir, const std::string& ch, PlotOutcome* out) {
+  if (!r.HasForceError()) {
+    AddNote(out, "force_error.png not drawn: no " + ch + "_FORCE_MODEL carries a certified force error (none)");
+    return;
+  }
+  std::string body = "set title 'Certified force error (" + ch + "_FORCE_MODEL force_error_n)'\n"
+                     "set xlabel 'time [s]'\nset ylabel 'certified force error [N]'\nset logscale y\n"
+                     "set format y '%.0e'\nplot ";
+  for (size_t g = 0; g < r.grasps().size(); ++g) {
+    const std::string k = std::to_string(g);
+    body += std::string(g == 0 ? "" : ", ") + Csv("force.csv") + " skip 1 using 1:($8 == " + k +
+            " && $9 > 0 ? $9 : 1/0) with points pt 7 ps 0.4 title 'grasp " + k + "'";
+  }
+  RunGnuplot(dir, "force_error", body + "\n", out);
+}
+
 // force.png: |F| and its components over time, snaps marked.
 void PlotForce(const std::string& dir, const SessionReview& r, const std::string& ch, PlotOutcome* out) {
   if (r.HasForce()) {
@@ -172,6 +191,7 @@ PlotOutcome MakePlots(const std::string& dir, const SessionReview& r) {
   PlotOutcome out;
   const std::string ch = SessionLabel(r.session());
   PlotForce(dir, r, ch, &out);
+  if (r.HasForce()) PlotForceError(r, dir, ch, &out);
   PlotKnot(dir, r, ch, &out);
   PlotSolver(dir, r, ch, &out);
   PlotDevice(dir, r, ch, &out);

@@ -127,7 +127,8 @@ void SessionReview::Add(const lcm::LogEvent& e) {
     c.has_seq = true;
     c.seq.Add(m.seq);
     const double n = std::sqrt(m.f0[0] * m.f0[0] + m.f0[1] * m.f0[1] + m.f0[2] * m.f0[2]);
-    force_.push_back({t, {m.f0[0], m.f0[1], m.f0[2]}, n, m.status, m.seq});
+    force_.push_back({t, {m.f0[0], m.f0[1], m.f0[2]}, n, m.status, m.seq,
+                      std::isfinite(m.force_error_n) ? m.force_error_n : -1.0, GraspIndex(m.grasp)});
     if (m.status == force_model_t::STATUS_SNAPPED) snap_times_s_.push_back(t);
     solve_.push_back({t, m.iterations, m.residual, m.solve_us, m.status});
     if (first_answered_pose_ < 0) first_answered_pose_ = m.device_seq;
@@ -202,10 +203,16 @@ std::vector<std::string> SessionReview::WriteCsv(const std::string& dir) const {
   };
   {
     auto f = open("force.csv");
-    f << "t_s,fx_n,fy_n,fz_n,f_norm_n,status,seq\n";
+    // force_error_n: "none" where the model carried none (-1), which gnuplot skips.
+    f << "t_s,fx_n,fy_n,fz_n,f_norm_n,status,seq,grasp_index,force_error_n\n";
     for (const auto& r : force_) {
       f << r.t_s << ',' << r.f[0] << ',' << r.f[1] << ',' << r.f[2] << ',' << r.norm_n << ','
-        << r.status << ',' << r.seq << '\n';
+        << r.status << ',' << r.seq << ',' << r.grasp << ',';
+      if (r.error_n >= 0.0) {
+        f << r.error_n << '\n';
+      } else {
+        f << "none\n";
+      }
     }
   }
   {
@@ -318,6 +325,7 @@ void SessionReview::SummaryForce(std::ostream& s) const {
     const auto mx = std::max_element(force_.begin(), force_.end(),
                                      [](const ForceRow& a, const ForceRow& b) { return a.norm_n < b.norm_n; });
     s << "max_force_n: " << Fmt("%.4f", mx->norm_n) << " at t_s " << Fmt("%.3f", mx->t_s) << "\n";
+    SummaryForceError(s);
   }
   s << "snaps: " << snap_times_s_.size() << " (force models with STATUS_SNAPPED)";
   if (shape_snaps_last_ >= 0) s << ", shapes count " << shape_snaps_last_ - shape_snaps_first_;
@@ -331,6 +339,42 @@ void SessionReview::SummaryForce(std::ostream& s) const {
     s << "latest_wins: models answer " << answered_poses_ << " poses of seq "
       << first_answered_pose_ << ".." << last_answered_pose_ << ", skipped_poses "
       << span - answered_poses_ << ", device_seq_regressions " << device_seq_regressions_ << "\n";
+  }
+}
+
+int SessionReview::GraspIndex(const std::string& grasp) {
+  for (size_t i = 0; i < grasps_.size(); ++i)
+    if (grasps_[i] == grasp) return static_cast<int>(i);
+  if (grasps_.size() < kMaxGrasps) grasps_.push_back(grasp);
+  return static_cast<int>(grasps_.size()) - 1;
+}
+
+bool SessionReview::HasForceError() const {
+  for (const auto& r : force_)
+    if (r.error_n >= 0.0) return true;
+  return false;
+}
+
+// The certified force error per grasp: median and max over the models that carry one, and
+// how many carry none (-1).
+void SessionReview::SummaryForceError(std::ostream& s) const {
+  for (size_t g = 0; g < grasps_.size(); ++g) {
+    std::vector<double> errors;
+    size_t models = 0;
+    for (const auto& r : force_) {
+      if (r.grasp != static_cast<int>(g)) continue;
+      ++models;
+      if (r.error_n >= 0.0) errors.push_back(r.error_n);
+    }
+    const std::string name = grasps_[g].empty() ? "-" : Shown(grasps_[g]);
+    s << "force_error_n (certified) grasp " << name << ": ";
+    if (errors.empty()) {
+      s << "none";
+    } else {
+      const Stats e = Percentiles(errors);
+      s << "p50 " << Fmt("%.3g", e.p50) << " max " << Fmt("%.3g", e.max) << " N";
+    }
+    s << "; none on " << models - errors.size() << " of " << models << " models\n";
   }
 }
 

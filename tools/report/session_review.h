@@ -27,7 +27,9 @@ struct ChannelStats {
   double first_s = 0.0, last_s = 0.0;  // log time of first / last message
 };
 
-struct ForceRow { double t_s; double f[3]; double norm_n; int status; int64_t seq; };
+// error_n: the model's certified force error (force_model_t.force_error_n, N; < 0: none);
+// grasp: the index of its grasp name in SessionReview::grasps().
+struct ForceRow { double t_s; double f[3]; double norm_n; int status; int64_t seq; double error_n; int grasp; };
 struct SolveRow { double t_s; int iterations; double residual; int solve_us; int status; };
 struct StatusRow {
   double t_s; std::string method; int iterations; double residual; double lambda_min;
@@ -53,6 +55,8 @@ class SessionReview {
  public:
   // Channels listed one by one; messages on further channels are only counted.
   static constexpr size_t kMaxListedChannels = 1000;
+  // Grasp names told apart in the force rows; further names share the last index.
+  static constexpr size_t kMaxGrasps = 16;
 
   explicit SessionReview(std::string session);
   void Add(const lcm::LogEvent& event);
@@ -66,6 +70,10 @@ class SessionReview {
 
   const std::map<std::string, ChannelStats>& channels() const { return channels_; }
   bool HasForce() const { return !force_.empty(); }
+  // Some force model carried a certified force error (force_error_n >= 0).
+  bool HasForceError() const;
+  // The grasp names of the force models in the order first seen (raw; shown escaped).
+  const std::vector<std::string>& grasps() const { return grasps_; }
   bool HasSolverStatus() const { return !status_.empty(); }
   bool HasDevice() const { return !device_.empty(); }
   bool HasRoundTrip() const { return !round_trip_.empty(); }
@@ -79,6 +87,8 @@ class SessionReview {
   // latest-wins; solver; knot; device and round trip.
   void SummaryChannels(std::ostream& s) const;
   void SummaryForce(std::ostream& s) const;
+  void SummaryForceError(std::ostream& s) const;
+  int GraspIndex(const std::string& grasp);
   void SummarySolver(std::ostream& s) const;
   void SummaryKnot(std::ostream& s) const;
   void SummaryDevice(std::ostream& s) const;
@@ -91,6 +101,7 @@ class SessionReview {
   std::map<std::string, ChannelStats> channels_;  // by the raw name; shown escaped
   int64_t unlisted_messages_ = 0, unlisted_bytes_ = 0;  // beyond kMaxListedChannels
   std::vector<ForceRow> force_;
+  std::vector<std::string> grasps_;
   std::vector<double> snap_times_s_;
   std::vector<SolveRow> solve_;
   std::vector<StatusRow> status_;

@@ -38,7 +38,7 @@ function onMessage(m) {
       data.lastShapeStatus = m.status;
       data.lastShapeUtime = m.utime;
       break;
-    case 'force': charts.addForceModel(m); break;
+    case 'force': charts.addForceModel(m); panel.force = m; break;
     case 'solver': panel.solver = m; break;
     case 'device': panel.device = m; break;
     case 'bridge': panel.bridge = m; data.mode = m.mode; break;

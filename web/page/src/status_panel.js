@@ -1,17 +1,24 @@
 // The status panel: what the page measures (shapes and frames per second, the shape's
 // age, the browser round trip), the server's solver status, the device's status (tick
-// rate, lateness, pose -> model round trip) and the bridge's counters.
+// rate, lateness, pose -> model round trip), the last force model's certified force error
+// and the bridge's counters.
 // Every text here comes from the session's messages or a log, so it is hostile: it goes
 // into the page only as DOM text (textContent), never as markup.
 import { STATUS_NAMES, statusColour, css } from './colours.js';
 
 const fmt = (v, digits = 0) => (v === undefined || v === null || Number.isNaN(v) ? '–' : Number(v).toFixed(digits));
 const exp = (v) => (v === undefined || v === null ? '–' : Number(v).toExponential(2));
+// force_model_t.force_error_n: newtons, or -1 when the server could make no estimate.
+export const FORCE_ERROR_KEY = 'force error (certified)';
+export const forceErrorText = (v) => {
+  if (v === undefined || v === null || Number.isNaN(Number(v))) return '–';
+  return Number(v) < 0 ? 'none' : `${Number(v).toExponential(2)} N`;
+};
 
 export class StatusPanel {
   constructor(element) {
     this.element = element;
-    this.solver = null; this.device = null; this.bridge = null; this.shape = null;
+    this.solver = null; this.device = null; this.bridge = null; this.shape = null; this.force = null;
   }
 
   render(page) {
@@ -32,6 +39,7 @@ export class StatusPanel {
       if (sh.knot) rows.push(['knot', sh.knot]);
       if (sh.contacts) rows.push(['contacts', sh.contacts.length / 6]);
     }
+    if (this.force) rows.push([FORCE_ERROR_KEY, forceErrorText(this.force.force_error_n)]);
     if (s) {
       rows.push(['updates / s', fmt(s.update_rate_hz)], ['solve p50 / p99', `${fmt(s.solve_us_p50)} / ${fmt(s.solve_us_p99)} us`],
                 ['iterations', s.iterations], ['residual', exp(s.residual)], ['lambda_min', exp(s.lambda_min)],
