@@ -63,6 +63,7 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   SolveAndStartHere();
   // Judged after the tracking solver's own solve, which may still leave a saddle.
   start_continuation_steps_ = 0;
+  substeps_ = 0;
   if (start_family_ && !IsStableStart(result_.summary) && StartByContinuation(u)) {
     solver_->Reset();
     SolveAndStartHere();
