@@ -88,7 +88,8 @@ bool EquilibriumTracker::RetryFailedUpdate(const Vec& u) {
   if (!done) {
     // No equilibrium: back to the failed state, solved once more at u (with the lagged
     // data the retries moved) so the solver's factorisation is that state's; the update
-    // reports failure as before unless this solve converges.
+    // reports failure as before unless this solve converges. No sub-steps to report.
+    substeps_ = 0;
     x = x_;
     last = solver_->Solve(u, &x);
     AddWork(last, &total);
