@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <iomanip>
+#include <numeric>
 
 #include "sweep.h"
 #include "topology/identify_knot.h"
@@ -40,27 +41,36 @@ ResolutionRow RunResolution(const ResolutionSweep& sweep, const std::string& met
   Scene scene = LoadScene(sweep.scene_file, {{"params.n", std::to_string(sweep.n)}});
   scene.solver.method = method;
   auto tracker = MakeTracker(scene);
-  const std::vector<SweepRow> trace = RunSweep(tracker.get(), PathControls(scene, sweep.steps_per_leg));
+  const std::vector<Vec> controls = PathControls(scene, sweep.steps_per_leg);
   ResolutionRow r;
   r.sweep = sweep.name;
   r.method = method;
   r.n = sweep.n;
-  r.rows = static_cast<int>(trace.size());
-  r.start_continuation_steps = tracker->start_continuation_steps();
+  r.rows = static_cast<int>(controls.size());
   std::vector<int> unconverged;
-  for (const SweepRow& row : trace) {
-    if (row.status == EquilibriumStatus::kFailed) ++r.failed;
-    if (row.termination != Termination::kConverged) unconverged.push_back(row.step);
-    r.max_iterations = std::max(r.max_iterations, row.iterations);
-    r.mean_us += row.solve_us;
+  std::vector<double> us;
+  // The rows of snapthread-sweep --path (RunSweep's Reset, then Update), with the
+  // tracker's count of the retry's sub-steps at each row.
+  for (size_t i = 0; i < controls.size(); ++i) {
+    const TrackResult& t = i == 0 ? tracker->Reset(controls[i]) : tracker->Update(controls[i]);
+    if (i == 0) r.start_continuation_steps = tracker->start_continuation_steps();
+    if (i > 0 && tracker->substeps() > 0) ++r.retried;
+    if (t.summary.status == EquilibriumStatus::kFailed) ++r.failed;
+    if (!t.summary.IsConverged()) unconverged.push_back(static_cast<int>(i));
+    r.max_iterations = std::max(r.max_iterations, t.summary.iterations);
+    us.push_back(t.summary.solve_us);
   }
-  if (!trace.empty()) r.mean_us /= static_cast<double>(trace.size());
+  if (!us.empty()) {
+    r.mean_us = std::accumulate(us.begin(), us.end(), 0.0) / static_cast<double>(us.size());
+    std::nth_element(us.begin(), us.begin() + us.size() / 2, us.end());
+    r.median_us = us[us.size() / 2];
+  }
   r.unconverged = static_cast<int>(unconverged.size());
   r.unconverged_rows = RowRuns(unconverged);
   if (!unconverged.empty()) r.first_unconverged = unconverged.front();
-  if (sweep.name_knot && !trace.empty()) {
+  if (sweep.name_knot && !controls.empty()) {
     Eigen::Matrix3Xd nodes;
-    tracker->model().NodePositions(trace.back().state, trace.back().u, &nodes);
+    tracker->model().NodePositions(tracker->state(), controls.back(), &nodes);
     std::vector<Eigen::Vector3d> points(nodes.cols());
     for (Eigen::Index k = 0; k < nodes.cols(); ++k) points[k] = nodes.col(k);
     const topology::KnotInfo knot = topology::IdentifyKnot(points);
@@ -70,24 +80,26 @@ ResolutionRow RunResolution(const ResolutionSweep& sweep, const std::string& met
 }
 
 void WriteResolutionCsv(const std::vector<ResolutionRow>& rows, std::ostream& out) {
-  out << "sweep,n,method,rows,failed,unconverged,unconverged_rows,last_knot,start_continuation_steps,"
-         "max_iterations,us_per_update\n";
+  out << "sweep,n,method,rows,failed,unconverged,unconverged_rows,retried,last_knot,start_continuation_steps,"
+         "max_iterations,median_us_per_update,mean_us_per_update\n";
   out << std::setprecision(6);
   for (const auto& r : rows)
     out << r.sweep << ',' << r.n << ',' << r.method << ',' << r.rows << ',' << r.failed << ',' << r.unconverged
-        << ",\"" << r.unconverged_rows << "\"," << r.last_knot << ',' << r.start_continuation_steps << ','
-        << r.max_iterations << ',' << r.mean_us << '\n';
+        << ",\"" << r.unconverged_rows << "\"," << r.retried << ',' << r.last_knot << ','
+        << r.start_continuation_steps << ',' << r.max_iterations << ',' << r.median_us << ',' << r.mean_us << '\n';
 }
 
 void PrintResolutionTable(const std::vector<ResolutionRow>& rows, std::ostream& out) {
   char buf[512];
-  std::snprintf(buf, sizeof buf, "%-20s %5s %-12s %5s %6s %11s %-10s %5s %8s  %s\n", "sweep", "n", "method", "rows",
-                "failed", "unconverged", "last_knot", "cont", "us/up", "unconverged rows");
+  std::snprintf(buf, sizeof buf, "%-20s %5s %-12s %5s %6s %11s %7s %-10s %5s %9s %9s  %s\n", "sweep", "n", "method",
+                "rows", "failed", "unconverged", "retried", "last_knot", "cont", "median_us", "mean_us",
+                "unconverged rows");
   out << buf;
   for (const auto& r : rows) {
-    std::snprintf(buf, sizeof buf, "%-20s %5d %-12s %5d %6d %11d %-10s %5d %8.0f  %.200s\n", r.sweep.c_str(), r.n,
-                  r.method.c_str(), r.rows, r.failed, r.unconverged, r.last_knot.empty() ? "-" : r.last_knot.c_str(),
-                  r.start_continuation_steps, r.mean_us, r.unconverged_rows.c_str());
+    std::snprintf(buf, sizeof buf, "%-20s %5d %-12s %5d %6d %11d %7d %-10s %5d %9.0f %9.0f  %.200s\n",
+                  r.sweep.c_str(), r.n, r.method.c_str(), r.rows, r.failed, r.unconverged, r.retried,
+                  r.last_knot.empty() ? "-" : r.last_knot.c_str(), r.start_continuation_steps, r.median_us, r.mean_us,
+                  r.unconverged_rows.c_str());
     out << buf;
   }
 }

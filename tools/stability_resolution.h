@@ -27,12 +27,14 @@ struct ResolutionRow {
   int n = 0;
   int rows = 0;
   int failed = 0;          // rows with status failed: no usable state
-  int unconverged = 0;     // rows whose solve ended other than converged (failed included)
+  int unconverged = 0;     // rows not converged (accuracy-limited counts as converged)
   std::string unconverged_rows;  // their numbers, runs joined: "0-8,569,619-620"
   int first_unconverged = -1;    // -1: none
   std::string last_knot;   // the knot of the last row ("" unless the sweep names it)
   int start_continuation_steps = 0;  // of the reset at row 0 (0: the direct start)
+  int retried = 0;         // rows the tracker's retry (RetryFailedUpdate) solved in sub-steps
   int max_iterations = 0;  // per row
+  double median_us = 0.0;  // solve time per row (update), median
   double mean_us = 0.0;    // per row
 };
 

@@ -63,6 +63,7 @@ const TrackResult& EquilibriumTracker::Reset(const Vec& u) {
   SolveAndStartHere();
   // Judged after the tracking solver's own solve, which may still leave a saddle.
   start_continuation_steps_ = 0;
+  substeps_ = 0;
   if (start_family_ && !IsStableStart(result_.summary) && StartByContinuation(u)) {
     solver_->Reset();
     SolveAndStartHere();
@@ -199,7 +200,9 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   x_ = x_pred_;
   u_ = u;
   result_.summary = solver_->Solve(u, &x_);
+  substeps_ = 0;
   FinishUnfinishedSnap(u);
+  RetryFailedUpdate(u);
   // A snap is a jump to another branch: the state left the predicted one by more than
   // the threshold (for every method alike, so the charts compare like with like). The
   // status is DecideStatus's, now with that fact.

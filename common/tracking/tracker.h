@@ -51,6 +51,8 @@ class EquilibriumTracker {
   void SetStartContinuation(ModelFamily family) { start_family_ = std::move(family); }
   // Number of continuation steps the last Reset took (0: the direct start was stable).
   int start_continuation_steps() const { return start_continuation_steps_; }
+  // Sub-steps the last Update's retry (RetryFailedUpdate) took; 0: none.
+  int substeps() const { return substeps_; }
   // Start again from a saved equilibrium x at controls u (a server checkpoint): the
   // model's lagged data is moved to x first (AcceptState), then x is solved again with the
   // tracking solver, warm-started at x, so the state stays on its branch and the
@@ -93,6 +95,19 @@ class EquilibriumTracker {
   // from its last accepted, energy-decreasing state with more solves, at most
   // kSnapRetries; the summary counts them all.
   void FinishUnfinishedSnap(const Vec& u);
+  // An update left with no usable state after FinishUnfinishedSnap (linear-solver-
+  // failed, non-finite; no time budget) is retried (common/tracking/substep.cc): the
+  // failed state solved at controls further along the step, u + a (u - u_prev) for
+  // a = 1, 2, 4, where the snap it crawled through finishes, and the equilibrium found
+  // there followed back to u (ContinueInSubsteps). True when it reached an equilibrium
+  // at u; otherwise the failed state is solved once more at u. The summary counts all
+  // the work.
+  bool RetryFailedUpdate(const Vec& u);
+  // Natural-parameter continuation of the equilibrium *x at u0 to u1 in sub-steps (a
+  // quarter of the way first, halved where one fails, down to 1/64), the lagged data
+  // following each sub-step's equilibrium; false if a sub-step fails at the smallest
+  // length. *last is the last solve; the work is added to *total.
+  bool ContinueInSubsteps(const Vec& u0, const Vec& u1, Vec* x, SolverSummary* total, SolverSummary* last);
   // Reset's start solve of `model` from *x: newton-ls, unlimited, then off a saddle
   // along its negative mode (at most 8 times).
   SolverSummary SolveStart(const Model& model, const Vec& u, Vec* x) const;
@@ -134,6 +149,7 @@ class EquilibriumTracker {
   double snap_threshold_ = 0.1;
   ModelFamily start_family_;
   int start_continuation_steps_ = 0;
+  int substeps_ = 0;
   double lambda_ref_ = -1.0;
   TrackResult result_;
   // scratch
