@@ -18,6 +18,9 @@ constexpr double kForceErrorMargin = 2.0;
 // The force's own round-off, in units of eps times (|F| + force scale): below this no
 // two evaluations of F agree, so no estimate is smaller.
 constexpr double kForceRoundOff = 16.0;
+// The force change to the corrected state this many times the first-order one marks a
+// correction long along a soft mode, whose length the reduced quartic caps.
+constexpr double kCurvedCorrection = 4.0;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 // The round-off probe moves each coordinate by this many units in its last place: the
 // gradient sums many terms, each with its own rounding, so one unit understates it.
@@ -53,17 +56,49 @@ double SolverBase::ForceErrorFromFactor(const Vec& x, const Vec& u) {
   const double linear = w.err_df.lpNorm<Eigen::Infinity>();
   // Where E_u curves over the correction (a flat valley, a fold), the force change to the
   // corrected state itself: two evaluations of E_u, a few terms at the grasp.
-  w.err_x = x - w.err_dx;
   model_.ControlGradient(x, u, &w.err_eu0);
-  model_.ControlGradient(w.err_x, u, &w.err_eu1);
-  double change = (w.err_eu1 - w.err_eu0).lpNorm<Eigen::Infinity>();
-  if (!std::isfinite(change)) change = 0.0;
+  double change = ForceChangeAlongCorrection(x, u, 1.0);
+  // That change far above the first-order one: the correction is long along a soft mode
+  // and the force curves over it. There the correction overshoots where the energy
+  // stiffens beyond its quadratic (the reduced quartic of (2.54)-(2.55)): its length is
+  // capped at the root of the reduced equation, and the change taken there.
+  if (change > kCurvedCorrection * linear) change = ForceChangeAlongCorrection(x, u, CappedCorrection(x, u));
   const double round_off = kForceRoundOff * kEps * (w.err_eu0.lpNorm<Eigen::Infinity>() + model_.ForceScale());
   err_value_ = kForceErrorMargin * std::max(linear, change) + round_off;
   if (!std::isfinite(err_value_)) err_value_ = -1.0;
   err_serial_ = factor_serial_;
   w.err_state = x;
   return err_value_;
+}
+
+double SolverBase::ForceChangeAlongCorrection(const Vec& x, const Vec& u, double t) {
+  Workspace& w = ws_;
+  w.err_x = x - t * w.err_dx;
+  model_.ControlGradient(w.err_x, u, &w.err_eu1);
+  const double change = (w.err_eu1 - w.err_eu0).lpNorm<Eigen::Infinity>();
+  return std::isfinite(change) ? change : 0.0;
+}
+
+double SolverBase::CappedCorrection(const Vec& x, const Vec& u) {
+  // The reduced energy along the correction, e(t) = E(x - t dx) - E(x), is
+  // -c t + c t^2 / 2 + gamma_3 t^3 + gamma_4 t^4 with c = dx . E_x = dx . E_xx dx (the
+  // seed's (2.54)-(2.55) along dx). One gradient at the corrected state gives
+  // e'(1) = 3 gamma_3 + 4 gamma_4 = -dx . E_x(x - dx) =: q. Where q > 0 the energy stiffens
+  // and the equilibrium lies short of t = 1: e'(t) = c (t - 1) + q t^3 = 0 (the quartic
+  // alone, the longer of the two one-term models, so the cap errs on the long side).
+  // Elsewhere (q <= 0, c <= 0: softening, indefinite) the whole correction is kept.
+  Workspace& w = ws_;
+  const double c = w.err_dx.dot(w.g);
+  w.err_x = x - w.err_dx;
+  model_.Gradient(w.err_x, u, &w.noise_g);
+  const double q = -w.err_dx.dot(w.noise_g);
+  if (!(c > 0.0) || !(q > 0.0) || !std::isfinite(q)) return 1.0;
+  double lo = 0.0, hi = 1.0;  // c (t - 1) + q t^3 rises from -c to q: one root in (0, 1)
+  for (int i = 0; i < 40; ++i) {
+    const double t = 0.5 * (lo + hi);
+    (c * (t - 1.0) + q * t * t * t > 0.0 ? hi : lo) = t;
+  }
+  return hi;
 }
 
 bool SolverBase::AtRoundOff(double r, const Vec& x, const Vec& u, SolverSummary* s) {
