@@ -2,11 +2,14 @@
 // "Accuracy targets"): thread3d and the rod at n = 10 and 100, both families, both path
 // kinds, at the default settings against a round-off-polished reference.
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "accuracy_matrix.h"
+#include "allocation_counter.h"
 #include "models/registry.h"
+#include "tracking/tracker.h"
 
 namespace snapthread {
 namespace {
@@ -57,6 +60,41 @@ TEST(AccuracyMatrixCells, FamiliesScaleAsTheContinuum) {
     EXPECT_EQ(AccuracyCellControls({model, AccuracyFamily::kFixedLength, 100, AccuracyPath::kHandSpeed}).size(), 101u);
     EXPECT_EQ(AccuracyCellControls({model, AccuracyFamily::kUnitSegments, 10, AccuracyPath::kLargeSteps}).size(), 21u);
   }
+}
+
+// Where the Newton correction is long along a soft mode (thread3d n = 100 near the
+// clamp's axis at the old cutoff 1e-6, lambda_min ~ 3e-8), the force curves over it: the
+// first-order estimate's force change to x - dx was up to 100 times the true error
+// (median 130 on this path). The second correction brings it to the valley: covered,
+// and within 10 times at the median.
+TEST(AccuracyMatrixEstimate, LongSoftCorrectionIsNotOverestimated) {
+  SolverOptions o;
+  o.cutoff = 1e-6;
+  o.force_tolerance = 0.0;
+  const AccuracyCellResult r =
+      RunAccuracyCell({"thread3d", AccuracyFamily::kUnitSegments, 100, AccuracyPath::kHandSpeed}, o);
+  EXPECT_GE(r.covered, 0.99 * r.rows) << r.covered << " of " << r.rows;
+  EXPECT_EQ(r.unestimated, 0);
+  EXPECT_LE(r.ratio_median, 10.0);
+  EXPECT_GE(r.ratio_min, 1.0);
+}
+
+// Once warm, an update that takes the second correction allocates nothing.
+TEST(AccuracyMatrixEstimate, SecondCorrectionAllocatesNothing) {
+  const AccuracyCell cell{"thread3d", AccuracyFamily::kUnitSegments, 100, AccuracyPath::kHandSpeed};
+  SolverOptions o;
+  o.cutoff = 1e-6;
+  o.force_tolerance = 0.0;
+  EquilibriumTracker tracker(MakeModel(AccuracyCellParams(cell)), o);
+  const std::vector<Vec> us = AccuracyCellControls(cell);
+  tracker.Reset(us[0]);
+  for (int i = 1; i < 25; ++i) tracker.Update(us[i]);
+  long mallocs = 0;
+  for (int i = 25; i < 35; ++i) mallocs += test_support::MallocsDuring([&] { tracker.Update(us[i]); });
+  if (test_support::kCountsAllocations) {
+    EXPECT_EQ(mallocs, 0);
+  }
+  EXPECT_GE(tracker.Update(us[35]).summary.force_error, 0.0);
 }
 
 // The rod of 100 unit segments is left out: its start solve (newton-ls from the initial
