@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "linalg/linear_solver.h"
+#include "accuracy_matrix.h"
 #include "models/models.h"
 #include "models/registry.h"
 #include "sweep.h"
@@ -41,43 +41,9 @@ std::vector<Vec> Path(int n, int steps) {
   return us;
 }
 
-// The exact equilibrium next to x: Newton steps (E_xx + mu I) dx = -E_x, kept while
-// |E_x| falls (mu from 0, x10 on a refused step, /100 on a kept one), down to round-off.
-// Independent of the solvers under test: the model and a linear solver only.
-Vec Polish(const Model& model, const Vec& u, Vec x) {
-  const int n = model.NumStates();
-  std::string error;
-  auto solver = MakeLinearSolver("auto", n, model.HessianBandwidth(), &error);
-  SparseMatrix h = model.HessianPattern();
-  EXPECT_EQ(solver->Analyze(h), LinearSolverStatus::kSuccess);
-  Vec g(n), dx(n), trial(n), gt(n);
-  model.Gradient(x, u, &g);
-  double mu = 0.0;
-  int refused = 0;
-  for (int it = 0; it < 200 && refused < 12; ++it) {
-    model.Hessian(x, u, &h);
-    for (int k = 0; k < h.outerSize(); ++k)
-      for (SparseMatrix::InnerIterator it(h, k); it; ++it)
-        if (it.row() == it.col()) it.valueRef() += mu;
-    if (solver->Factorize(h) != LinearSolverStatus::kSuccess || solver->Solve(g, &dx) != LinearSolverStatus::kSuccess) {
-      mu = std::max(mu * 10.0, 1e-12);
-      ++refused;
-      continue;
-    }
-    trial = x - dx;
-    model.Gradient(trial, u, &gt);
-    if (gt.allFinite() && gt.norm() < g.norm()) {
-      x.swap(trial);
-      g.swap(gt);
-      mu /= 100.0;
-      refused = 0;
-    } else {
-      mu = std::max(mu * 10.0, 1e-12);
-      ++refused;
-    }
-  }
-  return x;
-}
+// The exact equilibrium next to x: damped Newton steps to round-off with the model and a
+// linear solver only (PolishToRoundOff, tools/accuracy_matrix.h).
+Vec Polish(const Model& model, const Vec& u, const Vec& x) { return PolishToRoundOff(model, u, x); }
 
 struct Row {
   SolverSummary summary;

@@ -18,6 +18,12 @@ constexpr double kForceErrorMargin = 2.0;
 // The force's own round-off, in units of eps times (|F| + force scale): below this no
 // two evaluations of F agree, so no estimate is smaller.
 constexpr double kForceRoundOff = 16.0;
+// The force change to the corrected state this many times the first-order one marks a
+// correction long along a soft mode over which the force curves: a second correction
+// (SecondOrderForceChange) checks it.
+constexpr double kCurvedCorrection = 4.0;
+// Two corrections that shrink by less than this do not contract: no second-order estimate.
+constexpr double kMaxContraction = 0.5;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 // The round-off probe moves each coordinate by this many units in its last place: the
 // gradient sums many terms, each with its own rounding, so one unit understates it.
@@ -53,17 +59,47 @@ double SolverBase::ForceErrorFromFactor(const Vec& x, const Vec& u) {
   const double linear = w.err_df.lpNorm<Eigen::Infinity>();
   // Where E_u curves over the correction (a flat valley, a fold), the force change to the
   // corrected state itself: two evaluations of E_u, a few terms at the grasp.
-  w.err_x = x - w.err_dx;
   model_.ControlGradient(x, u, &w.err_eu0);
+  w.err_x = x - w.err_dx;
   model_.ControlGradient(w.err_x, u, &w.err_eu1);
   double change = (w.err_eu1 - w.err_eu0).lpNorm<Eigen::Infinity>();
   if (!std::isfinite(change)) change = 0.0;
+  if (change > kCurvedCorrection * linear) change = SecondOrderForceChange(u, change);
   const double round_off = kForceRoundOff * kEps * (w.err_eu0.lpNorm<Eigen::Infinity>() + model_.ForceScale());
   err_value_ = kForceErrorMargin * std::max(linear, change) + round_off;
   if (!std::isfinite(err_value_)) err_value_ = -1.0;
   err_serial_ = factor_serial_;
   w.err_state = x;
   return err_value_;
+}
+
+double SolverBase::SecondOrderForceChange(const Vec& u, double first) {
+  // The correction is long along a soft mode and the force curves over it. x - dx lies on
+  // the straight chord of a curved valley (a soft mode that turns the shape: moving
+  // nodes along the chord stretches segments), and E_u there carries that spurious
+  // stretch. A second correction from x - dx with the same factorisation (a chord step:
+  // one gradient, one solve) brings it back into the valley; the force change to
+  // x - dx - dx2 is then the second-order estimate. The steps' contraction
+  // q = |dx2| / |dx| bounds what is left: a further q / (1 - q) of the second step's
+  // force change. Where they do not contract (q >= 1/2) the first change stands.
+  // Scratch: the round-off probe's vectors (AtRoundOff writes them afresh when it runs).
+  Workspace& w = ws_;
+  model_.Gradient(w.err_x, u, &w.noise_g);
+  if (w.factor->Solve(w.noise_g, &w.noise_x) != LinearSolverStatus::kSuccess || !w.noise_x.allFinite())
+    return first;
+  // Its part along dx (the soft mode itself, amplified by 1 / lambda_min from the chord's
+  // stretch) is not a correction but the chord's artefact: only the rest is taken.
+  const double dx2 = w.err_dx.squaredNorm();
+  if (!(dx2 > 0.0)) return first;
+  w.noise_x -= (w.noise_x.dot(w.err_dx) / dx2) * w.err_dx;
+  const double q = w.noise_x.norm() / std::sqrt(dx2);
+  if (!(q < kMaxContraction)) return first;
+  w.err_x -= w.noise_x;
+  model_.ControlGradient(w.err_x, u, &w.err_df);
+  const double second = (w.err_df - w.err_eu0).lpNorm<Eigen::Infinity>();
+  const double last_step = (w.err_df - w.err_eu1).lpNorm<Eigen::Infinity>();
+  const double change = second + q / (1.0 - q) * last_step;
+  return std::isfinite(change) ? change : first;
 }
 
 bool SolverBase::AtRoundOff(double r, const Vec& x, const Vec& u, SolverSummary* s) {

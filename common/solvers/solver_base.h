@@ -80,9 +80,12 @@ class SolverBase : public EquilibriumSolver {
   // The certified force error at x with HessianFactor() at x (or next to it, kReuseStep)
   // and the workspace gradient = E_x(x): dx = E_xx^-1 E_x, the Newton correction (2.18),
   // moves the force by E_ux dx to first order (2.14-2.15); the estimate is a margin times
-  // the larger of that and the force change to x - dx (curvature of E_u), plus the
-  // force's round-off. -1 when the solve fails. Cached per factorisation and state.
+  // the larger of that and the force change to x - dx (curvature of E_u; where it
+  // dominates, after a second correction), plus the force's round-off. -1 when the solve fails. Cached per factorisation and state.
   double ForceErrorFromFactor(const Vec& x, const Vec& u);
+  // ForceErrorFromFactor's force change where the correction dx is long along a soft
+  // mode: to x - dx - dx2 after a second correction (accuracy.cc); `first` where none.
+  double SecondOrderForceChange(const Vec& u, double first);
   // No force tolerance, or the force error at x (as ForceErrorFromFactor) within it or
   // not estimable.
   bool ForceCertified(const Vec& x, const Vec& u);
