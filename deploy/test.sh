@@ -76,7 +76,7 @@ cmake --build "$here/build" -j"$jobs"
 Stage "Release tests"
 cd "$here/build"
 # Labels containing `open`: tests of work in progress not yet reliable (named in the README;
-# today none: snap_ahead_process_test, issue 17, runs here as `process`).
+# today none: snap_ahead_process_test runs here as `process`).
 ctest --output-on-failure -j2 --timeout 600 -LE open
 
 if [ "$quick" = 1 ]; then

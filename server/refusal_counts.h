@@ -1,5 +1,5 @@
 // Every refused DEVICE_STATE and COMMAND counted by the role its sender claimed and the
-// reason (issue: "every refusal is counted per role and reason"), published in
+// reason, published in
 // solver_status_t.refusals as "role/reason=count ..." (the non-zero ones, in table
 // order) and in the summary. A fixed table of atomic counters: any thread counts without
 // a lock or an allocation (the gate on the receive thread, the wrong-grasp check on the

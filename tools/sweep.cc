@@ -47,7 +47,8 @@ std::vector<Vec> PathControls(const Scene& scene, int steps_per_leg) {
   return us;
 }
 
-std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls) {
+std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls,
+                               const std::function<void(size_t done, size_t total)>& on_row) {
   std::vector<SweepRow> rows;
   rows.reserve(controls.size());
   const GraspTorqueCapability* const grasp_torque = tracker->model().grasp_torque();
@@ -73,6 +74,7 @@ std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Ve
     row.status = r.summary.status;
     row.termination = r.summary.termination;
     rows.push_back(std::move(row));
+    if (on_row) on_row(i + 1, controls.size());
   }
   return rows;
 }

@@ -2,6 +2,8 @@
 // stability suite and the benchmarks share this).
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -41,13 +43,15 @@ struct SweepRow {
 // scene stays at the scene's grasp direction).
 std::vector<Vec> SweepControls(const Scene& scene, const SweepSpec& spec);
 
-// The scene's grasp.path (every grasp's, issue 15), each leg cut into `steps_per_leg` equal steps (positions
+// The scene's grasp.path (every grasp's), each leg cut into `steps_per_leg` equal steps (positions
 // linear, grip directions normalised-linear); first waypoint first.
 std::vector<Vec> PathControls(const Scene& scene, int steps_per_leg);
 
 // Resets a tracker at the first control (solved to the cutoff) and updates it along
-// the path. Row 0 is the reset state.
-std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls);
+// the path. Row 0 is the reset state. on_row (optional) is told after each row how many
+// are done, of how many: snapthread-sweep's progress at a terminal.
+std::vector<SweepRow> RunSweep(EquilibriumTracker* tracker, const std::vector<Vec>& controls,
+                               const std::function<void(size_t done, size_t total)>& on_row = {});
 
 // One column of the sweep's table: its name in the CSV and one value per row, a number or
 // a text. snapthread-sweep writes the table as CSV (WriteSweepCsv); the Python module's

@@ -1,6 +1,7 @@
 // snapthread-sweep: offline quasi-static sweep of a scene along a straight control path,
 // one CSV row per step.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -10,6 +11,7 @@
 #include "models/registry.h"
 #include "scene/scene_schema.h"
 #include "solvers/registry.h"
+#include "progress.h"
 #include "sweep.h"
 #include "tool_main.h"
 
@@ -108,7 +110,15 @@ int main(int argc, char** argv) {
       controls = SweepControls(scene, spec);
     }
     auto tracker = MakeTracker(scene);
-    const auto rows = RunSweep(tracker.get(), controls);
+    // A line a second on a terminal (docs/cli.md, "Progress"); nothing in a pipe or a test.
+    const Progress progress("sweep");
+    auto last = std::chrono::steady_clock::now();
+    const auto rows = RunSweep(tracker.get(), controls, [&](size_t done, size_t total) {
+      const auto now = std::chrono::steady_clock::now();
+      if (!progress.active() || now - last < std::chrono::seconds(1)) return;
+      last = now;
+      progress.Step(static_cast<int>(done), static_cast<int>(total), "rows");
+    });
     if (!shape_file.empty()) {
       std::ofstream shapes(shape_file);
       if (!shapes) throw std::runtime_error("--shape-out: cannot write '" + shape_file + "'");

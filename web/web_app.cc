@@ -135,7 +135,7 @@ int RunWeb(WebOptions o) {
   const asio::ip::address address = asio::ip::make_address(o.bind, ec);
   if (ec) {
     std::fprintf(stderr, "snapthread-web: --bind '%s' is not an IP address\n", o.bind.c_str());
-    return 1;
+    return app::kExitUsage;
   }
   if (!ResolveToken(address, &o)) return 1;
   Feeds feeds;

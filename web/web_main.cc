@@ -18,8 +18,7 @@
 namespace {
 
 constexpr const char* kProgram = "snapthread-web";
-// snapthread-web has always exited 1 for bad arguments (app/exit_codes.h).
-constexpr int kExitBadArguments = snapthread::app::kExitUsageAsFailure;
+constexpr int kExitBadArguments = snapthread::app::kExitUsage;
 
 void AddWebFlags(CLI::App* app, snapthread::web::WebOptions* o) {
   using snapthread::app::FiniteNumber;

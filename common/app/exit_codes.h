@@ -8,10 +8,6 @@
 // A program that waits for something with a deadline exits kExitTimeout when it passed:
 // snapthread-ctl without an authenticated reply, the viewer's screenshot without its
 // shapes (docs/cli.md).
-//
-// Two programs still use 1 for bad arguments (kExitUsageAsFailure):
-// snapthread-report (which also exits 2 when nothing of the log could be read) and
-// snapthread-web; tests/bad_input pins what each does.
 #pragma once
 
 namespace snapthread::app {
@@ -23,7 +19,5 @@ inline constexpr int kExitUsage = 2;
 // (snapthread-viewer) did not arrive in time.
 inline constexpr int kExitTimeout = 3;
 inline constexpr int kExitNoReply = kExitTimeout;
-// For the programs above whose bad arguments exit 1.
-inline constexpr int kExitUsageAsFailure = kExitFailure;
 
 }  // namespace snapthread::app

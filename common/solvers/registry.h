@@ -1,5 +1,5 @@
 // The solver registry: every equilibrium method by name, with a one-line doc and a
-// factory (issue 11 #3, like the model registry). MakeSolver looks names up here; help
+// factory, like the model registry. MakeSolver looks names up here; help
 // texts, the stability suite and the bench iterate it instead of spelling method lists.
 // The built-in methods are registered in registry.cc, one line each; a test may add its
 // own (a test-only solver) before it makes one.

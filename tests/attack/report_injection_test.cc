@@ -346,7 +346,7 @@ TEST(ReportInjectionCliTest, RefusesASessionOutsideTheGrammar) {
         RunReport(dir, {log, "--session", session, "--out", dir + "/out"}, dir + "/report");
     ASSERT_TRUE(r.exited);
     if (session.empty()) continue;  // "" means: infer it
-    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find("bad --session"), std::string::npos) << r.err;
     EXPECT_TRUE(PrintableLines(r.err)) << r.err;
   }

@@ -319,7 +319,7 @@ TEST_F(WebAccessTest, ATokenFileOthersMayReadOrABadTokenIsRefusedAtStart) {
   const test_support::ProcessResult both = run({"--token", token_, "--token-file", WriteTokenFile(token_, 0600)});
   EXPECT_NE(both.exit_code, 0) << "--token and --token-file exclude each other: " << both.out;
   const test_support::ProcessResult bad_name = run({"--host-name", "evil.example; script-src *"});
-  EXPECT_EQ(bad_name.exit_code, 1) << bad_name.out;
+  EXPECT_EQ(bad_name.exit_code, 2) << bad_name.out;
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// snapthread-bench: speed against accuracy (issue 6).
+// snapthread-bench: speed against accuracy.
 //
 //  * accuracy   each standard sweep with a snap, per method / cutoff / iteration budget:
 //               updates per second against force and state error versus the tight
@@ -71,7 +71,7 @@ TimedSweep TimeSweep(const Scene& scene, const std::vector<Vec>& controls, int r
 // ---------------------------------------------------------------- rod speed
 
 // Updates per second along scenes/rod_greenhill.yaml's path (2000 steps) at each n,
-// logged one line per n (issue 14's targets: n = 10 >= 50 k, n = 100 >= 10 k).
+// logged one line per n (the rod's targets: n = 10 >= 50 k, n = 100 >= 10 k).
 struct RodSpeedRow {
   int n = 0;
   Spread rate_hz;
@@ -294,7 +294,7 @@ void PrintAdvice(const Advice& advice, std::ostream& out);
 
 // ---------------------------------------------------------------- contact scaling
 
-// Issue 15 item 8, on the scaling chart: self-contact's E + E_x + E_xx (broad and narrow
+// On the scaling chart: self-contact's E + E_x + E_xx (broad and narrow
 // phase) on a close helix of n segments, whose active pairs grow like n
 // (contact_scaling.cc). Evaluations per second, median over repetitions.
 struct ContactScalingRow {

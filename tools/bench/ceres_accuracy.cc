@@ -1,4 +1,4 @@
-// Issue 13's "10x faster than Ceres at equal force accuracy", decided on the thread3d
+// "10x faster than Ceres at equal force accuracy", decided on the thread3d
 // path: a reference trace (the project's tracker at a tight cutoff, each row polished by
 // Newton to round-off), the project's force error against it, and Ceres Solver down a
 // ladder of cutoffs per setting until its force error (max and median over the rows)
@@ -87,7 +87,7 @@ PolishedTrace MakePolishedTrace(const Scene& scene, const std::vector<Vec>& cont
   return ref;
 }
 
-// Issue 13's Ceres side: the reference trace, the project's force error against it, and
+// The Ceres side: the reference trace, the project's force error against it, and
 // the Ceres settings, each solver down the cutoff ladder until it matches the project.
 }  // namespace
 
@@ -173,7 +173,7 @@ void WriteCeresCsv(const std::vector<PathRow>& rows, std::ostream& out) {
 // The equal-accuracy part of the table: every Ceres setting run, then the verdict.
 void PrintCeresAccuracy(const std::vector<PathRow>& rows, std::ostream& out) {
   char buf[400];
-  out << "Equal force accuracy (issue 13): reference = the project's equilibria, each Newton-polished to\n"
+  out << "Equal force accuracy: reference = the project's equilibria, each Newton-polished to\n"
          "round-off; force error = |F - F_ref|_inf / force scale over rows 1..steps; Ceres down a\n"
          "ladder of cutoffs per setting until max and median are both <= the project's:\n";
   std::snprintf(buf, sizeof buf, "%6s %14s %14s %14s %13s %13s\n", "n", "ref |E_x| max", "ref |E_x| med",

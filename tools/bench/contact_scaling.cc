@@ -1,4 +1,4 @@
-// The contact line of the scaling chart (issue 15 item 8: "contact cost linear in n"):
+// The contact line of the scaling chart ("contact cost linear in n"):
 // self-contact's energy, gradient and Hessian (contact/self_contact.h: broad phase, then
 // the narrow phase on its candidate pairs) on a close helix of n segments, where every
 // segment lies within the barrier's reach of the turns above and below it, so the active

@@ -199,14 +199,14 @@ void RunAccuracyChart(const BenchFlags& f, BenchOutput* out) {
 }
 
 void RunRodChart(const BenchFlags& f, BenchOutput* out) {
-  // Issue 14's targets: n = 10 >= 50 k and n = 100 >= 10 k updates/s.
+  // The rod's targets: n = 10 >= 50 k and n = 100 >= 10 k updates/s.
   std::ostringstream table;
   table << "== rod: updates/s along rod_greenhill's path (median of " << std::max(f.repetitions, 3) << " runs)\n";
   RunRodSpeedBench(f.scenes_dir, {10, 100}, std::max(f.repetitions, 3), table);
   out->Table(table);
 }
 
-// Self-contact's cost against n (issue 15 item 8), for the scaling chart's table and plot.
+// Self-contact's cost against n, for the scaling chart's table and plot.
 std::vector<ContactScalingRow> ContactScalingTable(const ScalingOptions& o, std::ostringstream& table) {
   const auto contact = RunContactScaling(o.ns, o.repetitions, o.min_sample_s);
   table << "== scaling: self-contact E + E_x + E_xx on a close helix (evaluations/s, median of " << o.repetitions

@@ -1,4 +1,4 @@
-// The thread3d path benchmark (issue 13): the issue's n = 1000 sweep (grasp from
+// The thread3d path benchmark: the n = 1000 hand-speed sweep (grasp from
 // (n - 0.5, 0.5, 0) to (n - 0.5, 0.8, 0.2), thread3d_loop's thread without the grip
 // direction, higher-order, cutoff 1e-6) and the same path at n = 10 and 100, timed per
 // update; the floor (a plain banded LDL^T factor + solve of the same size and band,
@@ -27,7 +27,7 @@ struct PathOptions {
   double force_tolerance = -1.0;
   bool ceres = true;
   int floor_samples = 301;  // timed factor + solve pairs per floor
-  // Equal force accuracy (issue 13's "10x faster than Ceres at equal force accuracy"):
+  // Equal force accuracy (the project against Ceres, each at its own best settings):
   // the reference trace is the project's rows, each polished by Newton steps while
   // ||E_x|| falls (ceres_accuracy.cc); Ceres runs at cutoff 10^-k cutoff,
   // k = 0 .. ceres_ladder - 1, with each of CeresSolverNames(n), until its force error

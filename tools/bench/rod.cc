@@ -1,4 +1,4 @@
-// The rod's speed (issue 14, item 8): median updates per second along the Greenhill
+// The rod's speed: median updates per second along the Greenhill
 // path (scenes/rod_greenhill.yaml, 0 -> 720 degrees of roll in 2000 steps through the
 // buckle) at several n, each from a fresh tracker (the reset is not timed).
 #include <iomanip>

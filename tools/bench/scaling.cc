@@ -257,7 +257,7 @@ void PrintScalingTargets(const std::vector<ScalingRow>& rows, const std::vector<
     return 0.0;
   };
   char buf[256];
-  out << "issue-6 targets (higher-order, auto backend, cutoff 1e-6, hand-speed update):\n";
+  out << "targets (higher-order, auto backend, cutoff 1e-6, hand-speed update):\n";
   for (const auto& [n, target] : std::vector<std::pair<int, double>>{{10, 1e5}, {100, 1e4}, {1000, 1e3}}) {
     const double r = rate("higher-order", "auto", n);
     if (r <= 0) {

@@ -24,7 +24,7 @@ struct KeygenOptions {
   std::string host = "LAB_PC";  // --host: the other machine, for the printed scp commands
   bool force = false;      // --force: replace an existing root key or credential
   bool show_id = false;    // --id
-  std::string role;        // --role device|operator|observer (issue), device|operator (revoke)
+  std::string role;        // --role device|operator|observer (issuing), device|operator (revoke)
   std::string device;      // --device NAME
   std::string name;        // --name NAME
   std::string expires;     // --expires UNIX_S | never

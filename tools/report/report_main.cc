@@ -29,8 +29,9 @@ namespace app = snapthread::app;
 using namespace snapthread::report;
 
 constexpr const char* kProgram = "snapthread-report";
-constexpr int kExitBadArguments = app::kExitUsageAsFailure;
-constexpr int kExitUnreadable = 2;  // nothing of the log could be read, or it is too large
+constexpr int kExitBadArguments = app::kExitUsage;
+// Nothing of the log could be read, or it is too large: a failure outside the arguments.
+constexpr int kExitUnreadable = app::kExitFailure;
 
 struct ReportOptions {
   std::string log_path, out_dir;

@@ -42,7 +42,7 @@ struct DeviceRow {
   double force_norm_n; int64_t force_clamps; int64_t stiffness_clamps; int64_t slew_limits;
   int64_t fades; int64_t snaps_felt;
 };
-// solver_status_t's knot type and active contacts (issue 15).
+// solver_status_t's knot type and active contacts.
 struct KnotRow { double t_s; std::string knot; int determinant; int contacts; };
 struct RoundTripRow { double t_s; double loop_us; double server_us; };
 

@@ -1,5 +1,5 @@
 #!/bin/sh
-# The rod's charts in docs/images (issue 14, item 7), from snapthread-sweep runs:
+# The rod's charts in docs/images, from snapthread-sweep runs:
 #   rod_greenhill.png  critical twist against n beside Greenhill's 8.9868 EI/GJ, and the
 #                      torque-twist curve through the buckle (n = 40);
 #   rod_hockling.png   the rod just before and just after the loop snaps in, and the

@@ -1,5 +1,5 @@
 #!/bin/sh
-# The viewer's picture of a twisted rod in docs/images (issue 14 item 3): rod_greenhill run
+# The viewer's picture of a twisted rod in docs/images: rod_greenhill run
 # along its path (the grasp rolled about the tangent) to ROW of STEPS, its shape built by
 # the server's code (snapthread-scene-shape) and drawn by snapthread-viewer --screenshot
 # under Xvfb: the dark stripe along the material director d1, the twist density as colour.

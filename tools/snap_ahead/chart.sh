@@ -1,5 +1,5 @@
 #!/bin/sh
-# The snap-ahead chart in docs/images (issue 17): snap position error, in servo ticks of
+# The snap-ahead chart in docs/images: snap position error, in servo ticks of
 # travel, against the server's update rate (1000, 300, 100, 30 Hz), with and without
 # snap-ahead, for curve2d_snap and thread3d_loop (snapthread-snap-ahead-chart: sessions
 # on a fake clock, so the numbers do not depend on the machine's load). thread3d_loop's
