@@ -13,6 +13,9 @@ constexpr double kDifferenceStep = 1e-2;
 // In a flat valley the quartic's minimum counts as the followed one out to this many
 // reduction caps (max_reduction_step) along v'; beyond, the minimum is gone.
 constexpr double kFlatValleyReach = 4.0;
+// A valley is flat when lambda_0 is below this fraction of E_xx's largest diagonal entry
+// (a 1000-segment thread: ~1e-12); a stiffer E_xx with a long Newton step is past a fold.
+constexpr double kFlatValleyRatio = 1e-6;
 // Newton steps that stall at the gradient's round-off before a row whose force is not
 // certified yet is called accuracy-limited.
 constexpr int kRoundOffRetries = 2;
@@ -283,6 +286,15 @@ void HigherOrderSolver::SnapAndStop(const Vec& u, Vec* x, SolverSummary* s, doub
     s->termination = Termination::kConverged;
 }
 
+double HigherOrderSolver::MaxHessianDiagonal() {
+  const SparseMatrix& hess = Hessian();
+  double m = 0.0;
+  for (int j = 0; j < hess.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(hess, j); it; ++it)
+      if (it.row() == j) m = std::max(m, std::abs(it.value()));
+  return m;
+}
+
 void HigherOrderSolver::FinishFlatValley(const Vec& u, Vec* x, SolverSummary* s, double* r) {
   const bool done = MinimizeFully(u, x, s);
   *r = EvalGradient(*x, u, s);
@@ -379,10 +391,7 @@ bool HigherOrderSolver::ReductionIteration(const Vec& u, Vec* x, LinearSolverSta
   const double r_before = *r;
   *r = EvalGradientAndHessian(*x, u, s);
   *reduction_stalls = (*r < 0.5 * r_before) ? 0 : *reduction_stalls + 1;
-  if (flat_valley) {
-    return true;
-  }
-  if (*reduction_stalls >= 2 || *r > r_before) {
+  if (!flat_valley && (*reduction_stalls >= 2 || *r > r_before)) {
     // Stalled at the gradient's round-off is converged (no vanished minimum to leave).
     if (AtRoundOff(*r, *x, u, s)) {
       StopAtRoundOff(s);
@@ -430,11 +439,19 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
           StopAtRoundOff(&s);
           break;
         }
-        // E_xx positive definite (no inertia change: NearFold saw no negative pivot) and
-        // a Newton step longer than the reduction's cap: a flat valley, along whose soft
-        // mode the quadratic model overshoots. The reduction steps along it with the
-        // reduced quartic (2.54-2.55), and tells whether its minimum is still near.
+        // E_xx positive definite (no inertia change: NearFold saw no negative pivot), flat
+        // (lambda_0 below kFlatValleyRatio of its largest diagonal entry) and a Newton step
+        // longer than the reduction's cap: a flat valley, along whose soft mode the
+        // quadratic model overshoots. The reduction steps along it with the reduced
+        // quartic (2.54-2.55), and tells whether its minimum is still near. A stiff E_xx
+        // with such a step has carried the state over a fold: finish it as a snap.
+        flat_lambda_ = kFlatValleyRatio * MaxHessianDiagonal();
+        if (!(lambda0 <= flat_lambda_)) {
+          SnapAndStop(u, &xr, &s, &r);
+          break;
+        }
         flat_valley = true;
+        s.flat_valley = true;
       }
       degenerate = check != NewtonCheck::kTake;
     }
@@ -467,6 +484,9 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   if (s.termination == Termination::kBudgetSpent && in_flat_valley) FinishFlatValley(u, x, &s, &r);
   // A budget spent on an indefinite E_xx finishes the snap in this update (Conclude).
   Conclude(u, x, &s, /*leave_saddles=*/true, /*finish_snap_on_spent_budget=*/true);
+  // On a branch as flat as a flat valley (lambda_min below the flatness scale met there)
+  // the state may slide far on it: the tracker then asks for the solve's own evidence.
+  if (s.lambda_min > 0.0 && s.lambda_min <= flat_lambda_) s.flat_valley = true;
   return s;
 }
 

@@ -58,6 +58,8 @@ class HigherOrderSolver final : public SolverBase {
   // A budget spent in a flat valley: minimise on past the budget (no snap: the state is
   // still on its branch), converged on the same stopping rule; |E_x| in *r.
   void FinishFlatValley(const Vec& u, Vec* x, SolverSummary* s, double* r);
+  // The largest |diagonal entry| of E_xx at the factorised state (the flatness scale).
+  double MaxHessianDiagonal();
   NewtonCheck CheckNewtonStep(const Vec& u, const Vec& x, double lambda0, SolverSummary* s, bool* trial_gradient);
   // Takes the Newton step and updates |E_x| in *r; true when it did not halve |E_x|.
   bool NewtonIteration(const Vec& u, Vec* x, bool trial_gradient, double* r, SolverSummary* s);
@@ -68,6 +70,9 @@ class HigherOrderSolver final : public SolverBase {
   bool ReductionIteration(const Vec& u, Vec* x, LinearSolverStatus st, bool flat_valley, int* reduction_stalls,
                           double* r, SolverSummary* s);
 
+  // kFlatValleyRatio times E_xx's largest diagonal entry where a long Newton step was
+  // last judged (0: never): lambda_min below it is a flat valley.
+  double flat_lambda_ = 0.0;
   std::vector<int> col_k_rows_, col_k_pos_, row_k_pos_;
   Vec delta_, vt_, w_, rhs_, gp_, gm_, xs_, g_trial_;
 };

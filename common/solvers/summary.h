@@ -52,6 +52,7 @@ struct SolverSummary {
   // snap minimiser ran (whether the state really changed branch is the tracker's call).
   bool snapped = false;
   bool used_reduction = false;  // higher-order: the one-direction reduction was used
+  bool flat_valley = false;     // higher-order: a step slid along a flat valley (no snap)
   double solve_us = 0.0;
   // Certified force error of the returned state, model force units, max norm over the
   // controls (docs/accuracy.md): the force change |E_ux E_xx^-1 E_x| of the Newton

@@ -200,15 +200,16 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   u_ = u;
   result_.summary = solver_->Solve(u, &x_);
   FinishUnfinishedSnap(u);
-  // A snap is a jump to another branch: the solve left the followed minimum's basin by
-  // its own evidence (summary.snapped: an inertia change, or the followed minimum gone)
-  // and the state left the predicted one by more than the threshold. A long slide along
-  // a flat valley on the same branch is no snap. The status is DecideStatus's, now with
-  // that fact. A snap spread over updates jumps from the state predicted where it began.
+  // A snap is a jump to another branch: the state left the predicted one by more than
+  // the threshold, unless the solve slid along a flat valley on its branch and saw no
+  // sign of leaving it (summary.snapped: an inertia change, or the followed minimum
+  // gone). The status is DecideStatus's, now with that fact. A snap spread over updates
+  // jumps from the state predicted where it began.
   if (!continuing_snap) snap_origin_ = x_pred_;
   const double jump = (x_ - snap_origin_).lpNorm<Eigen::Infinity>();
-  result_.summary.status =
-      DecideStatus(result_.summary, options_.degeneracy_ratio, result_.summary.snapped && jump > snap_threshold_);
+  const bool slid = result_.summary.flat_valley && !result_.summary.snapped;
+  const bool left_branch = jump > snap_threshold_ && !slid;
+  result_.summary.status = DecideStatus(result_.summary, options_.degeneracy_ratio, left_branch);
   result_.snapped = result_.summary.status == EquilibriumStatus::kSnapped;
   // After a snap the secant would point along the jump: restart it (and during one).
   have_prev_ = !result_.snapped && result_.summary.status != EquilibriumStatus::kSnapping;
