@@ -286,6 +286,28 @@ void HigherOrderSolver::SnapAndStop(const Vec& u, Vec* x, SolverSummary* s, doub
     s->termination = Termination::kConverged;
 }
 
+bool HigherOrderSolver::EnterFlatValley(const Vec& u, Vec* x, double lambda0, SolverSummary* s, double* r) {
+  // A long Newton step from a gradient at its round-off is noise amplified along a flat
+  // valley, not a fold crossed: the state has converged as far as it can.
+  if (AtRoundOff(*r, *x, u, s)) {
+    StopAtRoundOff(s);
+    return false;
+  }
+  // E_xx positive definite (no inertia change: NearFold saw no negative pivot), flat
+  // (lambda_0 below kFlatValleyRatio of its largest diagonal entry) and a Newton step
+  // longer than the reduction's cap: a flat valley, along whose soft mode the quadratic
+  // model overshoots. The reduction steps along it with the reduced quartic (2.54-2.55),
+  // and tells whether its minimum is still near. A stiff E_xx with such a step has
+  // carried the state over a fold: finish it as a snap.
+  flat_lambda_ = kFlatValleyRatio * MaxHessianDiagonal();
+  if (!(lambda0 <= flat_lambda_)) {
+    SnapAndStop(u, x, s, r);
+    return false;
+  }
+  s->flat_valley = true;
+  return true;
+}
+
 double HigherOrderSolver::MaxHessianDiagonal() {
   const SparseMatrix& hess = Hessian();
   double m = 0.0;
@@ -433,25 +455,8 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
         break;
       }
       if (check == NewtonCheck::kSnap) {
-        // A long Newton step from a gradient at its round-off is noise amplified along a
-        // flat valley, not a fold crossed: the state has converged as far as it can.
-        if (AtRoundOff(r, xr, u, &s)) {
-          StopAtRoundOff(&s);
-          break;
-        }
-        // E_xx positive definite (no inertia change: NearFold saw no negative pivot), flat
-        // (lambda_0 below kFlatValleyRatio of its largest diagonal entry) and a Newton step
-        // longer than the reduction's cap: a flat valley, along whose soft mode the
-        // quadratic model overshoots. The reduction steps along it with the reduced
-        // quartic (2.54-2.55), and tells whether its minimum is still near. A stiff E_xx
-        // with such a step has carried the state over a fold: finish it as a snap.
-        flat_lambda_ = kFlatValleyRatio * MaxHessianDiagonal();
-        if (!(lambda0 <= flat_lambda_)) {
-          SnapAndStop(u, &xr, &s, &r);
-          break;
-        }
+        if (!EnterFlatValley(u, &xr, lambda0, &s, &r)) break;
         flat_valley = true;
-        s.flat_valley = true;
       }
       degenerate = check != NewtonCheck::kTake;
     }

@@ -58,6 +58,10 @@ class HigherOrderSolver final : public SolverBase {
   // A budget spent in a flat valley: minimise on past the budget (no snap: the state is
   // still on its branch), converged on the same stopping rule; |E_x| in *r.
   void FinishFlatValley(const Vec& u, Vec* x, SolverSummary* s, double* r);
+  // After a Newton step longer than the reduction's cap (E_xx positive definite): true
+  // when x is in a flat valley (the iteration follows it with the reduction); false when
+  // the solve has ended here (converged at round-off, or a stiff E_xx: a snap, finished).
+  bool EnterFlatValley(const Vec& u, Vec* x, double lambda0, SolverSummary* s, double* r);
   // The largest |diagonal entry| of E_xx at the factorised state (the flatness scale).
   double MaxHessianDiagonal();
   NewtonCheck CheckNewtonStep(const Vec& u, const Vec& x, double lambda0, SolverSummary* s, bool* trial_gradient);
