@@ -13,6 +13,10 @@ bool SolverBase::GlobalizedStep(const Vec& u, Vec* x, SolverSummary* s) {
   // has no negative pivot, then backtrack on the energy (Armijo).
   const LinearSolverStatus st = FactorAt(*x, u, s);
   const SymmetricLinearSolver* f = w.factor.get();
+  // More negative pivots than at the last returned state: the inertia has changed, the
+  // state is out of the followed minimum's basin (a fold crossed, or a saddle met).
+  if (st == LinearSolverStatus::kSuccess && w.factor->NegativePivots() > accepted_negative_pivots_)
+    s->snapped = true;
   if (st != LinearSolverStatus::kSuccess || w.factor->NegativePivots() > 0) {
     EnsureSparseHessian();
     double max_diag = 0.0;

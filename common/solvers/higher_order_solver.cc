@@ -10,6 +10,15 @@ namespace {
 // Step for the central differences of the analytic gradient along v' (|v'|_inf = 1 in
 // model units): r = D^3E[v',v'] to O(h^2) with round-off ~ eps |E_x| / h^2.
 constexpr double kDifferenceStep = 1e-2;
+// In a flat valley the quartic's minimum counts as the followed one out to this many
+// reduction caps (max_reduction_step) along v'; beyond, the minimum is gone.
+constexpr double kFlatValleyReach = 4.0;
+// A valley is flat when lambda_0 is below this fraction of E_xx's largest diagonal entry
+// (a 1000-segment thread: ~1e-12); a stiffer E_xx with a long Newton step is past a fold.
+constexpr double kFlatValleyRatio = 1e-6;
+// Newton steps that stall at the gradient's round-off before a row whose force is not
+// certified yet is called accuracy-limited.
+constexpr int kRoundOffRetries = 2;
 
 double QuarticSlope(const ReducedQuartic& q, double s) {
   return q.phi1 + s * (2.0 * q.phi2 + s * (3.0 * q.phi3 + s * 4.0 * q.phi4));
@@ -90,6 +99,32 @@ bool FollowedMinimum(const ReducedQuartic& q, double cap, double* s_out) {
   return true;
 }
 
+bool QuarticMinimumNearby(const ReducedQuartic& q, double cap, double reach, double* s_out) {
+  if (!(q.phi4 > 0.0) || !(reach > 0.0)) return false;
+  if (q.phi1 == 0.0) {
+    *s_out = 0.0;
+    return q.phi2 >= 0.0;
+  }
+  // phi' starts against the downhill direction and, with phi4 > 0, ends along it: the
+  // first sign change on a doubling grid out to `reach`, then bisection to the root.
+  const double dir = q.phi1 > 0.0 ? -1.0 : 1.0;
+  double lo = 0.0, hi = 0.0;
+  for (double t = reach / 64.0;; t = std::min(2.0 * t, reach)) {
+    if (QuarticSlope(q, dir * t) * dir >= 0.0) {
+      hi = t;
+      break;
+    }
+    lo = t;
+    if (t >= reach) return false;
+  }
+  for (int it = 0; it < 60 && hi - lo > 1e-14 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (QuarticSlope(q, dir * mid) * dir >= 0.0 ? hi : lo) = mid;
+  }
+  *s_out = dir * std::min(hi, cap);
+  return true;
+}
+
 HigherOrderSolver::HigherOrderSolver(const Model& model, const SolverOptions& options)
     : SolverBase(model, options) {
   for (Vec* v : {&delta_, &vt_, &w_, &rhs_, &gp_, &gm_, &xs_, &g_trial_}) v->resize(num_states());
@@ -119,7 +154,7 @@ LinearSolverStatus HigherOrderSolver::FactorRestricted(int k, SolverSummary* s) 
   return FactorModified(s);
 }
 
-HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec* x,
+HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec* x, bool flat_valley,
                                                                SolverSummary* s) {
   s->used_reduction = true;
   const Vec& v = LowestEigenvector();
@@ -135,7 +170,12 @@ HigherOrderSolver::StepResult HigherOrderSolver::ReductionStep(const Vec& u, Vec
   if (!ReducedQuarticAt(u, *x, k, s, &q)) return StepResult::kFailed;
 
   double s_star = 0.0;
-  if (!FollowedMinimum(q, options().max_reduction_step, &s_star)) return StepResult::kSnap;
+  // A flat valley's minimum held by the quartic term alone is still the followed one when
+  // it is near: within a few caps (kFlatValleyReach), as far as the expansion is trusted.
+  const double cap = options().max_reduction_step;
+  if (!FollowedMinimum(q, cap, &s_star) &&
+      !(flat_valley && QuarticMinimumNearby(q, cap, kFlatValleyReach * cap, &s_star)))
+    return StepResult::kSnap;
 
   return BacktrackAlongCurve(u, x, s_star, e0);
 }
@@ -240,8 +280,49 @@ void HigherOrderSolver::SnapAndStop(const Vec& u, Vec* x, SolverSummary* s, doub
     s->message = "snap minimiser did not converge";
   }
   *r = EvalGradient(*x, u, s);
-  if (s->termination != Termination::kLinearSolverFailed && (*r < options().cutoff || s->at_round_off))
+  // Converged on the same rule as every iteration (the cutoff ceiling and the certified
+  // force error, Converged), or at the gradient's round-off; not on |E_x| < cutoff alone.
+  if (s->termination != Termination::kLinearSolverFailed && (s->at_round_off || Converged(*r, *x, u, s)))
     s->termination = Termination::kConverged;
+}
+
+bool HigherOrderSolver::EnterFlatValley(const Vec& u, Vec* x, double lambda0, SolverSummary* s, double* r) {
+  // A long Newton step from a gradient at its round-off is noise amplified along a flat
+  // valley, not a fold crossed: the state has converged as far as it can.
+  if (AtRoundOff(*r, *x, u, s)) {
+    StopAtRoundOff(s);
+    return false;
+  }
+  // E_xx positive definite (no inertia change: NearFold saw no negative pivot), flat
+  // (lambda_0 below kFlatValleyRatio of its largest diagonal entry) and a Newton step
+  // longer than the reduction's cap: a flat valley, along whose soft mode the quadratic
+  // model overshoots. The reduction steps along it with the reduced quartic (2.54-2.55),
+  // and tells whether its minimum is still near. A stiff E_xx with such a step has
+  // carried the state over a fold: finish it as a snap.
+  flat_lambda_ = kFlatValleyRatio * MaxHessianDiagonal();
+  if (!(lambda0 <= flat_lambda_)) {
+    SnapAndStop(u, x, s, r);
+    return false;
+  }
+  s->flat_valley = true;
+  return true;
+}
+
+double HigherOrderSolver::MaxHessianDiagonal() {
+  const SparseMatrix& hess = Hessian();
+  double m = 0.0;
+  for (int j = 0; j < hess.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(hess, j); it; ++it)
+      if (it.row() == j) m = std::max(m, std::abs(it.value()));
+  return m;
+}
+
+void HigherOrderSolver::FinishFlatValley(const Vec& u, Vec* x, SolverSummary* s, double* r) {
+  const bool done = MinimizeFully(u, x, s);
+  *r = EvalGradient(*x, u, s);
+  // The stopping rule of every iteration: the cutoff ceiling and the certified force
+  // error (Converged), or |E_x| at its round-off.
+  if (done && (Converged(*r, *x, u, s) || s->at_round_off)) s->termination = Termination::kConverged;
 }
 
 HigherOrderSolver::NewtonCheck HigherOrderSolver::CheckNewtonStep(const Vec& u, const Vec& x, double lambda0,
@@ -289,15 +370,15 @@ bool HigherOrderSolver::NewtonIteration(const Vec& u, Vec* x, bool trial_gradien
   return !(*r < 0.5 * r_before);
 }
 
-bool HigherOrderSolver::ReductionIteration(const Vec& u, Vec* x, LinearSolverStatus st, int* reduction_stalls,
-                                           double* r, SolverSummary* s) {
+bool HigherOrderSolver::ReductionIteration(const Vec& u, Vec* x, LinearSolverStatus st, bool flat_valley,
+                                           int* reduction_stalls, double* r, SolverSummary* s) {
   // A factorisation that failed on an exactly singular E_xx still allows the
   // reduction: it needs only the restricted factor and the last eigenvector.
   const bool many_negative = st == LinearSolverStatus::kSuccess && HessianFactor().NegativePivots() > 1;
   StepResult res = StepResult::kFailed;
   if (!many_negative) {
     EnsureEigenvector();
-    res = ReductionStep(u, x, s);
+    res = ReductionStep(u, x, flat_valley, s);
   }
   if (res == StepResult::kSnap || many_negative) {
     // At the gradient's round-off the reduced quartic is noise: no vanished minimum.
@@ -332,7 +413,7 @@ bool HigherOrderSolver::ReductionIteration(const Vec& u, Vec* x, LinearSolverSta
   const double r_before = *r;
   *r = EvalGradientAndHessian(*x, u, s);
   *reduction_stalls = (*r < 0.5 * r_before) ? 0 : *reduction_stalls + 1;
-  if (*reduction_stalls >= 2 || *r > r_before) {
+  if (!flat_valley && (*reduction_stalls >= 2 || *r > r_before)) {
     // Stalled at the gradient's round-off is converged (no vanished minimum to leave).
     if (AtRoundOff(*r, *x, u, s)) {
       StopAtRoundOff(s);
@@ -353,9 +434,11 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
   bool newton_stalled = false;
   bool trial_gradient = false;  // g_trial_ holds E_x at xs_ (the Newton trial state)
   int reduction_stalls = 0;
+  bool in_flat_valley = false;  // the last iteration stepped along a flat valley
+  int round_off_stalls = 0;     // Newton steps stalled at round-off with the force uncertified
   while (NextIteration(r, u, x, &s)) {
     const LinearSolverStatus st = FactorAt(xr, u, &s);
-    bool degenerate = true;
+    bool degenerate = true, flat_valley = false;
     double lambda0 = 0.0;
     if (st == LinearSolverStatus::kSuccess) {
       lambda0 = UpdateEigenpair(1);
@@ -372,31 +455,43 @@ SolverSummary HigherOrderSolver::Solve(const Vec& u, Vec* x) {
         break;
       }
       if (check == NewtonCheck::kSnap) {
-        // A long Newton step from a gradient at its round-off is noise amplified along a
-        // flat valley, not a fold crossed: the state has converged as far as it can.
-        if (AtRoundOff(r, xr, u, &s)) {
-          StopAtRoundOff(&s);
-          break;
-        }
-        SnapAndStop(u, &xr, &s, &r);
-        break;
+        if (!EnterFlatValley(u, &xr, lambda0, &s, &r)) break;
+        flat_valley = true;
       }
-      degenerate = check == NewtonCheck::kRefused;
+      degenerate = check != NewtonCheck::kTake;
     }
     if (!degenerate) {
       newton_stalled = NewtonIteration(u, &xr, trial_gradient, &r, &s);
       // A regular Newton step that does not halve |E_x| at its round-off: converged as
       // far as double precision allows (not a fold: the reduction would only wander).
+      // In a flat valley round-off in E_x moves the Newton step far along the soft mode,
+      // and one stalled step says little: where the force is not certified yet, a few
+      // more Newton steps (kRoundOffRetries) before the row is called accuracy-limited.
       if (newton_stalled && AtRoundOff(r, xr, u, &s)) {
-        StopAtRoundOff(&s);
-        break;
+        if (Converged(r, xr, u, &s)) {
+          s.termination = Termination::kConverged;
+          break;
+        }
+        if (++round_off_stalls > kRoundOffRetries) {
+          StopAtRoundOff(&s);
+          break;
+        }
+        newton_stalled = false;
       }
       continue;
     }
-    if (!ReductionIteration(u, &xr, st, &reduction_stalls, &r, &s)) break;
+    in_flat_valley = flat_valley;
+    if (!ReductionIteration(u, &xr, st, flat_valley, &reduction_stalls, &r, &s)) break;
   }
+  // A budget spent sliding along a flat valley (E_xx positive definite: no inertia
+  // change, no snap) is finished in this update like a snap (DESIGN.md #4), without the
+  // snap's label: the state is still on its branch.
+  if (s.termination == Termination::kBudgetSpent && in_flat_valley) FinishFlatValley(u, x, &s, &r);
   // A budget spent on an indefinite E_xx finishes the snap in this update (Conclude).
   Conclude(u, x, &s, /*leave_saddles=*/true, /*finish_snap_on_spent_budget=*/true);
+  // On a branch as flat as a flat valley (lambda_min below the flatness scale met there)
+  // the state may slide far on it: the tracker then asks for the solve's own evidence.
+  if (s.lambda_min > 0.0 && s.lambda_min <= flat_lambda_) s.flat_valley = true;
   return s;
 }
 

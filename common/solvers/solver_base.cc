@@ -58,6 +58,7 @@ void SolverBase::Reset() {
   factor_at_state_ = false;
   err_serial_ = -1;
   lambda_ref_ = -1.0;
+  accepted_negative_pivots_ = 0;
 }
 
 const SymmetricLinearSolver* SolverBase::Factorization() const {
@@ -178,6 +179,7 @@ void SolverBase::Conclude(const Vec& u, Vec* x, SolverSummary* s, bool leave_sad
   if (s->termination == Termination::kConverged && s->at_round_off && force_target_ > 0.0 &&
       s->force_error > force_target_)
     s->termination = Termination::kAccuracyLimited;
+  if (s->IsSolutionUsable() && s->negative_pivots >= 0) accepted_negative_pivots_ = s->negative_pivots;
   // The status against the reference of the last regular state, then the reference.
   s->lambda_ref = lambda_ref_;
   s->status = DecideStatus(*s, options_.degeneracy_ratio, /*left_branch=*/false);

@@ -139,7 +139,8 @@ class SolverBase : public EquilibriumSolver {
   // keep using the factorisation (see kReuseStep in solver_base.cc).
   void TakeNewtonStep(const Vec& u, Vec* x);
   // Newton-ls step: inertia-corrected Newton direction + Armijo backtracking from x with
-  // Gradient(). Returns false if no decrease could be found.
+  // Gradient(). Returns false if no decrease could be found. An E_xx with more negative
+  // pivots than at the last returned state is an inertia change: it marks s->snapped.
   bool GlobalizedStep(const Vec& u, Vec* x, SolverSummary* s);
   // Globalised minimisation to the cutoff past the iteration budget (a snap is finished
   // inside its control step, DESIGN.md #4). From a saddle, where the gradient vanishes,
@@ -235,6 +236,9 @@ class SolverBase : public EquilibriumSolver {
   long err_serial_ = -1;     // factor_serial_ of the cached force error (at ws_.err_state)
   double err_value_ = -1.0;
   double lambda_ref_ = -1.0;     // lambda_0 at the last regular converged state
+  // Negative pivots of E_xx at the last usable returned state: a factorisation with more
+  // is an inertia change (the state left the followed minimum's basin, GlobalizedStep).
+  int accepted_negative_pivots_ = 0;
   // MinimizeFully stopped at the time budget: the snap goes on at the next update.
   bool snap_in_progress_ = false;
   double best_residual_ = 0.0;   // stagnation tracking in NextIteration

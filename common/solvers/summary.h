@@ -48,10 +48,12 @@ struct SolverSummary {
   // against (DESIGN.md #1); <= 0 before the first regular state.
   double lambda_ref = -1.0;
   int negative_pivots = 0;   // inertia of E_xx at the returned state (-1: not factorised)
-  // higher-order: the reduction found that the followed minimum had vanished and the
-  // snap minimiser ran (whether the state really changed branch is the tracker's call).
+  // The solve saw it leave the followed minimum: the reduction found it vanished (higher-
+  // order) or an E_xx with more negative pivots than at the last returned state (an
+  // inertia change, GlobalizedStep); whether the state changed branch is the tracker's call.
   bool snapped = false;
   bool used_reduction = false;  // higher-order: the one-direction reduction was used
+  bool flat_valley = false;     // higher-order: a step slid along a flat valley (no snap)
   double solve_us = 0.0;
   // Certified force error of the returned state, model force units, max norm over the
   // controls (docs/accuracy.md): the force change |E_ux E_xx^-1 E_x| of the Newton

@@ -204,12 +204,15 @@ const TrackResult& EquilibriumTracker::Update(const Vec& u) {
   FinishUnfinishedSnap(u);
   RetryFailedUpdate(u);
   // A snap is a jump to another branch: the state left the predicted one by more than
-  // the threshold (for every method alike, so the charts compare like with like). The
-  // status is DecideStatus's, now with that fact.
-  // A snap spread over updates jumps from the state predicted where it began.
+  // the threshold, unless the solve slid along a flat valley on its branch and saw no
+  // sign of leaving it (summary.snapped: an inertia change, or the followed minimum
+  // gone). The status is DecideStatus's, now with that fact. A snap spread over updates
+  // jumps from the state predicted where it began.
   if (!continuing_snap) snap_origin_ = x_pred_;
   const double jump = (x_ - snap_origin_).lpNorm<Eigen::Infinity>();
-  result_.summary.status = DecideStatus(result_.summary, options_.degeneracy_ratio, jump > snap_threshold_);
+  const bool slid = result_.summary.flat_valley && !result_.summary.snapped;
+  const bool left_branch = jump > snap_threshold_ && !slid;
+  result_.summary.status = DecideStatus(result_.summary, options_.degeneracy_ratio, left_branch);
   result_.snapped = result_.summary.status == EquilibriumStatus::kSnapped;
   // After a snap the secant would point along the jump: restart it (and during one).
   have_prev_ = !result_.snapped && result_.summary.status != EquilibriumStatus::kSnapping;
@@ -263,7 +266,12 @@ bool EquilibriumTracker::TangentPrediction(const Vec& u) {
   }
   if (!scratch_.allFinite()) return false;
   const double step = scratch_.lpNorm<Eigen::Infinity>();
-  const double cap = 5.0 * snap_threshold_;
+  // The cap keeps a wild tangent from throwing the warm start far; it grows with the
+  // control step past hand speed (kHandSpeedStep), where the tangent's step grows with
+  // it: cut to a fixed length, the prediction leaves the grasp's segment compressed by
+  // most of the control step (an indefinite E_xx at the warm start, taken for a fold).
+  constexpr double kHandSpeedStep = 0.01;
+  const double cap = 5.0 * snap_threshold_ * std::max(1.0, du_.lpNorm<Eigen::Infinity>() / kHandSpeedStep);
   x_pred_ -= (step > cap ? cap / step : 1.0) * scratch_;
   return true;
 }
