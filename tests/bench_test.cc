@@ -419,9 +419,10 @@ TEST(BenchPath, AccuracyComparesEveryRowWithTheReference) {
   EXPECT_DOUBLE_EQ(b.coverage_resolved, 0.5);  // row 2 covered, row 3 has no estimate
 }
 
-// On a short n = 10 path at the default settings, the reference (cutoff 1e-11, no force
-// tolerance, no iteration limit) ends converged on every row, every row's force is within
-// the target, and the certified estimate covers it.
+// On a short n = 10 path at the default settings every row's force is within the target
+// of its own state polished to round-off, the certified estimate covers it, and the
+// independent sweep (cutoff 1e-11, force tolerance 1e-8, no iteration limit) ends
+// converged on every row and agrees within the target.
 TEST(BenchPath, DefaultSettingsMeetTheAccuracyTargetOnAShortPath) {
   const Scene base = LoadScene(std::string(SNAPTHREAD_TEST_SOURCE_DIR) + "/scenes/thread3d_loop.yaml");
   const PathOptions o;
@@ -429,14 +430,15 @@ TEST(BenchPath, DefaultSettingsMeetTheAccuracyTargetOnAShortPath) {
   const std::vector<Vec> controls = Thread3dPathControls(scene, 40);
   auto tracker = MakeTracker(scene);
   tracker->Reset(controls[0]);
-  std::vector<Vec> forces{tracker->last().force};
+  std::vector<Vec> states{tracker->state()}, forces{tracker->last().force};
   std::vector<double> estimates{tracker->last().summary.force_error};
   for (size_t i = 1; i < controls.size(); ++i) {
     const TrackResult& r = tracker->Update(controls[i]);
+    states.push_back(tracker->state());
     forces.push_back(r.force);
     estimates.push_back(r.summary.force_error);
   }
-  const PathAccuracy a = MeasurePathAccuracy(scene, controls, forces, estimates, o);
+  const PathAccuracy a = MeasurePathAccuracy(scene, controls, states, forces, estimates, o);
   ASSERT_TRUE(a.ran);
   EXPECT_EQ(a.rows, 40);
   EXPECT_EQ(a.reference_not_converged, 0);
@@ -444,6 +446,7 @@ TEST(BenchPath, DefaultSettingsMeetTheAccuracyTargetOnAShortPath) {
   EXPECT_EQ(a.rows_without_estimate, 0);
   EXPECT_GE(a.coverage, 0.95) << a.coverage;
   EXPECT_GT(a.estimate_median, 0.0);
+  EXPECT_LE(a.sweep_error_max, o.force_target) << a.sweep_error_max;
 }
 
 #ifdef SNAPTHREAD_HAVE_CERES

@@ -13,6 +13,7 @@
 
 #include "models/model.h"
 #include "models/params.h"
+#include "polish.h"
 #include "solvers/options.h"
 #include "solvers/summary.h"
 
@@ -89,11 +90,6 @@ ModelParams AccuracyCellParams(const AccuracyCell& cell);
 // degrees (hand speed) or 90 (large steps).
 std::vector<Vec> AccuracyCellControls(const AccuracyCell& cell);
 
-// Damped Newton steps (E_xx + mu I) dx = -E_x from x while |E_x| falls (mu from 0, x10
-// on a refused step, /100 on a kept one; 12 refusals in a row or 200 steps end it): the
-// equilibrium next to x at round-off. Independent of the solvers: the model and a linear
-// solver only.
-Vec PolishToRoundOff(const Model& model, const Vec& u, Vec x);
 
 // Runs one cell with `options` (the defaults) against the reference.
 AccuracyCellResult RunAccuracyCell(const AccuracyCell& cell, const SolverOptions& options = {});

@@ -242,7 +242,7 @@ std::vector<PathRow> RunPathBench(const std::string& scenes_dir, const PathOptio
                 << "; E, E_x, E_xx into the band " << row.assembly_us.median << " us, its factorisation "
                 << row.factor_us.median << " us, a solve " << row.solve_us.median << " us)\n"
                 << std::defaultfloat << std::flush;
-    if (o.accuracy) row.accuracy = MeasurePathAccuracy(scene, controls, forces, estimates, o, progress);
+    if (o.accuracy) row.accuracy = MeasurePathAccuracy(scene, controls, states, forces, estimates, o, progress);
     if (!o.ceres) {
       row.ceres.note = "not run (--no-ceres)";
     } else if (!CeresBuilt()) {
@@ -262,7 +262,7 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
          "ceres_rows_not_converged,ceres_start_on_saddle,assembly_us_median,factor_us_median,solve_us_median,"
          "ceres_equal_us_median,project_force_error_max,project_force_error_median,force_error_max,"
          "force_error_median,estimate_max,estimate_median,coverage,estimate_ratio_median,rows_over_target,"
-         "reference_not_converged,coverage_resolved,rows_resolved,reference_estimate_max,reference_estimate_median\n";
+         "reference_not_converged,coverage_resolved,rows_resolved,reference_estimate_max,reference_estimate_median,sweep_error_max,sweep_error_median\n";
   out << std::setprecision(6);
   for (const auto& r : rows) {
     const auto& c = r.ceres;
@@ -279,7 +279,8 @@ void WritePathCsv(const std::vector<PathRow>& rows, std::ostream& out) {
         << r.accuracy.coverage << ',' << r.accuracy.ratio_median << ',' << r.accuracy.rows_over_target << ','
         << r.accuracy.reference_not_converged << ',' << r.accuracy.coverage_resolved << ','
         << r.accuracy.rows_resolved << ',' << r.accuracy.reference_estimate_max << ','
-        << r.accuracy.reference_estimate_median << '\n';
+        << r.accuracy.reference_estimate_median << ',' << r.accuracy.sweep_error_max << ','
+        << r.accuracy.sweep_error_median << '\n';
   }
 }
 

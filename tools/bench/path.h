@@ -63,6 +63,12 @@ struct PathAccuracy {
   int rows_over_target = 0;            // true error > PathOptions::force_target
   // The reference's own certified error / ForceScale over rows 1..steps: how exact the truth is.
   double reference_estimate_max = 0.0, reference_estimate_median = 0.0;
+  // The same path solved again at the reference's tolerances (an independent sweep):
+  // |F - F_sweep|_inf / ForceScale. Where the valley floor is flat to round-off (n = 1000)
+  // the sweep settles on another point of it, so this measures path dependence within
+  // round-off, not the row's error.
+  double sweep_error_max = 0.0, sweep_error_median = 0.0;
+  int sweep_not_converged = 0;
 };
 // The statistics of PathAccuracy from the per-row forces, certified estimates (model
 // units, -1 = none) and reference forces (rows 1..end; row 0, the reset, is left out).
@@ -70,11 +76,13 @@ struct PathAccuracy {
 PathAccuracy CompareWithReference(const std::vector<Vec>& forces, const std::vector<double>& estimates,
                                   const std::vector<Vec>& reference_forces, double force_scale, double force_target,
                                   const std::vector<double>& reference_estimates = {});
-// Runs the reference sweep of `scene` along `controls` and compares (CompareWithReference);
-// one line of progress when `progress` is set.
-PathAccuracy MeasurePathAccuracy(const Scene& scene, const std::vector<Vec>& controls, const std::vector<Vec>& forces,
-                                 const std::vector<double>& estimates, const PathOptions& options,
-                                 std::ostream* progress = nullptr);
+// Compares each row with the reference: its own state polished to round-off by damped
+// Newton steps (PolishToRoundOff: the model and a linear solver only, independent of the
+// solvers), and with an independent sweep at the reference's tolerances; one line of
+// progress when `progress` is set.
+PathAccuracy MeasurePathAccuracy(const Scene& scene, const std::vector<Vec>& controls, const std::vector<Vec>& states,
+                                 const std::vector<Vec>& forces, const std::vector<double>& estimates,
+                                 const PathOptions& options, std::ostream* progress = nullptr);
 
 // One Ceres run: a trust-region strategy and linear solver (CeresSolverNames) and the
 // ||E_x||_2 cutoff that stops each row.
