@@ -9,9 +9,9 @@
 #include <iomanip>
 #include <string>
 
-#include "linalg/linear_solver.h"
 #include "models/models.h"
 #include "path.h"
+#include "polish.h"
 
 namespace snapthread {
 
@@ -38,43 +38,15 @@ struct PolishedTrace {
 PolishedTrace MakePolishedTrace(const Scene& scene, const std::vector<Vec>& controls,
                                 const std::vector<Vec>& states) {
   const auto model = MakeModel(scene.params);
-  std::string error;
-  auto factor = MakeLinearSolver("auto", model->NumStates(), model->HessianBandwidth(), &error);
-  SparseMatrix h = model->HessianPattern();
-  factor->Analyze(h);
   PolishedTrace ref;
   std::vector<double> gradients;
-  Vec g, trial_g, dx, eu;
+  Vec g, eu;
   for (size_t i = 0; i < controls.size(); ++i) {
     const Vec& u = controls[i];
-    Vec x = states[i];
-    model->Gradient(x, u, &g);
     // Damped so that a step along the softest mode (lambda_min ~1e-11 at n = 1000, far
-    // beyond where E_x is linear) does not stall the polish: (E_xx + mu I) dx = -E_x,
-    // kept when it lowers ||E_x||_2 (Levenberg's rule on the gradient norm, mu from 0).
-    double mu = 0.0;
-    for (int step = 0, failures = 0; step < 200 && failures < 12; ++step) {
-      model->Hessian(x, u, &h);
-      for (int j = 0; j < h.rows(); ++j) h.coeffRef(j, j) += mu;
-      bool kept = false;
-      if (factor->Factorize(h) == LinearSolverStatus::kSuccess &&
-          factor->Solve(-g, &dx) == LinearSolverStatus::kSuccess) {
-        const Vec trial = x + dx;
-        model->Gradient(trial, u, &trial_g);
-        if (trial_g.allFinite() && trial_g.norm() < g.norm()) {
-          x = trial;
-          g = trial_g;
-          kept = true;
-        }
-      }
-      if (kept) {
-        failures = 0;
-        mu = mu < 1e-12 ? 0.0 : mu / 100;
-      } else {
-        ++failures;
-        mu = mu == 0.0 ? 1e-10 : 10 * mu;
-      }
-    }
+    // beyond where E_x is linear) does not stall the polish (tools/polish.h).
+    const Vec x = PolishToRoundOff(*model, u, states[i]);
+    model->Gradient(x, u, &g);
     model->ControlGradient(x, u, &eu);
     ref.moved_max = std::max(ref.moved_max, (x - states[i]).lpNorm<Eigen::Infinity>());
     ref.states.push_back(x);
